@@ -1,0 +1,50 @@
+"""The package's small error hierarchy.
+
+Every exception raised for malformed input derives from :class:`HexapodWorkspaceError`.
+An unreachable *pose* is a result, never an exception.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "ConfigError",
+    "GeometryError",
+    "HexapodWorkspaceError",
+    "InputError",
+    "LogReadError",
+    "RecordingError",
+    "ResolutionError",
+    "UnreachableReferenceError",
+]
+
+
+class HexapodWorkspaceError(Exception):
+    """Base class of every error this package raises on purpose."""
+
+
+class ConfigError(HexapodWorkspaceError, ValueError):
+    """A parameter of the configuration is missing, malformed or out of range."""
+
+
+class GeometryError(ConfigError):
+    """The manipulator geometry or its limits are invalid."""
+
+
+class InputError(HexapodWorkspaceError, ValueError):
+    """A request (poses, position, direction) is malformed: wrong shape, NaN or infinite."""
+
+
+class ResolutionError(InputError):
+    """A requested resolution (rays, slices, tolerance) is outside the supported bounds."""
+
+
+class UnreachableReferenceError(HexapodWorkspaceError):
+    """The reference orientation is itself unreachable, so the workspace is empty."""
+
+
+class RecordingError(HexapodWorkspaceError):
+    """An MCAP log could not be written."""
+
+
+class LogReadError(HexapodWorkspaceError):
+    """An MCAP log could not be read (missing, truncated beyond use, or not a log)."""
