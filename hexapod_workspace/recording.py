@@ -388,7 +388,8 @@ def message_to_fields(message: Any) -> Any:
         return {
             f.name: message_to_fields(getattr(message, f.name))
             for f in dataclasses.fields(message)
-            if f.name != _EMPTY_FIELD
+            # constants are upper case; rosbags adds __msgtype__
+            if f.name != _EMPTY_FIELD and not f.name.startswith("__") and not f.name.isupper()
         }
     if hasattr(message, "get_fields_and_field_types"):  # an rclpy message
         return {

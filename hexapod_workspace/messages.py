@@ -1,0 +1,566 @@
+"""The single mapping from core results to ROS message fields, ROS-free.
+
+Every function returns plain nested dicts keyed by the ROS field names of the message named in
+its docstring (nested messages are dicts, message arrays lists of dicts, ``uint8[]`` is
+``bytes``, numeric arrays numpy arrays). The node fills rclpy messages from them; the CLI's
+``--record`` builds rosbags messages from them (:func:`hexapod_workspace.recording.serialize`);
+replay reads recorded messages back with the inverse helpers at the end of this module.
+
+Units are SI (m, rad) as everywhere in the package. Stamps are ns since the epoch.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike, NDArray
+
+    from hexapod_workspace.constraints import CheckResult
+    from hexapod_workspace.orientation import OrientationWorkspace
+    from hexapod_workspace.projected import ProjectedWorkspace
+
+__all__ = [
+    "KIND_NAMES",
+    "ORIENTATION",
+    "POINT_FIELD_NAMES",
+    "PROJECTED_EXACT",
+    "PROJECTED_TORSION_ZERO",
+    "TOPICS",
+    "TYPES",
+    "boundary_points",
+    "check_poses_request_fields",
+    "check_poses_response_fields",
+    "commanded_pose_fields",
+    "compute_workspace_request_fields",
+    "compute_workspace_response_fields",
+    "header_fields",
+    "point_fields",
+    "pointcloud_fields",
+    "pointcloud_to_array",
+    "pose_check_fields",
+    "pose_checks_fields",
+    "reachability_result_fields",
+    "stamp_fields",
+    "stamp_to_ns",
+    "summary_fields",
+    "summary_line",
+    "tilt_torsion_fields",
+    "workspace_kind",
+    "workspace_request_fields",
+]
+
+#: WorkspaceRequest.kind constants (msg_defs/msg/WorkspaceRequest.msg).
+ORIENTATION = 0
+PROJECTED_TORSION_ZERO = 1
+PROJECTED_EXACT = 2
+#: kind -> name used by the CLI and the core (``method`` of a projected workspace).
+KIND_NAMES = {
+    ORIENTATION: "orientation",
+    PROJECTED_TORSION_ZERO: "torsion_zero",
+    PROJECTED_EXACT: "exact",
+}
+#: PointCloud2 fields of a boundary cloud, all float32, in this order (point_step 24 bytes).
+POINT_FIELD_NAMES = ("x", "y", "z", "phi", "theta", "psi")
+_FLOAT32 = 7  # sensor_msgs/PointField.FLOAT32
+
+#: Topic and service names the node uses and the CLI records under (the node is named
+#: ``hexapod_workspace``; ``~/boundary`` resolves to ``/hexapod_workspace/boundary``).
+TOPICS = {
+    "workspace_request": "/hexapod_workspace/workspace_request",
+    "commanded_pose": "/hexapod_workspace/commanded_pose",
+    "boundary": "/hexapod_workspace/boundary",
+    "summary": "/hexapod_workspace/summary",
+    "reachability": "/hexapod_workspace/reachability",
+    "check_poses": "/hexapod_workspace/check_poses",
+    "compute_workspace": "/hexapod_workspace/compute_workspace",
+    "compute_orientation_workspace": "/hexapod_workspace/compute_orientation_workspace",
+    "compute_projected_workspace": "/hexapod_workspace/compute_projected_workspace",
+}
+#: ROS type of each entry of :data:`TOPICS` (services: the service type).
+TYPES = {
+    "workspace_request": "hexapod_workspace_msgs/msg/WorkspaceRequest",
+    "commanded_pose": "hexapod_workspace_msgs/msg/CommandedPose",
+    "boundary": "sensor_msgs/msg/PointCloud2",
+    "summary": "hexapod_workspace_msgs/msg/WorkspaceSummary",
+    "reachability": "hexapod_workspace_msgs/msg/ReachabilityResult",
+    "check_poses": "hexapod_workspace_msgs/srv/CheckPoses",
+    "compute_workspace": "hexapod_workspace_msgs/srv/ComputeWorkspace",
+    "compute_orientation_workspace": "std_srvs/srv/Trigger",
+    "compute_projected_workspace": "std_srvs/srv/Trigger",
+}
+
+
+# --------------------------------------------------------------------------- small pieces
+
+
+def stamp_fields(stamp_ns: int) -> dict[str, int]:
+    """builtin_interfaces/msg/Time from ns since the epoch."""
+    sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
+    return {"sec": sec, "nanosec": nanosec}
+
+
+def stamp_to_ns(stamp: Any) -> int:
+    """ns since the epoch from a Time dict or message (``sec``, ``nanosec``)."""
+    sec, nanosec = _get(stamp, "sec"), _get(stamp, "nanosec")
+    return int(sec) * 1_000_000_000 + int(nanosec)
+
+
+def header_fields(stamp_ns: int, frame_id: str) -> dict[str, Any]:
+    """std_msgs/msg/Header."""
+    return {"stamp": stamp_fields(stamp_ns), "frame_id": str(frame_id)}
+
+
+def point_fields(position: ArrayLike) -> dict[str, float]:
+    """geometry_msgs/msg/Point from a (3,) position, m."""
+    x, y, z = (float(v) for v in np.asarray(position, dtype=float).reshape(3))
+    return {"x": x, "y": y, "z": z}
+
+
+def tilt_torsion_fields(angles: ArrayLike) -> dict[str, float]:
+    """hexapod_workspace_msgs/msg/TiltTorsion from (φ, θ, ψ), rad."""
+    phi, theta, psi = (float(v) for v in np.asarray(angles, dtype=float).reshape(3))
+    return {"phi": phi, "theta": theta, "psi": psi}
+
+
+# --------------------------------------------------------------------------- pose checks
+
+
+def pose_check_fields(result: CheckResult, index: int) -> dict[str, Any]:
+    """hexapod_workspace_msgs/msg/PoseCheck of pose ``index`` of a check result."""
+    margins = result.margins
+    return {
+        "reachable": bool(result.reachable[index]),
+        "violated": list(result.violated[index]),
+        "leg_length_margin": float(margins["leg_length"][index]),
+        "base_joint_margin": float(margins["base_joint"][index]),
+        "platform_joint_margin": float(margins["platform_joint"][index]),
+        "leg_interference_margin": float(margins["leg_interference"][index]),
+        "limiting_leg": int(result.limiting_leg[index]),
+    }
+
+
+def pose_checks_fields(result: CheckResult) -> list[dict[str, Any]]:
+    """PoseCheck dicts of every pose of a check result, in order."""
+    violated = result.violated
+    columns = {
+        "leg_length_margin": result.margins["leg_length"].tolist(),
+        "base_joint_margin": result.margins["base_joint"].tolist(),
+        "platform_joint_margin": result.margins["platform_joint"].tolist(),
+        "leg_interference_margin": result.margins["leg_interference"].tolist(),
+    }
+    reachable = result.reachable.tolist()
+    limiting = np.asarray(result.limiting_leg).tolist()
+    return [
+        {
+            "reachable": bool(reachable[i]),
+            "violated": list(violated[i]),
+            **{name: float(values[i]) for name, values in columns.items()},
+            "limiting_leg": int(limiting[i]),
+        }
+        for i in range(len(reachable))
+    ]
+
+
+def _failed_pose_check() -> dict[str, Any]:
+    nan = math.nan
+    return {
+        "reachable": False,
+        "violated": [],
+        "leg_length_margin": nan,
+        "base_joint_margin": nan,
+        "platform_joint_margin": nan,
+        "leg_interference_margin": nan,
+        "limiting_leg": 0,
+    }
+
+
+def check_poses_request_fields(position: ArrayLike, angles: ArrayLike) -> dict[str, Any]:
+    """hexapod_workspace_msgs/srv/CheckPoses_Request from a position (3,) m and angles (N, 3)."""
+    angles = np.asarray(angles, dtype=float).reshape(-1, 3)
+    return {
+        "position": point_fields(position),
+        "orientations": [{"phi": p, "theta": t, "psi": s} for p, t, s in angles.tolist()],
+    }
+
+
+def check_poses_response_fields(
+    result: CheckResult | None, *, success: bool = True, message: str | None = None
+) -> dict[str, Any]:
+    """hexapod_workspace_msgs/srv/CheckPoses_Response.
+
+    ``result=None`` (or ``success=False``) gives a failure response with an empty result list;
+    the default message is ``"N/M reachable"``.
+    """
+    if result is None or not success:
+        return {"success": False, "message": message or "request failed", "results": []}
+    reachable = int(np.count_nonzero(result.reachable))
+    return {
+        "success": True,
+        "message": message if message is not None else f"{reachable}/{len(result)} reachable",
+        "results": pose_checks_fields(result),
+    }
+
+
+def commanded_pose_fields(
+    angles: ArrayLike,
+    position: ArrayLike,
+    *,
+    request_id: str = "",
+    stamp_ns: int = 0,
+    frame_id: str = "",
+) -> dict[str, Any]:
+    """hexapod_workspace_msgs/msg/CommandedPose."""
+    return {
+        "header": header_fields(stamp_ns, frame_id),
+        "request_id": str(request_id),
+        "position": point_fields(position),
+        "orientation": tilt_torsion_fields(angles),
+    }
+
+
+def reachability_result_fields(
+    result: CheckResult | None,
+    *,
+    position: ArrayLike,
+    angles: ArrayLike,
+    stamp_ns: int,
+    frame_id: str,
+    request_id: str = "",
+    index: int = 0,
+    message: str | None = None,
+) -> dict[str, Any]:
+    """hexapod_workspace_msgs/msg/ReachabilityResult answering one CommandedPose.
+
+    ``result=None`` means the command itself was invalid: ``success`` false, margins NaN,
+    ``message`` the reason.
+    """
+    if result is None:
+        check = _failed_pose_check()
+        verdict = message or "invalid command"
+    else:
+        check = pose_check_fields(result, index)
+        verdict = message or (
+            "reachable" if check["reachable"] else "unreachable: " + ", ".join(check["violated"])
+        )
+    return {
+        "header": header_fields(stamp_ns, frame_id),
+        "request_id": str(request_id),
+        "success": result is not None,
+        "message": verdict,
+        "position": point_fields(position),
+        "orientation": tilt_torsion_fields(angles),
+        "check": check,
+    }
+
+
+# --------------------------------------------------------------------------- workspaces
+
+
+def workspace_kind(workspace: ProjectedWorkspace | OrientationWorkspace) -> int:
+    """WorkspaceRequest kind of a result: ORIENTATION, PROJECTED_TORSION_ZERO or _EXACT."""
+    method = getattr(workspace, "method", None)
+    if method is None:
+        return ORIENTATION
+    return PROJECTED_EXACT if method == "exact" else PROJECTED_TORSION_ZERO
+
+
+def workspace_request_fields(
+    kind: int,
+    position: ArrayLike,
+    *,
+    request_id: str = "",
+    n_rays: int = 0,
+    psi_step: float = 0.0,
+    tolerance: float = 0.0,
+    stamp_ns: int = 0,
+    frame_id: str = "",
+) -> dict[str, Any]:
+    """hexapod_workspace_msgs/msg/WorkspaceRequest (0 resolution fields = node parameter)."""
+    return {
+        "header": header_fields(stamp_ns, frame_id),
+        "request_id": str(request_id),
+        "kind": int(kind),
+        "position": point_fields(position),
+        "n_rays": int(n_rays),
+        "psi_step": float(psi_step),
+        "tolerance": float(tolerance),
+    }
+
+
+def _request_for(
+    workspace: ProjectedWorkspace | OrientationWorkspace,
+    *,
+    request_id: str,
+    stamp_ns: int,
+    frame_id: str,
+) -> dict[str, Any]:
+    kind = workspace_kind(workspace)
+    if kind == ORIENTATION:
+        n_rays, psi_step = int(workspace.n_rays), float(workspace.psi_step)
+    else:
+        n_rays, psi_step = int(np.asarray(workspace.phi).shape[0]), 0.0
+    return workspace_request_fields(
+        kind,
+        workspace.position,
+        request_id=request_id,
+        n_rays=n_rays,
+        psi_step=psi_step,
+        tolerance=float(workspace.tolerance),
+        stamp_ns=stamp_ns,
+        frame_id=frame_id,
+    )
+
+
+def compute_workspace_request_fields(
+    workspace: ProjectedWorkspace | OrientationWorkspace,
+    *,
+    request_id: str = "",
+    stamp_ns: int = 0,
+    frame_id: str = "",
+) -> dict[str, Any]:
+    """hexapod_workspace_msgs/srv/ComputeWorkspace_Request that asks for what ``workspace``
+    answers (kind, position, resolution used): what the CLI records as its request."""
+    return {
+        "request": _request_for(
+            workspace, request_id=request_id, stamp_ns=stamp_ns, frame_id=frame_id
+        )
+    }
+
+
+def boundary_points(workspace: ProjectedWorkspace | OrientationWorkspace) -> NDArray[np.float64]:
+    """Boundary points of a result, columns x, y, z, φ, θ, ψ (see ComputeWorkspace.srv).
+
+    Returns
+    -------
+    ndarray, shape (M, 6)
+        Orientation workspace: x, y, z = θ cos φ, θ sin φ, ψ (the cylindrical picture).
+        Projected workspace: x, y, z = the unit approach vector of each boundary direction.
+    """
+    if workspace_kind(workspace) == ORIENTATION:
+        return np.asarray(workspace.boundary_points(), dtype=float).reshape(-1, 6)
+    phi = np.asarray(workspace.phi, dtype=float)
+    theta = np.asarray(workspace.theta, dtype=float)
+    psi = np.broadcast_to(np.asarray(workspace.psi, dtype=float), phi.shape)
+    sin_theta = np.sin(theta)
+    return np.column_stack(
+        (np.cos(phi) * sin_theta, np.sin(phi) * sin_theta, np.cos(theta), phi, theta, psi)
+    )
+
+
+def summary_fields(
+    workspace: ProjectedWorkspace | OrientationWorkspace | None,
+    *,
+    stamp_ns: int,
+    frame_id: str,
+    request_id: str = "",
+    kind: int | None = None,
+    position: ArrayLike | None = None,
+    n_points: int | None = None,
+    success: bool = True,
+    reference_reachable: bool = True,
+    message: str | None = None,
+    n_rays: int = 0,
+    tolerance: float = math.nan,
+) -> dict[str, Any]:
+    """hexapod_workspace_msgs/msg/WorkspaceSummary.
+
+    Parameters
+    ----------
+    workspace : ProjectedWorkspace, OrientationWorkspace or None
+        ``None`` for a failed computation (then give ``kind``, ``position``, ``message``, and
+        ``reference_reachable=False`` when the reference orientation was unreachable).
+    stamp_ns, frame_id : int, str
+        Header; use the same stamp for the summary and its boundary cloud.
+    n_points : int, optional
+        Points of the published cloud; default the number of boundary points.
+
+    Fields that do not apply to the kind are NaN.
+    """
+    nan = math.nan
+    fields: dict[str, Any] = {
+        "header": header_fields(stamp_ns, frame_id),
+        "request_id": str(request_id),
+        "tilt_min": nan,
+        "tilt_max": nan,
+        "solid_angle": nan,
+        "psi_min": nan,
+        "psi_max": nan,
+        "volume": nan,
+    }
+    if workspace is None or not success:
+        fields.update(
+            kind=int(kind if kind is not None else ORIENTATION),
+            success=False,
+            message=message or "workspace computation failed",
+            position=point_fields(position if position is not None else np.zeros(3)),
+            reference_reachable=bool(reference_reachable) and workspace is not None,
+            n_rays=int(n_rays),
+            tolerance=float(tolerance),
+            n_points=int(n_points or 0),
+            elapsed=0.0 if workspace is None else float(workspace.elapsed),
+        )
+        return fields
+    kind = workspace_kind(workspace) if kind is None else int(kind)
+    if kind == ORIENTATION:
+        fields.update(
+            psi_min=float(workspace.psi_min),
+            psi_max=float(workspace.psi_max),
+            volume=float(workspace.volume),
+            n_rays=int(workspace.n_rays),
+        )
+    else:
+        fields.update(
+            tilt_min=float(workspace.tilt_min),
+            tilt_max=float(workspace.tilt_max),
+            solid_angle=float(workspace.solid_angle),
+            n_rays=int(np.asarray(workspace.phi).shape[0]),
+        )
+    fields.update(
+        kind=kind,
+        success=True,
+        position=point_fields(workspace.position),
+        reference_reachable=True,
+        tolerance=float(workspace.tolerance),
+        n_points=int(n_points if n_points is not None else boundary_points(workspace).shape[0]),
+        elapsed=float(workspace.elapsed),
+    )
+    fields["message"] = message if message is not None else summary_line(fields)
+    return fields
+
+
+def pointcloud_fields(points: ArrayLike, *, frame_id: str, stamp_ns: int) -> dict[str, Any]:
+    """sensor_msgs/msg/PointCloud2 of boundary points: float32 x, y, z, phi, theta, psi.
+
+    Parameters
+    ----------
+    points : array_like, shape (M, 6)
+        Columns :data:`POINT_FIELD_NAMES` (:func:`boundary_points`).
+
+    Returns
+    -------
+    dict
+        Unorganised cloud (height 1), little-endian, point_step 24, ``data`` as ``bytes``
+        (an rclpy message wants ``array.array("B", data)``: assigning bytes-likes directly to
+        ``PointCloud2.data`` is slow for large clouds).
+    """
+    array = np.ascontiguousarray(np.asarray(points).reshape(-1, 6), dtype="<f4")
+    count = array.shape[0]
+    return {
+        "header": header_fields(stamp_ns, frame_id),
+        "height": 1,
+        "width": count,
+        "fields": [
+            {"name": name, "offset": 4 * i, "datatype": _FLOAT32, "count": 1}
+            for i, name in enumerate(POINT_FIELD_NAMES)
+        ],
+        "is_bigendian": False,
+        "point_step": 24,
+        "row_step": 24 * count,
+        "data": array.tobytes(),
+        "is_dense": bool(np.isfinite(array).all()),
+    }
+
+
+def compute_workspace_response_fields(
+    workspace: ProjectedWorkspace | OrientationWorkspace | None,
+    *,
+    stamp_ns: int,
+    frame_id: str,
+    request_id: str = "",
+    summary: Mapping[str, Any] | None = None,
+    boundary: Mapping[str, Any] | None = None,
+) -> dict[str, Any]:
+    """hexapod_workspace_msgs/srv/ComputeWorkspace_Response (summary + boundary cloud).
+
+    Pass ``summary``/``boundary`` dicts already built for publishing to avoid building them
+    twice; for a failure pass ``workspace=None`` and a failed ``summary``.
+    """
+    if summary is None:
+        summary = summary_fields(
+            workspace, stamp_ns=stamp_ns, frame_id=frame_id, request_id=request_id
+        )
+    if boundary is None:
+        points = boundary_points(workspace) if workspace is not None else np.zeros((0, 6))
+        boundary = pointcloud_fields(points, frame_id=frame_id, stamp_ns=stamp_ns)
+    return {
+        "success": bool(summary["success"]),
+        "message": str(summary["message"]),
+        "summary": dict(summary),
+        "boundary": dict(boundary),
+    }
+
+
+# --------------------------------------------------------------------------- inverse (replay)
+
+
+def _get(obj: Any, name: str) -> Any:
+    return obj[name] if isinstance(obj, Mapping) else getattr(obj, name)
+
+
+def pointcloud_to_array(cloud: Any) -> NDArray[np.float64]:
+    """Boundary points back from a PointCloud2 (dict, rosbags or rclpy message).
+
+    Returns
+    -------
+    ndarray, shape (M, 6), float64
+        Columns x, y, z, φ, θ, ψ; a column whose field the cloud lacks is NaN.
+
+    Raises
+    ------
+    ValueError
+        When ``data`` is shorter than ``width * height * point_step`` or a field is not
+        FLOAT32/FLOAT64.
+    """
+    count = int(_get(cloud, "width")) * int(_get(cloud, "height"))
+    step = int(_get(cloud, "point_step"))
+    order = ">" if bool(_get(cloud, "is_bigendian")) else "<"
+    data = _get(cloud, "data")
+    if isinstance(data, np.ndarray):
+        buffer = np.ascontiguousarray(data).view(np.uint8).reshape(-1)
+    else:  # bytes, bytearray, memoryview, array.array("B") of an rclpy message
+        buffer = np.frombuffer(data, dtype=np.uint8)
+    if buffer.size < count * step:
+        msg = f"PointCloud2 data has {buffer.size} bytes, expected {count * step}"
+        raise ValueError(msg)
+    out = np.full((count, 6), np.nan)
+    if count == 0:
+        return out
+    rows = buffer[: count * step].reshape(count, step)
+    for point_field in _get(cloud, "fields"):
+        name = str(_get(point_field, "name"))
+        if name not in POINT_FIELD_NAMES:
+            continue
+        datatype, offset = int(_get(point_field, "datatype")), int(_get(point_field, "offset"))
+        if datatype not in (7, 8):
+            msg = f"PointCloud2 field {name} has datatype {datatype}, expected FLOAT32/FLOAT64"
+            raise ValueError(msg)
+        width = 4 if datatype == 7 else 8
+        column = np.ascontiguousarray(rows[:, offset : offset + width]).view(f"{order}f{width}")
+        out[:, POINT_FIELD_NAMES.index(name)] = column[:, 0]
+    return out
+
+
+def summary_line(summary: Any) -> str:
+    """One-line human summary of a WorkspaceSummary (dict or message), degrees."""
+    kind = int(_get(summary, "kind"))
+    name = KIND_NAMES.get(kind, f"kind {kind}")
+    if not bool(_get(summary, "success")):
+        return f"{name}: failed: {_get(summary, 'message')}"
+    if kind == ORIENTATION:
+        return (
+            f"{name}: psi {math.degrees(_get(summary, 'psi_min')):.3f}..."
+            f"{math.degrees(_get(summary, 'psi_max')):.3f} deg, "
+            f"volume {float(_get(summary, 'volume')):.6g} rad^3, "
+            f"{int(_get(summary, 'n_points'))} boundary points"
+        )
+    return (
+        f"{name}: tilt {math.degrees(_get(summary, 'tilt_min')):.3f}..."
+        f"{math.degrees(_get(summary, 'tilt_max')):.3f} deg, "
+        f"solid angle {float(_get(summary, 'solid_angle')):.6g} sr, "
+        f"{int(_get(summary, 'n_points'))} boundary points"
+    )
