@@ -36,7 +36,7 @@ setup(
     name=PACKAGE,
     version="0.1.0",
     description="Orientation workspace of hexapods (Gough-Stewart platforms), CLI and ROS 2 node",
-    long_description=open("README.md", encoding="utf-8").read(),
+    long_description=(HERE / "README.md").read_text(encoding="utf-8"),
     long_description_content_type="text/markdown",
     license="Apache-2.0",
     python_requires=">=3.10",
