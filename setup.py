@@ -32,6 +32,7 @@ class BuildPyWithData(build_py):
                 if path.suffix in {".yaml", ".msg", ".srv"}:
                     shutil.copy2(path, target / path.name)
 
+
 setup(
     name=PACKAGE,
     version="0.1.0",
