@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# colcon build of both ROS packages into build/ install/ (log/): the interface package
+# hexapod_workspace_msgs (msg_defs/, ament_cmake + rosidl) and the ament_python package
+# hexapod_workspace (repository root). colcon stops descending at the root package.xml, so both
+# paths are named explicitly. Needs the full venv (tools/venv.sh full).
+#
+# Idempotent: skipped when no source file is newer than the last successful build.
+# FORCE=1 rebuilds anyway; extra arguments go to colcon build.
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+cd "$ROOT"
+
+stamp="$ROOT/install/.hexapod_build_stamp"
+sources=(msg_defs hexapod_workspace config launch resource setup.py setup.cfg package.xml
+         README.md "$VENV/.stamp-full")
+if [[ "${FORCE:-0}" != 1 && $# -eq 0 && -f "$stamp" ]] \
+   && [[ -z "$(find "${sources[@]}" -type f -newer "$stamp" -not -name '*.pyc' -print -quit 2>/dev/null)" ]]; then
+  log "colcon build up to date"
+  exit 0
+fi
+
+"$ROOT/tools/patch_ros_cmake.sh"
+start=$SECONDS
+log "colcon build (hexapod_workspace_msgs, hexapod_workspace)"
+PATH="$VENV/bin:$PATH" CMAKE_PREFIX_PATH="$VENV" AMENT_PREFIX_PATH="$VENV" \
+  "$VENV/bin/colcon" build --base-paths "$ROOT" "$ROOT/msg_defs" "$@" \
+  --cmake-args -DPython3_EXECUTABLE="$VENV/bin/python" -DBUILD_TESTING=OFF
+touch "$stamp"
+log "colcon build done in $((SECONDS - start)) s"
