@@ -1,0 +1,39 @@
+"""hexapod_workspace: orientation workspace of 6-DOF parallel manipulators (hexapods, GPMs).
+
+The core (model, kinematics, constraints, workspace algorithms) depends on numpy and the
+standard library only; ROS 2 lives in :mod:`hexapod_workspace.ros`.
+
+Units are SI (m, rad). Orientations are Tilt-and-Torsion angles (φ, θ, ψ) with
+``R = Rz(φ) Ry(θ) Rz(−φ) Rz(ψ)``; see :mod:`hexapod_workspace.rotations`.
+"""
+
+from .constraints import CONSTRAINT_NAMES, CheckResult, check
+from .errors import (
+    ConfigError,
+    GeometryError,
+    HexapodWorkspaceError,
+    InputError,
+    LogReadError,
+    RecordingError,
+    ResolutionError,
+    UnreachableReferenceError,
+)
+from .manipulator import HomePoseWarning, Manipulator
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "CONSTRAINT_NAMES",
+    "CheckResult",
+    "ConfigError",
+    "GeometryError",
+    "HexapodWorkspaceError",
+    "HomePoseWarning",
+    "InputError",
+    "LogReadError",
+    "Manipulator",
+    "RecordingError",
+    "ResolutionError",
+    "UnreachableReferenceError",
+    "check",
+]

@@ -1,0 +1,384 @@
+"""The manipulator model: joint positions, joint axes and limits of a 6-UPS hexapod (GPM).
+
+Built from a ROS 2 parameters file or a plain mapping (what the node holds), validated as a
+whole. Every error names the parameter, what was expected and what was given.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .errors import ConfigError, GeometryError
+from .params import flatten, load_params_file
+
+__all__ = ["PARAMETER_DEFAULTS", "HomePoseWarning", "Manipulator"]
+
+#: Parameters of the model with their defaults; ``None`` means required.
+PARAMETER_DEFAULTS: dict[str, Any] = {
+    "frame_id": "base",
+    "geometry.base_joints": None,
+    "geometry.platform_joints": None,
+    "geometry.home_position": None,
+    "geometry.base_joint_axes": [],
+    "geometry.platform_joint_axes": [],
+    "limits.leg_length_min": None,
+    "limits.leg_length_max": None,
+    "limits.base_joint_max_angle": None,
+    "limits.platform_joint_max_angle": None,
+    "limits.leg_diameter": 0.0,
+    "pose.position": None,
+}
+_MODEL_GROUPS = ("geometry.", "limits.", "pose.")
+
+
+class HomePoseWarning(UserWarning):
+    """The home pose (home position, identity orientation) violates a constraint."""
+
+
+def _describe(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _numbers(name: str, value: Any) -> NDArray[np.float64]:
+    """A flat float array from a parameter value, refusing non-numbers and non-finite values."""
+    if isinstance(value, (str, bytes)) or value is None:
+        msg = f"{name}: expected numbers, got {_describe(value)}"
+        raise ConfigError(msg)
+    items = list(np.ravel(np.asarray(value, dtype=object))) if np.ndim(value) else [value]
+    for item in items:
+        if isinstance(item, (bool, np.bool_)) or not isinstance(item, (int, float, np.number)):
+            msg = f"{name}: expected numbers, got {_describe(value)}"
+            raise ConfigError(msg)
+    array = np.asarray(items, dtype=np.float64)
+    if not np.all(np.isfinite(array)):
+        msg = f"{name}: expected finite numbers, got {_describe(value)}"
+        raise ConfigError(msg)
+    return array
+
+
+def _joint_array(name: str, value: Any) -> NDArray[np.float64]:
+    array = _numbers(name, value)
+    if array.size != 18:
+        msg = f"{name}: expected 18 numbers (6 joints × x, y, z), got {array.size}"
+        raise GeometryError(msg)
+    return array.reshape(6, 3)
+
+
+def _vector3(name: str, value: Any) -> NDArray[np.float64]:
+    array = _numbers(name, value)
+    if array.size != 3:
+        msg = f"{name}: expected 3 numbers (x, y, z), got {array.size}"
+        raise GeometryError(msg)
+    return array
+
+
+def _per_leg(name: str, value: Any) -> NDArray[np.float64]:
+    array = _numbers(name, value)
+    if array.size not in (1, 6):
+        msg = f"{name}: expected 1 or 6 numbers, got {array.size}"
+        raise GeometryError(msg)
+    return np.broadcast_to(array, (6,)).copy()
+
+
+def _axes(name: str, value: Any) -> NDArray[np.float64] | None:
+    array = _numbers(name, value)
+    if array.size == 0:
+        return None
+    if array.size != 18:
+        msg = f"{name}: expected 18 numbers (6 axes × x, y, z) or an empty list, got {array.size}"
+        raise GeometryError(msg)
+    axes = array.reshape(6, 3)
+    norms = np.linalg.norm(axes, axis=1)
+    zero = np.flatnonzero(norms < 1e-12)
+    if zero.size:
+        msg = f"{name}: expected non-zero axes, axis of joint {zero[0] + 1} is zero"
+        raise GeometryError(msg)
+    return axes / norms[:, None]
+
+
+def _frozen(array: NDArray[np.float64]) -> NDArray[np.float64]:
+    array = np.ascontiguousarray(array, dtype=np.float64)
+    array.setflags(write=False)
+    return array
+
+
+@dataclass(frozen=True, eq=False)
+class Manipulator:
+    """A 6-UPS Gough-Stewart platform: geometry, joint axes and limits, validated.
+
+    Attributes
+    ----------
+    base_joints : ndarray, shape (6, 3)
+        a_i = OA_i, centres of the base (universal) joints, base frame, m.
+    platform_joints : ndarray, shape (6, 3)
+        b_i = CB'_i, centres of the platform (spherical) joints, mobile frame (origin at the
+        tool tip C), m.
+    base_joint_axes : ndarray, shape (6, 3)
+        jA_i, unit axes of symmetry of the base joints, base frame, pointing into the legs.
+    platform_joint_axes : ndarray, shape (6, 3)
+        jB_i, unit axes of symmetry of the platform joints, mobile frame, pointing into the legs.
+    leg_length_min, leg_length_max : ndarray, shape (6,)
+        Leg length limits, m.
+    base_joint_max_angle, platform_joint_max_angle : ndarray, shape (6,)
+        Maximum angle between a joint axis and its leg, rad, in (0, π).
+    leg_diameter : float
+        D, m; legs must stay at least D apart (segment distance); 0 disables the check.
+    home_position : ndarray, shape (3,)
+        Home position OC, base frame, m; the default joint axes are the leg directions there.
+    position : ndarray, shape (3,)
+        Default tool-tip position OC (``pose.position``), base frame, m.
+    frame_id : str
+        Name of the base frame in published results.
+    axes_from_home : tuple of bool
+        Whether the (base, platform) joint axes were derived from the home pose (not given).
+    """
+
+    base_joints: NDArray[np.float64]
+    platform_joints: NDArray[np.float64]
+    base_joint_axes: NDArray[np.float64]
+    platform_joint_axes: NDArray[np.float64]
+    leg_length_min: NDArray[np.float64]
+    leg_length_max: NDArray[np.float64]
+    base_joint_max_angle: NDArray[np.float64]
+    platform_joint_max_angle: NDArray[np.float64]
+    leg_diameter: float
+    home_position: NDArray[np.float64]
+    position: NDArray[np.float64]
+    frame_id: str = "base"
+    axes_from_home: tuple[bool, bool] = field(default=(True, True))
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def from_mapping(cls, parameters: Mapping[str, Any], *, warn: bool = True) -> Manipulator:
+        """Build and validate a manipulator from parameters.
+
+        Parameters
+        ----------
+        parameters : Mapping
+            Nested (as in the parameters file under ``ros__parameters``) or dotted names
+            (``"geometry.base_joints"``, as a ROS node holds them), or mixed. Keys outside the
+            ``geometry``, ``limits`` and ``pose`` groups and ``frame_id`` are ignored (they
+            belong to the node: resolution, recording).
+        warn : bool
+            Emit a :class:`HomePoseWarning` when the home pose violates a constraint.
+
+        Returns
+        -------
+        Manipulator
+
+        Raises
+        ------
+        GeometryError
+            Invalid geometry or limits (names the parameter, the expectation and the value).
+        ConfigError
+            Missing or unknown model parameters, non-numbers, non-finite values.
+        """
+        flat = flatten(parameters)
+        unknown = sorted(
+            name
+            for name in flat
+            if name.startswith(_MODEL_GROUPS) and name not in PARAMETER_DEFAULTS
+        )
+        if unknown:
+            msg = f"{unknown[0]}: unknown parameter (expected one of {_model_names()})"
+            raise ConfigError(msg)
+        values = dict(PARAMETER_DEFAULTS)
+        values.update({k: v for k, v in flat.items() if k in PARAMETER_DEFAULTS})
+        if values["pose.position"] is None:
+            values["pose.position"] = values["geometry.home_position"]
+        missing = [name for name, value in values.items() if value is None]
+        if missing:
+            msg = f"{missing[0]}: required parameter is missing"
+            raise ConfigError(msg)
+
+        frame_id = values["frame_id"]
+        if not isinstance(frame_id, str) or not frame_id.strip():
+            msg = f"frame_id: expected a non-empty string, got {_describe(frame_id)}"
+            raise ConfigError(msg)
+
+        base_joints = _joint_array("geometry.base_joints", values["geometry.base_joints"])
+        platform_joints = _joint_array(
+            "geometry.platform_joints", values["geometry.platform_joints"]
+        )
+        home = _vector3("geometry.home_position", values["geometry.home_position"])
+        position = _vector3("pose.position", values["pose.position"])
+        length_min = _per_leg("limits.leg_length_min", values["limits.leg_length_min"])
+        length_max = _per_leg("limits.leg_length_max", values["limits.leg_length_max"])
+        if np.any(length_min < 0.0):
+            msg = f"limits.leg_length_min: expected values >= 0 m, got {length_min.min():g}"
+            raise GeometryError(msg)
+        bad = np.flatnonzero(length_min >= length_max)
+        if bad.size:
+            i = bad[0]
+            msg = (
+                f"limits.leg_length_min: expected < limits.leg_length_max for every leg, "
+                f"got {length_min[i]:g} >= {length_max[i]:g} m for leg {i + 1}"
+            )
+            raise GeometryError(msg)
+        angles = {}
+        for name in ("limits.base_joint_max_angle", "limits.platform_joint_max_angle"):
+            angle = _per_leg(name, values[name])
+            outside = np.flatnonzero((angle <= 0.0) | (angle >= math.pi))
+            if outside.size:
+                msg = (
+                    f"{name}: expected angles in (0, pi) rad, "
+                    f"got {angle[outside[0]]:g} for leg {outside[0] + 1}"
+                )
+                raise GeometryError(msg)
+            angles[name] = angle
+        diameter = _numbers("limits.leg_diameter", values["limits.leg_diameter"])
+        if diameter.size != 1:
+            msg = f"limits.leg_diameter: expected one number, got {diameter.size}"
+            raise GeometryError(msg)
+        if diameter[0] < 0.0:
+            msg = f"limits.leg_diameter: expected a value >= 0 m, got {diameter[0]:g}"
+            raise GeometryError(msg)
+
+        legs_home = home + platform_joints - base_joints
+        lengths_home = np.linalg.norm(legs_home, axis=1)
+        degenerate = np.flatnonzero(lengths_home < 1e-9)
+        if degenerate.size:
+            msg = (
+                f"geometry.home_position: expected non-zero legs at the home pose, "
+                f"leg {degenerate[0] + 1} has zero length there"
+            )
+            raise GeometryError(msg)
+        directions_home = legs_home / lengths_home[:, None]
+        base_axes = _axes("geometry.base_joint_axes", values["geometry.base_joint_axes"])
+        platform_axes = _axes(
+            "geometry.platform_joint_axes", values["geometry.platform_joint_axes"]
+        )
+        manipulator = cls(
+            base_joints=_frozen(base_joints),
+            platform_joints=_frozen(platform_joints),
+            base_joint_axes=_frozen(directions_home if base_axes is None else base_axes),
+            platform_joint_axes=_frozen(
+                -directions_home if platform_axes is None else platform_axes
+            ),
+            leg_length_min=_frozen(length_min),
+            leg_length_max=_frozen(length_max),
+            base_joint_max_angle=_frozen(angles["limits.base_joint_max_angle"]),
+            platform_joint_max_angle=_frozen(angles["limits.platform_joint_max_angle"]),
+            leg_diameter=float(diameter[0]),
+            home_position=_frozen(home),
+            position=_frozen(position),
+            frame_id=frame_id,
+            axes_from_home=(base_axes is None, platform_axes is None),
+        )
+        if warn:
+            problems = manipulator.home_pose_violations()
+            if problems:
+                warnings.warn(
+                    f"the home pose (position {home.tolist()} m, identity orientation) is "
+                    f"unreachable: {', '.join(problems)} violated",
+                    HomePoseWarning,
+                    stacklevel=2,
+                )
+        return manipulator
+
+    @classmethod
+    def from_params_file(cls, path: str | Path, *, warn: bool = True) -> Manipulator:
+        """Build a manipulator from a ROS 2 parameters file (root key ``hexapod_workspace``
+        or ``/**``).
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            YAML parameters file, as in DESIGN.md section 4.
+        warn : bool
+            See :meth:`from_mapping`.
+
+        Returns
+        -------
+        Manipulator
+        """
+        return cls.from_mapping(load_params_file(path), warn=warn)
+
+    # ------------------------------------------------------------------ views
+    def to_parameters(self) -> dict[str, Any]:
+        """The model as ROS parameters (dotted names, plain Python values).
+
+        ``Manipulator.from_mapping(m.to_parameters())`` rebuilds an equal manipulator; joint axes
+        that were derived from the home pose are given back as empty lists so that they keep
+        following ``geometry.home_position``.
+
+        Returns
+        -------
+        dict
+            ``{"frame_id": str, "geometry.base_joints": [18 floats], ...}``.
+        """
+
+        def floats(array: NDArray[np.float64]) -> list[float]:
+            return [float(v) for v in np.ravel(array)]
+
+        return {
+            "frame_id": self.frame_id,
+            "geometry.base_joints": floats(self.base_joints),
+            "geometry.platform_joints": floats(self.platform_joints),
+            "geometry.home_position": floats(self.home_position),
+            "geometry.base_joint_axes": []
+            if self.axes_from_home[0]
+            else floats(self.base_joint_axes),
+            "geometry.platform_joint_axes": []
+            if self.axes_from_home[1]
+            else floats(self.platform_joint_axes),
+            "limits.leg_length_min": floats(self.leg_length_min),
+            "limits.leg_length_max": floats(self.leg_length_max),
+            "limits.base_joint_max_angle": floats(self.base_joint_max_angle),
+            "limits.platform_joint_max_angle": floats(self.platform_joint_max_angle),
+            "limits.leg_diameter": float(self.leg_diameter),
+            "pose.position": floats(self.position),
+        }
+
+    def with_position(self, position: Any) -> Manipulator:
+        """A copy whose default position (``pose.position``) is ``position`` (m, base frame)."""
+        from dataclasses import replace
+
+        return replace(self, position=_frozen(_vector3("position", position)))
+
+    def home_pose_violations(self) -> list[str]:
+        """Names of the constraints violated at the home pose (home position, identity)."""
+        from .constraints import check
+
+        result = check(self, np.zeros((1, 3)), self.home_position)
+        return result.violated[0]
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Manipulator):
+            return NotImplemented
+        arrays_equal = all(
+            np.array_equal(getattr(self, name), getattr(other, name))
+            for name in (
+                "base_joints",
+                "platform_joints",
+                "base_joint_axes",
+                "platform_joint_axes",
+                "leg_length_min",
+                "leg_length_max",
+                "base_joint_max_angle",
+                "platform_joint_max_angle",
+                "home_position",
+                "position",
+            )
+        )
+        return (
+            arrays_equal
+            and self.leg_diameter == other.leg_diameter
+            and self.frame_id == other.frame_id
+            and self.axes_from_home == other.axes_from_home
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+def _model_names() -> str:
+    return ", ".join(name for name in PARAMETER_DEFAULTS if name.startswith(_MODEL_GROUPS))

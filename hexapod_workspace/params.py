@@ -1,0 +1,107 @@
+"""Read ROS 2 parameters files (the configuration format shared by the node and the CLI).
+
+A parameters file maps a node name (``hexapod_workspace``, ``/hexapod_workspace`` or the
+wildcard ``/**``) to ``{"ros__parameters": {...}}``. This module returns that mapping flattened
+to the node's dotted parameter names (``geometry.base_joints``, ...);
+:meth:`hexapod_workspace.Manipulator.from_mapping` interprets it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from .errors import ConfigError
+
+__all__ = ["NODE_NAME", "flatten", "load_params_file"]
+
+#: The node name, and the root key the CLI looks for in a parameters file.
+NODE_NAME = "hexapod_workspace"
+_ROOT_KEYS = (NODE_NAME, f"/{NODE_NAME}", "/**")
+
+
+def load_params_file(path: str | Path) -> dict[str, Any]:
+    """Load the ``ros__parameters`` mapping of this node from a ROS 2 parameters file.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        YAML parameters file.
+
+    Returns
+    -------
+    dict
+        Dotted parameter names to values (``{"geometry.base_joints": [...], ...}``). When the
+        file has both a wildcard ``/**`` section and a ``hexapod_workspace`` section, the latter's
+        values override the former's, as ROS does.
+
+    Raises
+    ------
+    ConfigError
+        When the file is missing, is not YAML, or has no section for this node.
+    """
+    import yaml  # PyYAML: only the configuration loader needs it
+
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as error:
+        msg = f"cannot read parameters file {path}: {error.strerror or error}"
+        raise ConfigError(msg) from error
+    try:
+        document = yaml.safe_load(text)
+    except yaml.YAMLError as error:
+        where = getattr(error, "problem_mark", None)
+        line = f" (line {where.line + 1})" if where is not None else ""
+        msg = f"parameters file {path} is not valid YAML{line}"
+        raise ConfigError(msg) from error
+    if not isinstance(document, Mapping):
+        msg = f"parameters file {path}: expected a mapping at the top level"
+        raise ConfigError(msg)
+    merged: dict[str, Any] = {}
+    found = False
+    for key in ("/**", f"/{NODE_NAME}", NODE_NAME):
+        section = document.get(key)
+        if section is None:
+            continue
+        if not isinstance(section, Mapping) or not isinstance(
+            section.get("ros__parameters"), Mapping
+        ):
+            msg = f"parameters file {path}: section {key!r} has no 'ros__parameters' mapping"
+            raise ConfigError(msg)
+        found = True
+        merged.update(flatten(section["ros__parameters"]))
+    if not found:
+        msg = (
+            f"parameters file {path}: no section for this node "
+            f"(expected one of {', '.join(repr(k) for k in _ROOT_KEYS)})"
+        )
+        raise ConfigError(msg)
+    return merged
+
+
+def flatten(parameters: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
+    """Flatten nested parameter mappings into ROS-style dotted names.
+
+    Parameters
+    ----------
+    parameters : Mapping
+        Nested (``{"limits": {"leg_diameter": 0.05}}``), dotted (``{"limits.leg_diameter":
+        0.05}``) or mixed.
+    prefix : str
+        Prefix for the names (used by the recursion).
+
+    Returns
+    -------
+    dict
+        ``{"limits.leg_diameter": 0.05, ...}``.
+    """
+    flat: dict[str, Any] = {}
+    for key, value in parameters.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, Mapping):
+            flat.update(flatten(value, prefix=f"{name}."))
+        else:
+            flat[name] = value
+    return flat

@@ -1,0 +1,346 @@
+"""Tilt-and-Torsion angles and the other orientation representations, batch-first.
+
+Conventions (DESIGN.md section 1): the Tilt-and-Torsion (T&T) angles (φ, θ, ψ) of Bonev & Ryu
+define ``R(φ, θ, ψ) = Rz(φ) · Ry(θ) · Rz(−φ) · Rz(ψ)``, the orientation of the mobile frame
+relative to the base frame, with φ ∈ (−π, π] (azimuth of the tilt axis), θ ∈ [0, π] (tilt) and
+ψ ∈ [−π, π] (torsion). The same rotation in ZYZ Euler angles is (φ, θ, ψ − φ). The *approach
+vector* (the tool axis z' in the base frame) is ``(cos φ sin θ, sin φ sin θ, cos θ)``.
+
+At θ = 0 the T&T representation is singular: φ and ψ merge and ``R = Rz(ψ)``. Every function
+here is defined there: the forward maps need no special case and the inverse maps return φ = 0
+and the whole rotation in ψ. At θ = π (tool pointing straight down) the approach vector has no
+azimuth either; the inverse maps return φ = 0 there too.
+
+Quaternions are ``(x, y, z, w)``, scalar last, as in ROS ``geometry_msgs/Quaternion``.
+All functions take arrays of any leading shape ``(...)`` and broadcast like numpy.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .errors import InputError
+
+__all__ = [
+    "approach_vector",
+    "matrix_to_quaternion",
+    "matrix_to_tt",
+    "quaternion_to_matrix",
+    "quaternion_to_tt",
+    "tt_to_matrix",
+    "tt_to_quaternion",
+    "tt_to_zyz",
+    "wrap_angle",
+    "zyz_to_matrix",
+    "zyz_to_tt",
+]
+
+#: Below this value of sin θ the inverse maps treat the rotation as lying on a singularity.
+SINGULAR_SIN = 1e-12
+
+
+def _last_axis(values: ArrayLike, size: int, name: str) -> NDArray[np.float64]:
+    array = np.asarray(values, dtype=np.float64)
+    if array.ndim == 0 or array.shape[-1] != size:
+        msg = f"{name}: expected an array of shape (..., {size}), got shape {array.shape}"
+        raise InputError(msg)
+    return array
+
+
+def wrap_angle(angle: ArrayLike) -> NDArray[np.float64]:
+    """Wrap angles into (−π, π].
+
+    Parameters
+    ----------
+    angle : array_like, shape (...)
+        Angles in rad.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        The same angles in (−π, π], rad.
+    """
+    angle = np.asarray(angle, dtype=np.float64)
+    wrapped = np.remainder(angle + np.pi, 2.0 * np.pi) - np.pi
+    return np.where(wrapped == -np.pi, np.pi, wrapped)
+
+
+def zyz_to_matrix(zyz: ArrayLike) -> NDArray[np.float64]:
+    """Rotation matrices from ZYZ Euler angles ``Rz(α) · Ry(β) · Rz(γ)``.
+
+    Parameters
+    ----------
+    zyz : array_like, shape (..., 3)
+        (α, β, γ) in rad.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        Rotation matrices (mobile frame expressed in the base frame).
+    """
+    zyz = _last_axis(zyz, 3, "zyz")
+    return _zyz_matrix(zyz[..., 0], zyz[..., 1], zyz[..., 2])
+
+
+def _zyz_matrix(
+    alpha: NDArray[np.float64], beta: NDArray[np.float64], gamma: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    cb, sb = np.cos(beta), np.sin(beta)
+    cg, sg = np.cos(gamma), np.sin(gamma)
+    matrix = np.empty((*np.shape(alpha), 3, 3))
+    matrix[..., 0, 0] = ca * cb * cg - sa * sg
+    matrix[..., 0, 1] = -ca * cb * sg - sa * cg
+    matrix[..., 0, 2] = ca * sb
+    matrix[..., 1, 0] = sa * cb * cg + ca * sg
+    matrix[..., 1, 1] = -sa * cb * sg + ca * cg
+    matrix[..., 1, 2] = sa * sb
+    matrix[..., 2, 0] = -sb * cg
+    matrix[..., 2, 1] = sb * sg
+    matrix[..., 2, 2] = cb
+    return matrix
+
+
+def tt_to_zyz(angles: ArrayLike) -> NDArray[np.float64]:
+    """Convert T&T angles (φ, θ, ψ) to ZYZ Euler angles (φ, θ, ψ − φ).
+
+    Parameters
+    ----------
+    angles : array_like, shape (..., 3)
+        (φ, θ, ψ) in rad.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        (α, β, γ) in rad, γ wrapped into (−π, π].
+    """
+    angles = _last_axis(angles, 3, "angles")
+    zyz = angles.copy()
+    zyz[..., 2] = wrap_angle(angles[..., 2] - angles[..., 0])
+    return zyz
+
+
+def zyz_to_tt(zyz: ArrayLike) -> NDArray[np.float64]:
+    """Convert ZYZ Euler angles (α, β, γ) to T&T angles in their canonical ranges.
+
+    Parameters
+    ----------
+    zyz : array_like, shape (..., 3)
+        (α, β, γ) in rad, any values.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        (φ, θ, ψ) in rad with φ ∈ (−π, π], θ ∈ [0, π], ψ ∈ (−π, π]; φ = 0 on the
+        singularities θ = 0 and θ = π.
+    """
+    return matrix_to_tt(zyz_to_matrix(zyz))
+
+
+def tt_to_matrix(angles: ArrayLike) -> NDArray[np.float64]:
+    """Rotation matrices from T&T angles, ``Rz(φ) · Ry(θ) · Rz(ψ − φ)``.
+
+    Parameters
+    ----------
+    angles : array_like, shape (..., 3)
+        (φ, θ, ψ) in rad. Any values are accepted (θ outside [0, π] is the same rotation as
+        its canonical representative).
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        Rotation matrices of the mobile frame in the base frame; column 2 is the approach
+        vector.
+    """
+    angles = _last_axis(angles, 3, "angles")
+    phi = angles[..., 0]
+    return _zyz_matrix(phi, angles[..., 1], angles[..., 2] - phi)
+
+
+def matrix_to_tt(matrix: ArrayLike) -> NDArray[np.float64]:
+    """T&T angles of rotation matrices.
+
+    Parameters
+    ----------
+    matrix : array_like, shape (..., 3, 3)
+        Rotation matrices (assumed orthonormal with determinant 1).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        (φ, θ, ψ) in rad, φ ∈ (−π, π], θ ∈ [0, π], ψ ∈ (−π, π]. On the singularities
+        (sin θ < 1e-12) φ = 0 and ψ carries the whole rotation about the tool axis.
+    """
+    matrix = np.asarray(matrix, dtype=np.float64)
+    if matrix.ndim < 2 or matrix.shape[-2:] != (3, 3):
+        msg = f"matrix: expected an array of shape (..., 3, 3), got shape {matrix.shape}"
+        raise InputError(msg)
+    r02, r12, r22 = matrix[..., 0, 2], matrix[..., 1, 2], matrix[..., 2, 2]
+    sin_theta = np.hypot(r02, r12)
+    theta = np.arctan2(sin_theta, r22)
+    regular = sin_theta >= SINGULAR_SIN
+    phi = np.where(regular, np.arctan2(r12, r02), 0.0)
+    gamma = np.arctan2(matrix[..., 2, 1], -matrix[..., 2, 0])
+    psi_regular = gamma + phi
+    # θ = 0: R = Rz(ψ). θ = π: R = Ry(π) · Rz(ψ) with φ = 0, so R[0, 0] = −cos ψ, R[0, 1] = sin ψ.
+    psi_top = np.arctan2(matrix[..., 1, 0], matrix[..., 0, 0])
+    psi_bottom = np.arctan2(matrix[..., 0, 1], -matrix[..., 0, 0])
+    psi = np.where(regular, psi_regular, np.where(r22 > 0.0, psi_top, psi_bottom))
+    return np.stack([wrap_angle(phi), theta, wrap_angle(psi)], axis=-1)
+
+
+def tt_to_quaternion(angles: ArrayLike) -> NDArray[np.float64]:
+    """Unit quaternions ``(x, y, z, w)`` of T&T angles, in closed form.
+
+    With α + γ = ψ and α − γ = 2φ − ψ, the ZYZ quaternion gives
+    ``x = −sin(θ/2) sin(φ − ψ/2)``, ``y = sin(θ/2) cos(φ − ψ/2)``,
+    ``z = cos(θ/2) sin(ψ/2)``, ``w = cos(θ/2) cos(ψ/2)``.
+
+    Parameters
+    ----------
+    angles : array_like, shape (..., 3)
+        (φ, θ, ψ) in rad.
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+        Quaternions (x, y, z, w), unit norm.
+    """
+    angles = _last_axis(angles, 3, "angles")
+    phi, theta, psi = angles[..., 0], angles[..., 1], angles[..., 2]
+    half_tilt_sin, half_tilt_cos = np.sin(theta / 2.0), np.cos(theta / 2.0)
+    azimuth = phi - psi / 2.0
+    return np.stack(
+        [
+            -half_tilt_sin * np.sin(azimuth),
+            half_tilt_sin * np.cos(azimuth),
+            half_tilt_cos * np.sin(psi / 2.0),
+            half_tilt_cos * np.cos(psi / 2.0),
+        ],
+        axis=-1,
+    )
+
+
+def quaternion_to_matrix(quaternion: ArrayLike) -> NDArray[np.float64]:
+    """Rotation matrices of quaternions ``(x, y, z, w)`` (normalised first).
+
+    Parameters
+    ----------
+    quaternion : array_like, shape (..., 4)
+        Quaternions (x, y, z, w), any non-zero norm.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+
+    Raises
+    ------
+    InputError
+        When a quaternion has zero or non-finite norm.
+    """
+    quaternion = _last_axis(quaternion, 4, "quaternion")
+    norm = np.linalg.norm(quaternion, axis=-1)
+    if not np.all(np.isfinite(norm) & (norm > 0.0)):
+        msg = "quaternion: expected finite, non-zero quaternions"
+        raise InputError(msg)
+    x, y, z, w = np.moveaxis(quaternion / norm[..., None], -1, 0)
+    matrix = np.empty((*quaternion.shape[:-1], 3, 3))
+    matrix[..., 0, 0] = 1.0 - 2.0 * (y * y + z * z)
+    matrix[..., 0, 1] = 2.0 * (x * y - z * w)
+    matrix[..., 0, 2] = 2.0 * (x * z + y * w)
+    matrix[..., 1, 0] = 2.0 * (x * y + z * w)
+    matrix[..., 1, 1] = 1.0 - 2.0 * (x * x + z * z)
+    matrix[..., 1, 2] = 2.0 * (y * z - x * w)
+    matrix[..., 2, 0] = 2.0 * (x * z - y * w)
+    matrix[..., 2, 1] = 2.0 * (y * z + x * w)
+    matrix[..., 2, 2] = 1.0 - 2.0 * (x * x + y * y)
+    return matrix
+
+
+def matrix_to_quaternion(matrix: ArrayLike) -> NDArray[np.float64]:
+    """Unit quaternions ``(x, y, z, w)`` of rotation matrices, with w ≥ 0.
+
+    Uses the largest-diagonal branch (Shepperd's method) for accuracy everywhere.
+
+    Parameters
+    ----------
+    matrix : array_like, shape (..., 3, 3)
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+    """
+    matrix = np.asarray(matrix, dtype=np.float64)
+    if matrix.ndim < 2 or matrix.shape[-2:] != (3, 3):
+        msg = f"matrix: expected an array of shape (..., 3, 3), got shape {matrix.shape}"
+        raise InputError(msg)
+    m00, m11, m22 = matrix[..., 0, 0], matrix[..., 1, 1], matrix[..., 2, 2]
+    trace = m00 + m11 + m22
+    candidates = np.stack(
+        [
+            # 4w², 4x², 4y², 4z² up to a common factor: choose the largest for stability.
+            1.0 + trace,
+            1.0 + m00 - m11 - m22,
+            1.0 - m00 + m11 - m22,
+            1.0 - m00 - m11 + m22,
+        ],
+        axis=-1,
+    )
+    choice = np.argmax(candidates, axis=-1)
+    largest = np.sqrt(np.maximum(np.take_along_axis(candidates, choice[..., None], -1)[..., 0], 0))
+    s = 2.0 * largest
+    d21 = matrix[..., 2, 1] - matrix[..., 1, 2]
+    d02 = matrix[..., 0, 2] - matrix[..., 2, 0]
+    d10 = matrix[..., 1, 0] - matrix[..., 0, 1]
+    s01 = matrix[..., 0, 1] + matrix[..., 1, 0]
+    s02 = matrix[..., 0, 2] + matrix[..., 2, 0]
+    s12 = matrix[..., 1, 2] + matrix[..., 2, 1]
+    half = largest / 2.0
+    by_branch = np.stack(
+        [
+            np.stack([d21 / s, d02 / s, d10 / s, half], axis=-1),
+            np.stack([half, s01 / s, s02 / s, d21 / s], axis=-1),
+            np.stack([s01 / s, half, s12 / s, d02 / s], axis=-1),
+            np.stack([s02 / s, s12 / s, half, d10 / s], axis=-1),
+        ],
+        axis=-2,
+    )
+    quaternion = np.take_along_axis(by_branch, choice[..., None, None], axis=-2)[..., 0, :]
+    quaternion = np.where(quaternion[..., 3:4] < 0.0, -quaternion, quaternion)
+    return quaternion / np.linalg.norm(quaternion, axis=-1, keepdims=True)
+
+
+def quaternion_to_tt(quaternion: ArrayLike) -> NDArray[np.float64]:
+    """T&T angles of quaternions ``(x, y, z, w)`` (normalised first).
+
+    Parameters
+    ----------
+    quaternion : array_like, shape (..., 4)
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        (φ, θ, ψ) in rad, canonical ranges as :func:`matrix_to_tt`.
+    """
+    return matrix_to_tt(quaternion_to_matrix(quaternion))
+
+
+def approach_vector(phi: ArrayLike, theta: ArrayLike) -> NDArray[np.float64]:
+    """Unit approach vectors (tool axis z' in the base frame) of tool directions.
+
+    Parameters
+    ----------
+    phi, theta : array_like, broadcastable shapes (...)
+        Azimuth and tilt in rad.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        ``(cos φ sin θ, sin φ sin θ, cos θ)``; at θ = 0 it is (0, 0, 1) whatever φ.
+    """
+    phi, theta = np.broadcast_arrays(
+        np.asarray(phi, dtype=np.float64), np.asarray(theta, dtype=np.float64)
+    )
+    sin_theta = np.sin(theta)
+    return np.stack([np.cos(phi) * sin_theta, np.sin(phi) * sin_theta, np.cos(theta)], axis=-1)
