@@ -42,7 +42,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from mcap.exceptions import McapError
 from mcap.records import Channel, Chunk, Footer, Message, Schema
 from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.writer import CompressionType
@@ -888,15 +887,7 @@ def _records(path: Path, contents: LogContents) -> Iterator[Any]:
                 record = next(records)
             except StopIteration:
                 break
-            except (
-                McapError,
-                ValueError,
-                EOFError,
-                OSError,
-                IndexError,
-                UnicodeDecodeError,
-                MemoryError,
-            ) as err:
+            except Exception as err:  # any failure to frame or parse a record is damage
                 contents.finished = False
                 reason = str(err) or type(err).__name__
                 contents.problems.append(
@@ -907,7 +898,7 @@ def _records(path: Path, contents: LogContents) -> Iterator[Any]:
             if isinstance(record, Chunk):
                 try:
                     yield from breakup_chunk(record, validate_crc=True)
-                except (McapError, ValueError, EOFError, IndexError, UnicodeDecodeError) as err:
+                except Exception as err:  # any failure to frame or parse a record is damage
                     contents.problems.append(
                         f"{path.name}: a chunk of {record.uncompressed_size} bytes near byte "
                         f"{offset} is corrupt ({err}); its messages are skipped"

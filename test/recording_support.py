@@ -1,0 +1,83 @@
+"""Helpers shared by the recording tests: independent decoding and comparison after decoding.
+
+Compare decoded messages, never raw bytes (Fast-CDR does not zero its padding).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from mcap.exceptions import McapError
+from mcap.reader import NonSeekingReader
+from mcap_ros2.decoder import DecoderFactory
+from rosbags.highlevel import AnyReader
+from rosbags.typesys.msg import normalize_msgtype
+
+NAN = "nan"
+EMPTY_MEMBER = "structure_needs_at_least_one_member"  # rosidl's filler of empty messages
+
+
+def plain(value: Any) -> Any:
+    """Turn a message (dict, rosbags dataclass, mcap_ros2 or rclpy object) into comparable
+    nested dicts/lists; uint8 arrays become bytes, NaN becomes the string "nan"."""
+    if isinstance(value, Mapping):
+        return {k: plain(v) for k, v in value.items() if _is_field(k)}
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {
+            f.name: plain(getattr(value, f.name))
+            for f in dataclasses.fields(value)
+            if _is_field(f.name)
+        }
+    if hasattr(value, "get_fields_and_field_types"):  # rclpy
+        return {k: plain(getattr(value, k)) for k in value.get_fields_and_field_types()}
+    if hasattr(value, "__slots__") and not isinstance(value, (str, bytes)):  # mcap_ros2
+        return {k: plain(getattr(value, k)) for k in value.__slots__ if _is_field(k)}
+    if isinstance(value, (bytes, bytearray, memoryview)):
+        return bytes(value)
+    if isinstance(value, np.ndarray):
+        if value.dtype == np.uint8:
+            return value.tobytes()
+        return [plain(v) for v in value.tolist()]
+    if hasattr(value, "typecode"):  # array.array of an rclpy message
+        return value.tobytes() if value.typecode == "B" else [plain(v) for v in value.tolist()]
+    if isinstance(value, (list, tuple)):
+        return [plain(v) for v in value]
+    if isinstance(value, float) and math.isnan(value):
+        return NAN
+    if isinstance(value, (np.floating, np.integer, np.bool_)):
+        return plain(value.item())
+    return value
+
+
+def _is_field(name: str) -> bool:
+    return not name.startswith("_") and not name.isupper() and name != EMPTY_MEMBER
+
+
+def read_with_rosbags(path: Path) -> list[tuple[str, str, Any]]:
+    """(topic, type, decoded) of a finished log with rosbags' AnyReader and the log's own
+    schemas (an independent typestore)."""
+    out = []
+    with AnyReader([Path(path)]) as reader:
+        for connection, _, raw in reader.messages():
+            message = reader.typestore.deserialize_cdr(raw, normalize_msgtype(connection.msgtype))
+            out.append((connection.topic, connection.msgtype, message))
+    return out
+
+
+def read_with_mcap_ros2(path: Path) -> list[tuple[str, str, Any]]:
+    """(topic, schema name, decoded) with mcap's streaming reader and mcap_ros2's decoder;
+    stops quietly where a killed file ends."""
+    out = []
+    with Path(path).open("rb") as stream:
+        reader = NonSeekingReader(stream, decoder_factories=[DecoderFactory()])
+        try:
+            for schema, channel, _, decoded in reader.iter_decoded_messages(log_time_order=False):
+                out.append((channel.topic, schema.name, decoded))
+        except (McapError, EOFError, ValueError):
+            pass
+    return out

@@ -1,0 +1,437 @@
+"""Tests of hexapod_workspace.recording: rosbag2-form MCAP writing, durability, tolerant reading.
+
+Every recorded message is decoded by two independent readers (rosbags' AnyReader with the log's
+own schemas, and mcap + mcap_ros2) and compared with what was written, after decoding.
+"""
+
+from __future__ import annotations
+
+import errno
+import signal
+import subprocess
+import sys
+import textwrap
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from mcap.reader import make_reader
+from mcap.writer import Writer as RawMcapWriter
+from recording_support import plain, read_with_mcap_ros2, read_with_rosbags
+from rosbags.rosbag2 import StoragePlugin
+from rosbags.rosbag2 import Writer as Rosbag2Writer
+from rosbags.rosbag2.metadata import parse_qos
+
+from hexapod_workspace import constraints, messages, recording
+from hexapod_workspace._resources import data_dir, example_config_path
+from hexapod_workspace.errors import LogReadError, RecordingError
+from hexapod_workspace.manipulator import Manipulator
+
+SUMMARY = "hexapod_workspace_msgs/msg/WorkspaceSummary"
+CLOUD = "sensor_msgs/msg/PointCloud2"
+
+
+def sample_messages() -> list[tuple[str, str, str, dict]]:
+    """(topic, type, qos, fields) of every kind the node records, from real check results."""
+    manipulator = Manipulator.from_params_file(example_config_path())
+    angles = np.radians([[0.0, 0.0, 0.0], [30.0, 20.0, 5.0], [45.0, 80.0, 10.0]])
+    result = constraints.check(manipulator, angles)
+    rng = np.random.default_rng(7)
+    points = rng.normal(size=(50, 6))
+    summary = messages.summary_fields(
+        None,
+        stamp_ns=10,
+        frame_id="base",
+        kind=1,
+        position=[0, 0, 1],
+        reference_reachable=False,
+        message="reference orientation unreachable",
+    )
+    topics, types = messages.TOPICS, messages.TYPES
+    check_req, check_resp = recording.service_topics(topics["check_poses"])
+    trig_req, trig_resp = recording.service_topics(topics["compute_projected_workspace"])
+    cw_req, cw_resp = recording.service_topics(topics["compute_workspace"])
+    return [
+        (
+            topics["commanded_pose"],
+            types["commanded_pose"],
+            recording.REQUEST_QOS,
+            messages.commanded_pose_fields(angles[1], result.position, request_id="c1"),
+        ),
+        (
+            topics["reachability"],
+            types["reachability"],
+            recording.RESULT_QOS,
+            messages.reachability_result_fields(
+                result,
+                position=result.position,
+                angles=angles[1],
+                stamp_ns=11,
+                frame_id="base",
+                request_id="c1",
+                index=1,
+            ),
+        ),
+        (
+            topics["workspace_request"],
+            types["workspace_request"],
+            recording.REQUEST_QOS,
+            messages.workspace_request_fields(1, [0, 0, 1], request_id="w1", n_rays=36),
+        ),
+        (topics["summary"], types["summary"], recording.RESULT_QOS, summary),
+        (
+            topics["boundary"],
+            types["boundary"],
+            recording.RESULT_QOS,
+            messages.pointcloud_fields(points, frame_id="base", stamp_ns=10),
+        ),
+        (
+            check_req,
+            types["check_poses"] + "_Request",
+            recording.SERVICE_QOS,
+            messages.check_poses_request_fields(result.position, angles),
+        ),
+        (
+            check_resp,
+            types["check_poses"] + "_Response",
+            recording.SERVICE_QOS,
+            messages.check_poses_response_fields(result),
+        ),
+        (trig_req, "std_srvs/srv/Trigger_Request", recording.SERVICE_QOS, {}),
+        (
+            trig_resp,
+            "std_srvs/srv/Trigger_Response",
+            recording.SERVICE_QOS,
+            {"success": True, "message": "projected workspace: tilt 0..30 deg"},
+        ),
+        (
+            cw_req,
+            types["compute_workspace"] + "_Request",
+            recording.SERVICE_QOS,
+            {"request": messages.workspace_request_fields(2, [0, 0, 1])},
+        ),
+        (
+            cw_resp,
+            types["compute_workspace"] + "_Response",
+            recording.SERVICE_QOS,
+            messages.compute_workspace_response_fields(
+                None, stamp_ns=10, frame_id="base", summary=summary
+            ),
+        ),
+    ]
+
+
+@pytest.fixture(scope="module")
+def finished_log(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list]:
+    path = tmp_path_factory.mktemp("log") / "session.mcap"
+    written = []
+    with recording.LogWriter(path) as writer:
+        for i, (topic, msgtype, qos, fields) in enumerate(sample_messages()):
+            writer.write_fields(topic, msgtype, fields, 1_000_000_000 + i, qos=qos)
+            written.append((topic, msgtype, plain(fields)))
+    return path, written
+
+
+def test_typestore_has_every_interface_with_full_definitions() -> None:
+    for path in data_dir("msg").glob("*.msg"):
+        text = recording.message_definition(f"hexapod_workspace_msgs/msg/{path.stem}")
+        assert text.strip() or path.stem == "Empty"
+    text = recording.message_definition("hexapod_workspace_msgs/srv/CheckPoses_Request")
+    assert "=" * 80 + "\nMSG: hexapod_workspace_msgs/TiltTorsion\n" in text
+    assert "MSG: geometry_msgs/Point" in text
+    summary = recording.message_definition(SUMMARY)
+    assert "MSG: builtin_interfaces/Time" in summary  # ROS 2 form, not ROS 1 "time"
+    assert recording.type_hash(SUMMARY).startswith("RIHS01_")
+    with pytest.raises(KeyError, match="unknown ROS type"):
+        recording.message_definition("nope_msgs/msg/Nope")
+
+
+def test_every_message_decodes_with_rosbags_and_mcap_ros2(finished_log) -> None:
+    path, written = finished_log
+    expected = [(topic, msgtype, fields) for topic, msgtype, fields in written]
+    by_rosbags = [(t, m, plain(msg)) for t, m, msg in read_with_rosbags(path)]
+    by_mcap_ros2 = [(t, m, plain(msg)) for t, m, msg in read_with_mcap_ros2(path)]
+    ours = [(m.topic, m.msgtype, plain(m.message)) for m in recording.read_log(path).messages]
+    assert by_rosbags == expected
+    assert by_mcap_ros2 == expected
+    assert ours == expected
+
+
+def test_rosbag2_form_schemas_channels_statistics_metadata(finished_log) -> None:
+    path, written = finished_log
+    with path.open("rb") as stream:
+        reader = make_reader(stream)
+        header = reader.get_header()
+        summary = reader.get_summary()
+        metadata = {m.name: m.metadata for m in reader.iter_metadata()}
+    assert header.profile == "ros2"
+    assert summary.statistics.message_count == len(written)
+    assert summary.statistics.channel_count == len({t for t, _, _ in written})
+    assert all(s.encoding == "ros2msg" for s in summary.schemas.values())
+    for channel in summary.channels.values():
+        assert channel.message_encoding == "cdr"
+        qos = parse_qos(channel.metadata["offered_qos_profiles"])
+        assert len(qos) == 1
+        schema = summary.schemas[channel.schema_id]
+        assert channel.metadata["topic_type_hash"] == recording.type_hash(schema.name)
+    result_channel = next(c for c in summary.channels.values() if c.topic.endswith("/summary"))
+    assert parse_qos(result_channel.metadata["offered_qos_profiles"])[0].durability.name == (
+        "TRANSIENT_LOCAL"
+    )
+    info = yaml.safe_load(metadata["rosbag2"]["serialized_metadata"])
+    assert info["message_count"] == len(written) and info["storage_identifier"] == "mcap"
+    assert metadata["rosbag2"]["ros_distro"] == "jazzy"
+
+
+def test_bag_directory_written_by_rosbags_is_read(tmp_path: Path) -> None:
+    """The other rosbag2 form (directory + metadata.yaml), written by an independent writer."""
+    bag = tmp_path / "bag"
+    store = recording.get_typestore()
+    fields = messages.summary_fields(
+        None, stamp_ns=3, frame_id="base", kind=0, position=[0, 0, 1], message="bad"
+    )
+    with Rosbag2Writer(bag, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+        connection = writer.add_connection("/hexapod_workspace/summary", SUMMARY, typestore=store)
+        writer.write(connection, 5, recording.serialize(SUMMARY, fields))
+    contents = recording.read_log(bag)
+    assert [plain(m.message) for m in contents.messages] == [plain(fields)]
+    assert contents.finished and not contents.problems
+    (bag / "metadata.yaml").unlink()  # a killed `ros2 bag record` leaves no metadata.yaml
+    assert len(recording.read_log(bag).messages) == 1
+
+
+def test_close_is_idempotent_and_write_after_close_fails(tmp_path: Path) -> None:
+    writer = recording.LogWriter(tmp_path / "a.mcap")
+    writer.write_fields("/t", SUMMARY, {"request_id": "x"})
+    writer.close()
+    writer.finish()
+    assert writer.closed
+    with pytest.raises(RecordingError, match="closed"):
+        writer.write_fields("/t", SUMMARY, {})
+    with pytest.raises(KeyError):
+        recording.LogWriter(tmp_path / "b.mcap").write("/never-added", b"")
+
+
+def test_unwritable_directory_raises_recording_error(tmp_path: Path) -> None:
+    blocker = tmp_path / "a_file"
+    blocker.write_text("not a directory")
+    with pytest.raises(RecordingError, match="cannot create MCAP log"):
+        recording.LogWriter(blocker / "logs" / "x.mcap")
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full (Linux)")
+def test_full_disk_at_creation_raises_recording_error() -> None:
+    with pytest.raises(RecordingError, match="No space left on device"):
+        recording.LogWriter("/dev/full")
+
+
+# A file-size limit makes the disk "full" in the middle of a log, in a child process only.
+FULL_DISK_CHILD = textwrap.dedent(
+    """
+    import resource, signal, sys, threading
+    from hexapod_workspace import recording
+    from hexapod_workspace.errors import RecordingError
+    signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (200_000, 200_000))
+    path, mode = sys.argv[1], sys.argv[2]
+    reported = threading.Event()
+    def on_error(error):
+        print("on_error", error.__cause__.errno, flush=True)
+        reported.set()
+    writer = recording.LogWriter(path, flush_interval=0.01 if mode == "timer" else 0,
+                                 on_error=on_error)
+    writer.add_channel("/t", "sensor_msgs/msg/PointCloud2")
+    data = recording.serialize("sensor_msgs/msg/PointCloud2", {"data": bytes(300_000)})
+    writer.write("/t", data)
+    if mode == "timer":
+        print("reported", reported.wait(60), writer.closed, flush=True)
+    else:
+        try:
+            writer.flush()
+        except RecordingError as error:
+            print("raised", error, flush=True)
+        print("closed", writer.closed, flush=True)
+        try:
+            writer.write("/t", data)
+        except RecordingError:
+            print("refused", flush=True)
+    writer.close()
+    print("done", flush=True)
+    """
+)
+
+
+@pytest.mark.parametrize("mode", ["flush", "timer"])
+def test_disk_full_mid_log_is_reported_not_raised_elsewhere(tmp_path: Path, mode: str) -> None:
+    child = subprocess.run(
+        [sys.executable, "-c", FULL_DISK_CHILD, str(tmp_path / "full.mcap"), mode],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert child.returncode == 0, child.stderr
+    lines = child.stdout.splitlines()
+    if mode == "timer":
+        assert lines == [f"on_error {errno.EFBIG}", "reported True True", "done"]
+    else:
+        assert lines[0].startswith("raised writing MCAP log") and "File too large" in lines[0]
+        assert lines[1:] == ["closed True", "refused", "done"]
+    assert "Traceback" not in child.stderr
+    recording.read_log(tmp_path / "full.mcap")  # what reached the disk is still readable
+
+
+def test_run_log_path_is_named_by_start_time_and_unique(tmp_path: Path) -> None:
+    start = 1_763_758_800_123_000_000  # 2025-11-21T21:00:00.123Z
+    first = recording.run_log_path(tmp_path, start_ns=start)
+    assert first.name == "hexapod_workspace_20251121T210000.123Z.mcap"
+    first.touch()
+    assert recording.run_log_path(tmp_path, start_ns=start) != first
+
+
+# --------------------------------------------------------------------------- durability
+
+CHILD = textwrap.dedent(
+    """
+    import sys, time
+    from hexapod_workspace import recording
+    path, mode = sys.argv[1], sys.argv[2]
+    kwargs = {"count": dict(flush_interval=0, flush_messages=5),
+              "timer": dict(flush_interval=0.05, flush_messages=10_000)}[mode]
+    with recording.LogWriter(path, **kwargs) as writer:
+        total = 12 if mode == "count" else 3
+        for i in range(total):
+            writer.write_fields("/hexapod_workspace/summary",
+                                "hexapod_workspace_msgs/msg/WorkspaceSummary",
+                                {"request_id": f"r{i}", "n_points": i}, 1_000 + i)
+        print("written", flush=True)
+        while True:
+            time.sleep(0.05)
+    """
+)
+
+
+def start_child(path: Path, mode: str) -> subprocess.Popen:
+    child = subprocess.Popen(
+        [sys.executable, "-c", CHILD, str(path), mode], stdout=subprocess.PIPE, text=True
+    )
+    assert child.stdout.readline().strip() == "written"
+    return child
+
+
+def test_sigkill_keeps_every_flushed_message(tmp_path: Path) -> None:
+    """flush_messages=5: after 12 writes exactly 10 are on disk; a SIGKILL loses only the 2."""
+    path = tmp_path / "killed.mcap"
+    child = start_child(path, "count")
+    child.send_signal(signal.SIGKILL)
+    child.wait()
+    contents = recording.read_log(path)
+    assert [m.message.request_id for m in contents.messages] == [f"r{i}" for i in range(10)]
+    assert not contents.finished and contents.problems
+    by_mcap_ros2 = read_with_mcap_ros2(path)
+    assert [m.request_id for _, _, m in by_mcap_ros2] == [f"r{i}" for i in range(10)]
+    store_decoded = [recording.deserialize(m.msgtype, m.data) for m in contents.messages]
+    assert [plain(m) for m in store_decoded] == [plain(m.message) for m in contents.messages]
+
+
+def test_sigkill_after_the_flush_interval_keeps_messages(tmp_path: Path) -> None:
+    """The background flusher writes pending messages out without further writes."""
+    path = tmp_path / "timer.mcap"
+    child = start_child(path, "timer")
+    try:
+        # Wait (no timed assertion) until the flusher has written the 3 messages out.
+        for _ in range(1200):
+            if len(recording.read_log(path).messages) == 3:
+                break
+            threading.Event().wait(0.05)
+    finally:
+        child.send_signal(signal.SIGKILL)
+        child.wait()
+    assert [m.message.n_points for m in recording.read_log(path).messages] == [0, 1, 2]
+
+
+def test_sigint_finishes_a_playable_log(tmp_path: Path) -> None:
+    path = tmp_path / "interrupted.mcap"
+    child = start_child(path, "count")
+    child.send_signal(signal.SIGINT)
+    child.wait()
+    contents = recording.read_log(path)
+    assert contents.finished and not contents.problems
+    assert len(contents.messages) == 12
+    assert [m.request_id for _, _, m in read_with_rosbags(path)] == [f"r{i}" for i in range(12)]
+
+
+# --------------------------------------------------------------------------- damaged logs
+
+
+def test_truncation_anywhere_reads_an_intact_prefix(tmp_path: Path) -> None:
+    source = tmp_path / "full.mcap"
+    with recording.LogWriter(source, flush_messages=1) as writer:
+        for i in range(6):
+            writer.write_fields("/s", SUMMARY, {"request_id": f"r{i}"}, 100 + i)
+    data = source.read_bytes()
+    seen_counts = set()
+    for cut in range(0, len(data), 7):
+        damaged = tmp_path / "cut.mcap"
+        damaged.write_bytes(data[:cut])
+        try:
+            contents = recording.read_log(damaged)
+        except LogReadError:
+            assert cut < 8  # not even the magic is there
+            continue
+        ids = [m.message.request_id for m in contents.messages]
+        assert ids == [f"r{i}" for i in range(len(ids))]
+        assert contents.problems and not contents.finished
+        seen_counts.add(len(ids))
+    assert seen_counts == set(range(7))  # every prefix length occurs
+
+
+def test_corrupt_chunk_is_skipped_and_reported(tmp_path: Path) -> None:
+    path = tmp_path / "corrupt.mcap"
+    with recording.LogWriter(path, flush_messages=1) as writer:
+        for i in range(3):
+            writer.write_fields("/s", SUMMARY, {"request_id": f"request-{i}"}, 100 + i)
+    data = bytearray(path.read_bytes())
+    where = data.find(b"request-1")
+    data[where] ^= 0xFF
+    path.write_bytes(bytes(data))
+    contents = recording.read_log(path)
+    assert [m.message.request_id for m in contents.messages] == ["request-0", "request-2"]
+    assert any("corrupt" in p for p in contents.problems)
+
+
+def test_unknown_types_are_skipped_with_a_note(tmp_path: Path) -> None:
+    path = tmp_path / "foreign.mcap"
+    with path.open("wb") as stream:
+        writer = RawMcapWriter(stream)
+        writer.start(profile="ros2")
+        foreign = writer.register_schema("foo_msgs/msg/Bar", "ros2msg", b"int32 a\n")
+        ours = writer.register_schema(
+            SUMMARY, "ros2msg", recording.message_definition(SUMMARY).encode()
+        )
+        channel_foreign = writer.register_channel("/foo", "cdr", foreign)
+        channel_ours = writer.register_channel("/s", "cdr", ours)
+        writer.add_message(channel_foreign, 1, b"\x00\x01\x00\x00\x07\x00\x00\x00", 1)
+        writer.add_message(channel_ours, 2, recording.serialize(SUMMARY, {"request_id": "k"}), 2)
+        writer.finish()
+    contents = recording.read_log(path)
+    assert [m.topic for m in contents.messages] == ["/s"]
+    assert contents.topics["/foo"].count == 1 and contents.topics["/foo"].decoded == 0
+    assert contents.problems == [
+        "/foo: type foo_msgs/msg/Bar is unknown here; 1 message(s) skipped"
+    ]
+
+
+def test_not_a_log(tmp_path: Path) -> None:
+    with pytest.raises(LogReadError, match="no such file"):
+        recording.read_log(tmp_path / "missing.mcap")
+    junk = tmp_path / "junk.mcap"
+    junk.write_bytes(b"this is not an mcap file")
+    with pytest.raises(LogReadError, match="not an MCAP file"):
+        recording.read_log(junk)
+    empty_dir = tmp_path / "empty"
+    empty_dir.mkdir()
+    with pytest.raises(LogReadError, match="without metadata.yaml"):
+        recording.read_log(empty_dir)
