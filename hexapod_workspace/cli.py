@@ -98,10 +98,15 @@ def read_poses_file(path: str | Path) -> NDArray[np.float64]:
     skip = 0
     cells = [cell.strip() for cell in first.split(",")]
     if first.strip() and not first.lstrip().startswith("#"):
-        try:
-            [float(cell) for cell in cells]
-        except ValueError:
-            skip = 1  # header row
+        # A header row has no numeric cell; a row with some numbers is data (errors reported).
+        numeric = 0
+        for cell in cells:
+            try:
+                float(cell)
+                numeric += 1
+            except ValueError:
+                pass
+        skip = 1 if numeric == 0 else 0
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # "empty input file": reported below

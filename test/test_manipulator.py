@@ -1,0 +1,246 @@
+"""Model construction and validation: one test per rule, each error naming the parameter."""
+
+from __future__ import annotations
+
+import math
+import textwrap
+import warnings
+
+import numpy as np
+import pytest
+
+from hexapod_workspace import ConfigError, GeometryError, HomePoseWarning, Manipulator
+from hexapod_workspace.params import load_params_file
+
+
+def build(parameters: dict, **changes) -> Manipulator:
+    values = dict(parameters)
+    values.update(changes)
+    return Manipulator.from_mapping(values, warn=False)
+
+
+def test_example_loads_with_defaults_from_the_home_pose(example):
+    assert example.base_joints.shape == (6, 3)
+    assert example.platform_joints.shape == (6, 3)
+    np.testing.assert_allclose(np.linalg.norm(example.base_joint_axes, axis=1), 1.0)
+    # Default axes: the leg directions at the home pose (DESIGN.md section 2).
+    legs = example.home_position + example.platform_joints - example.base_joints
+    directions = legs / np.linalg.norm(legs, axis=1, keepdims=True)
+    np.testing.assert_allclose(example.base_joint_axes, directions)
+    np.testing.assert_allclose(example.platform_joint_axes, -directions)
+    assert example.frame_id == "base"
+    np.testing.assert_array_equal(example.position, [0.0, 0.0, -1.3])
+
+
+def test_nested_and_dotted_mappings_are_the_same(example_parameters):
+    nested: dict = {}
+    for name, value in example_parameters.items():
+        node = nested
+        *groups, leaf = name.split(".")
+        for group in groups:
+            node = node.setdefault(group, {})
+        node[leaf] = value
+    assert Manipulator.from_mapping(nested) == Manipulator.from_mapping(example_parameters)
+
+
+def test_to_parameters_round_trip(example):
+    assert Manipulator.from_mapping(example.to_parameters()) == example
+
+
+def test_explicit_axes_round_trip_and_are_normalised(example_parameters):
+    axes = [0.0, 0.0, -2.0] * 6
+    model = build(example_parameters, **{"geometry.base_joint_axes": axes})
+    np.testing.assert_allclose(model.base_joint_axes, np.tile([0.0, 0.0, -1.0], (6, 1)))
+    assert Manipulator.from_mapping(model.to_parameters(), warn=False) == model
+
+
+def test_params_file_root_keys(tmp_path, example_parameters):
+    for root in ("hexapod_workspace", "/**", "/hexapod_workspace"):
+        path = tmp_path / "params.yaml"
+        lines = [f"{root!r}:", "  ros__parameters:"]
+        lines += [f"    {name}: {value!r}" for name, value in example_parameters.items()]
+        path.write_text("\n".join(lines) + "\n")
+        assert (
+            load_params_file(path)["limits.leg_diameter"]
+            == example_parameters["limits.leg_diameter"]
+        )
+        Manipulator.from_params_file(path)
+
+
+def test_params_file_without_node_section(tmp_path):
+    path = tmp_path / "other.yaml"
+    path.write_text("other_node:\n  ros__parameters: {a: 1}\n")
+    with pytest.raises(ConfigError, match="no section for this node"):
+        load_params_file(path)
+
+
+def test_params_file_invalid_yaml(tmp_path):
+    path = tmp_path / "broken.yaml"
+    path.write_text("hexapod_workspace: [unclosed\n")
+    with pytest.raises(ConfigError, match="not valid YAML"):
+        load_params_file(path)
+
+
+def test_params_file_missing(tmp_path):
+    with pytest.raises(ConfigError, match="cannot read"):
+        load_params_file(tmp_path / "absent.yaml")
+
+
+# ----------------------------------------------------------------- one test per rule
+def test_joint_array_must_be_6x3(example_parameters):
+    with pytest.raises(GeometryError) as error:
+        build(example_parameters, **{"geometry.base_joints": [0.0] * 17})
+    assert str(error.value) == (
+        "geometry.base_joints: expected 18 numbers (6 joints × x, y, z), got 17"
+    )
+    with pytest.raises(GeometryError, match="geometry.platform_joints: expected 18"):
+        build(example_parameters, **{"geometry.platform_joints": [[0.0, 0.0, 0.0]] * 5})
+
+
+def test_joint_array_accepts_6x3_nested(example_parameters, example):
+    nested = np.reshape(example_parameters["geometry.base_joints"], (6, 3)).tolist()
+    assert build(example_parameters, **{"geometry.base_joints": nested}) == example
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "limits.leg_length_min",
+        "limits.leg_length_max",
+        "limits.base_joint_max_angle",
+        "limits.platform_joint_max_angle",
+    ],
+)
+def test_limit_lists_have_length_1_or_6(example_parameters, name):
+    with pytest.raises(GeometryError) as error:
+        build(example_parameters, **{name: [0.5, 0.6]})
+    assert str(error.value) == f"{name}: expected 1 or 6 numbers, got 2"
+    build(example_parameters, **{name: [example_parameters[name][0]] * 6})
+
+
+def test_leg_length_min_below_max(example_parameters):
+    with pytest.raises(GeometryError) as error:
+        build(example_parameters, **{"limits.leg_length_min": [0.8, 0.8, 0.8, 1.5, 0.8, 0.8]})
+    assert "leg_length_min: expected < limits.leg_length_max" in str(error.value)
+    assert "1.5 >= 1.45 m for leg 4" in str(error.value)
+
+
+def test_leg_length_min_not_negative(example_parameters):
+    with pytest.raises(GeometryError, match="leg_length_min: expected values >= 0 m, got -0.1"):
+        build(example_parameters, **{"limits.leg_length_min": [-0.1]})
+
+
+@pytest.mark.parametrize("angle", [0.0, -0.1, math.pi, 4.0])
+@pytest.mark.parametrize("name", ["limits.base_joint_max_angle", "limits.platform_joint_max_angle"])
+def test_joint_angles_in_open_interval(example_parameters, name, angle):
+    with pytest.raises(GeometryError) as error:
+        build(example_parameters, **{name: [angle]})
+    assert str(error.value).startswith(f"{name}: expected angles in (0, pi) rad, got {angle:g}")
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+@pytest.mark.parametrize(
+    "name", ["geometry.base_joints", "geometry.home_position", "limits.leg_diameter"]
+)
+def test_numbers_must_be_finite(example_parameters, name, bad):
+    value = example_parameters[name]
+    value = [bad, *value[1:]] if isinstance(value, list) else bad
+    with pytest.raises(ConfigError, match=f"{name}: expected finite numbers"):
+        build(example_parameters, **{name: value})
+
+
+@pytest.mark.parametrize("bad", ["1.0", True, [1.0, "x", 2.0], b"123"])
+def test_numbers_must_be_numbers(example_parameters, bad):
+    with pytest.raises(ConfigError, match="pose.position: expected"):
+        build(example_parameters, **{"pose.position": bad})
+
+
+def test_axes_must_be_non_zero(example_parameters):
+    axes = [0.0, 0.0, 1.0] * 6
+    axes[9:12] = [0.0, 0.0, 0.0]
+    with pytest.raises(GeometryError) as error:
+        build(example_parameters, **{"geometry.platform_joint_axes": axes})
+    assert str(error.value) == (
+        "geometry.platform_joint_axes: expected non-zero axes, axis of joint 4 is zero"
+    )
+
+
+def test_axes_must_have_18_numbers(example_parameters):
+    with pytest.raises(GeometryError, match="base_joint_axes: expected 18 numbers .* got 3"):
+        build(example_parameters, **{"geometry.base_joint_axes": [0.0, 0.0, 1.0]})
+
+
+def test_leg_diameter_not_negative(example_parameters):
+    with pytest.raises(GeometryError) as error:
+        build(example_parameters, **{"limits.leg_diameter": -0.01})
+    assert str(error.value) == "limits.leg_diameter: expected a value >= 0 m, got -0.01"
+
+
+def test_zero_length_leg_at_home_is_refused(example_parameters):
+    base = np.reshape(example_parameters["geometry.base_joints"], (6, 3))
+    platform = np.reshape(example_parameters["geometry.platform_joints"], (6, 3))
+    home = base[2] - platform[2]  # leg 3 collapses to a point at the home pose
+    with pytest.raises(GeometryError, match="leg 3 has zero length"):
+        build(example_parameters, **{"geometry.home_position": home.tolist()})
+
+
+def test_missing_parameter(example_parameters):
+    values = dict(example_parameters)
+    del values["limits.leg_length_max"]
+    with pytest.raises(ConfigError, match="limits.leg_length_max: required parameter is missing"):
+        Manipulator.from_mapping(values)
+
+
+def test_unknown_model_parameter(example_parameters):
+    with pytest.raises(ConfigError, match="limits.leg_lenght_max: unknown parameter"):
+        build(example_parameters, **{"limits.leg_lenght_max": [1.0]})
+
+
+def test_node_parameters_outside_the_model_are_ignored(example_parameters, example):
+    extra = {"resolution.n_phi": 360, "recording.enabled": True, "use_sim_time": False}
+    assert build(example_parameters, **extra) == example
+
+
+def test_position_defaults_to_home(example_parameters):
+    values = dict(example_parameters)
+    del values["pose.position"]
+    model = Manipulator.from_mapping(values)
+    np.testing.assert_array_equal(model.position, model.home_position)
+
+
+def test_unreachable_home_pose_warns_but_builds(example_parameters):
+    with pytest.warns(HomePoseWarning, match="home pose .* unreachable: leg_length violated"):
+        model = Manipulator.from_mapping({**example_parameters, "limits.leg_length_max": [1.2]})
+    assert model.leg_length_max[0] == 1.2
+
+
+def test_reachable_home_pose_does_not_warn(example_parameters):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        Manipulator.from_mapping(example_parameters)
+
+
+def test_arrays_are_read_only(example):
+    with pytest.raises(ValueError, match="read-only"):
+        example.base_joints[0, 0] = 1.0
+
+
+def test_yaml_example_is_commented():
+    from hexapod_workspace._resources import example_config_path
+
+    text = example_config_path().read_text()
+    keys = [line for line in text.splitlines() if line.strip().endswith(":") or ": " in line]
+    assert len(keys) > 10
+    # Every key line of the example is preceded by a comment line (the issue asks for comments).
+    lines = text.splitlines()
+    for index, line in enumerate(lines):
+        stripped = line.strip()
+        is_key = stripped and not stripped.startswith(("#", "-")) and ":" in stripped.split()[0]
+        if is_key and index > 0 and not stripped.startswith("hexapod_workspace"):
+            previous = lines[index - 1].strip()
+            assert previous.startswith("#") or stripped in {
+                "ros__parameters:",
+                "geometry:",
+                "limits:",
+                "pose:",
+            }, textwrap.shorten(line, 60)
