@@ -33,6 +33,7 @@ import atexit
 import contextlib
 import dataclasses
 import functools
+import queue
 import threading
 import time
 import weakref
@@ -368,11 +369,14 @@ def build_message(
     return store.types[msgtype](**values)
 
 
-def serialize(msgtype: str, fields: Mapping[str, Any] | Any) -> bytes:
-    """Serialise a message (a field dict or a rosbags message object) to little-endian CDR."""
+def serialize(msgtype: str, fields: Mapping[str, Any] | Any) -> memoryview:
+    """Serialise a message (a field dict or a rosbags message object) to little-endian CDR.
+
+    Returns a read-only bytes-like view (no copy of large payloads); ``bytes(...)`` it to keep.
+    """
     store = get_typestore()
     message = build_message(msgtype, fields, store=store) if isinstance(fields, Mapping) else fields
-    return bytes(store.serialize_cdr(message, store_name(msgtype)))
+    return store.serialize_cdr(message, store_name(msgtype)).toreadonly()
 
 
 def deserialize(msgtype: str, data: bytes | memoryview) -> Any:
@@ -443,8 +447,11 @@ class LogWriter:
     chunk_size : int
         Bytes of pending messages that close a chunk at once.
     on_error : callable, optional
-        Called with the :class:`RecordingError` when a background flush fails (the writer is
-        then closed; the node uses it to turn recording off).
+        Called with the :class:`RecordingError` when a background flush or a background write
+        fails (the writer is then closed; the node uses it to turn recording off).
+    background : bool
+        :meth:`write` only queues the message; a worker thread writes it (in order). A service
+        then does not wait for the disk. :meth:`flush` and :meth:`close` wait for the queue.
 
     Raises
     ------
@@ -460,6 +467,7 @@ class LogWriter:
         flush_messages: int = DEFAULT_FLUSH_MESSAGES,
         chunk_size: int = DEFAULT_CHUNK_SIZE,
         on_error: Callable[[RecordingError], None] | None = None,
+        background: bool = False,
     ) -> None:
         if flush_messages < 1 or flush_interval < 0 or chunk_size < 1:
             msg = (
@@ -497,6 +505,11 @@ class LogWriter:
                 self._close_file_quietly()
             msg = f"cannot create MCAP log {self.path}: {err.strerror or err}"
             raise RecordingError(msg) from err
+        self._queue: queue.Queue[Any] | None = queue.Queue() if background else None
+        self._worker: threading.Thread | None = None
+        if background:
+            self._worker = threading.Thread(target=self._drain, name="mcap-log-writer", daemon=True)
+            self._worker.start()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         if self.flush_interval > 0:
@@ -583,32 +596,61 @@ class LogWriter:
             The file could not be written (disk full, ...); the writer is closed.
         """
         log_time_ns = time.time_ns() if log_time_ns is None else int(log_time_ns)
+        publish_time_ns = log_time_ns if publish_time_ns is None else int(publish_time_ns)
         with self._lock:
             self._check_open()
             if topic not in self._channels:
                 msg = f"topic {topic!r} is not registered (call add_channel first)"
                 raise KeyError(msg)
-            channel_id = self._channels[topic][0]
-            try:
-                self._mcap.add_message(
-                    channel_id=channel_id,
-                    log_time=log_time_ns,
-                    data=bytes(data),
-                    publish_time=log_time_ns if publish_time_ns is None else publish_time_ns,
-                    sequence=self._counts[topic],
-                )
-            except OSError as err:
-                raise self._fail(err) from err
-            self._counts[topic] += 1
-            self._first_ns = (
-                log_time_ns if self._first_ns is None else min(self._first_ns, log_time_ns)
+            if self._queue is None:
+                self._write_locked(topic, data, log_time_ns, publish_time_ns)
+                return
+        self._queue.put((topic, data, log_time_ns, publish_time_ns))
+
+    def _write_locked(
+        self,
+        topic: str,
+        data: bytes | bytearray | memoryview,
+        log_time_ns: int,
+        publish_time_ns: int,
+    ) -> None:
+        try:
+            self._mcap.add_message(
+                channel_id=self._channels[topic][0],
+                log_time=log_time_ns,
+                data=data,  # copied into the chunk at once: no bytes() copy here
+                publish_time=publish_time_ns,
+                sequence=self._counts[topic],
             )
-            self._last_ns = max(self._last_ns, log_time_ns)
-            if self._pending == 0:
-                self._oldest_pending = time.monotonic()
-            self._pending += 1
-            if self._pending >= self.flush_messages:
-                self._flush_locked()
+        except OSError as err:
+            raise self._fail(err) from err
+        self._counts[topic] += 1
+        self._first_ns = log_time_ns if self._first_ns is None else min(self._first_ns, log_time_ns)
+        self._last_ns = max(self._last_ns, log_time_ns)
+        if self._pending == 0:
+            self._oldest_pending = time.monotonic()
+        self._pending += 1
+        if self._pending >= self.flush_messages:
+            self._flush_locked()
+
+    def _drain(self) -> None:
+        """Background mode: write queued messages in order until the stop sentinel."""
+        assert self._queue is not None
+        while True:
+            item = self._queue.get()
+            try:
+                if item is None:
+                    return
+                with self._lock:
+                    if self._closed:
+                        continue  # failed earlier: what is still queued is dropped
+                    try:
+                        self._write_locked(*item)
+                    except RecordingError as err:
+                        if self._on_error is not None:
+                            self._on_error(err)
+            finally:
+                self._queue.task_done()
 
     def write_fields(
         self,
@@ -618,7 +660,7 @@ class LogWriter:
         log_time_ns: int | None = None,
         *,
         qos: str = REQUEST_QOS,
-    ) -> bytes:
+    ) -> memoryview:
         """Register the topic if needed, serialise ``fields`` (dict or rosbags message) and
         write it. Returns the CDR bytes written."""
         data = serialize(msgtype, fields)
@@ -636,6 +678,8 @@ class LogWriter:
         RecordingError
             The file could not be written; the writer is closed.
         """
+        if self._queue is not None:
+            self._queue.join()
         with self._lock:
             self._check_open()
             self._flush_locked()
@@ -700,6 +744,10 @@ class LogWriter:
         RecordingError
             When finishing fails (disk full); the file then stays readable up to its last chunk.
         """
+        if self._worker is not None and self._worker is not threading.current_thread():
+            self._queue.put(None)
+            self._worker.join()
+            self._worker = None
         with self._lock:
             if self._closed:
                 return

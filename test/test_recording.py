@@ -241,11 +241,12 @@ FULL_DISK_CHILD = textwrap.dedent(
         print("on_error", error.__cause__.errno, flush=True)
         reported.set()
     writer = recording.LogWriter(path, flush_interval=0.01 if mode == "timer" else 0,
-                                 on_error=on_error)
+                                 flush_messages=1 if mode == "background" else 64,
+                                 background=mode == "background", on_error=on_error)
     writer.add_channel("/t", "sensor_msgs/msg/PointCloud2")
     data = recording.serialize("sensor_msgs/msg/PointCloud2", {"data": bytes(300_000)})
     writer.write("/t", data)
-    if mode == "timer":
+    if mode in ("timer", "background"):
         print("reported", reported.wait(60), writer.closed, flush=True)
     else:
         try:
@@ -263,7 +264,7 @@ FULL_DISK_CHILD = textwrap.dedent(
 )
 
 
-@pytest.mark.parametrize("mode", ["flush", "timer"])
+@pytest.mark.parametrize("mode", ["flush", "timer", "background"])
 def test_disk_full_mid_log_is_reported_not_raised_elsewhere(tmp_path: Path, mode: str) -> None:
     child = subprocess.run(
         [sys.executable, "-c", FULL_DISK_CHILD, str(tmp_path / "full.mcap"), mode],
@@ -274,13 +275,23 @@ def test_disk_full_mid_log_is_reported_not_raised_elsewhere(tmp_path: Path, mode
     )
     assert child.returncode == 0, child.stderr
     lines = child.stdout.splitlines()
-    if mode == "timer":
+    if mode in ("timer", "background"):
         assert lines == [f"on_error {errno.EFBIG}", "reported True True", "done"]
     else:
         assert lines[0].startswith("raised writing MCAP log") and "File too large" in lines[0]
         assert lines[1:] == ["closed True", "refused", "done"]
     assert "Traceback" not in child.stderr
     recording.read_log(tmp_path / "full.mcap")  # what reached the disk is still readable
+
+
+def test_background_writer_keeps_order_and_drains_on_close(tmp_path: Path) -> None:
+    path = tmp_path / "background.mcap"
+    with recording.LogWriter(path, background=True, flush_messages=7) as writer:
+        for i in range(100):
+            writer.write_fields("/s", SUMMARY, {"n_points": i}, 1_000 + i)
+        writer.flush()
+        assert sum(writer.message_counts.values()) == 100
+    assert [m.message.n_points for m in recording.read_log(path).messages] == list(range(100))
 
 
 def test_run_log_path_is_named_by_start_time_and_unique(tmp_path: Path) -> None:

@@ -1,0 +1,217 @@
+"""Benchmark: recording one 10^6-point boundary cloud, against reference writers, same run.
+
+Prints absolute times (median of --repeat runs) and ratios:
+- ours: points -> PointCloud2 field dict -> CDR (rosbags) -> hexapod_workspace LogWriter -> disk
+- rosbags: the same CDR bytes through rosbags' own rosbag2 writer (MCAP storage)
+- mcap_ros2: mcap_ros2's writer (its own CDR encoder) on the same field dict
+and the service-time impact: a workspace computation with and without recording its result.
+
+Usage: python benchmarks/recording.py [--points 1000000] [--repeat 5] [--dir DIR]
+Goal (issue 5): <= 100 ms for 10^6 points, and no slowdown of the service that produced it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from hexapod_workspace import messages, recording
+
+CLOUD = "sensor_msgs/msg/PointCloud2"
+
+
+def timed(function: Callable[[int], object], repeat: int) -> float:
+    """Median wall time of ``function(run_index)`` in ms (one warm-up run first)."""
+    function(-1)
+    times = []
+    for index in range(repeat):
+        start = time.perf_counter()
+        function(index)
+        times.append((time.perf_counter() - start) * 1e3)
+    return statistics.median(times)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--points", type=int, default=1_000_000)
+    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--dir", type=Path, default=None, help="where to write (default: tmp)")
+    args = parser.parse_args()
+    rng = np.random.default_rng(20261121)
+    points = rng.normal(size=(args.points, 6))
+    workdir = Path(tempfile.mkdtemp(prefix="bench-rec-", dir=args.dir))
+    stamp = time.time_ns()
+
+    def ours(index: int) -> None:
+        fields = messages.pointcloud_fields(points, frame_id="base", stamp_ns=stamp)
+        data = recording.serialize(CLOUD, fields)
+        with recording.LogWriter(workdir / f"ours{index}.mcap", flush_interval=0) as writer:
+            writer.add_channel("/hexapod_workspace/boundary", CLOUD, recording.RESULT_QOS)
+            writer.write("/hexapod_workspace/boundary", data, stamp)
+
+    def ours_write_only(
+        index: int,
+        data: bytes = recording.serialize(
+            CLOUD, messages.pointcloud_fields(points, frame_id="base", stamp_ns=stamp)
+        ),
+    ) -> None:
+        with recording.LogWriter(workdir / f"w{index}.mcap", flush_interval=0) as writer:
+            writer.add_channel("/hexapod_workspace/boundary", CLOUD, recording.RESULT_QOS)
+            writer.write("/hexapod_workspace/boundary", data, stamp)
+
+    def rosbags_writer(index: int) -> None:
+        from rosbags.rosbag2 import StoragePlugin, Writer
+
+        fields = messages.pointcloud_fields(points, frame_id="base", stamp_ns=stamp)
+        data = recording.serialize(CLOUD, fields)
+        store = recording.get_typestore()
+        with Writer(
+            workdir / f"rosbags{index}", version=9, storage_plugin=StoragePlugin.MCAP
+        ) as writer:
+            connection = writer.add_connection(
+                "/hexapod_workspace/boundary", CLOUD, typestore=store
+            )
+            writer.write(connection, stamp, data)
+
+    def mcap_ros2_writer(index: int) -> None:
+        from mcap_ros2.writer import Writer
+
+        fields = messages.pointcloud_fields(points, frame_id="base", stamp_ns=stamp)
+        with (workdir / f"mcap_ros2_{index}.mcap").open("wb") as stream:
+            writer = Writer(stream)
+            schema = writer.register_msgdef(CLOUD, recording.message_definition(CLOUD))
+            writer.write_message("/hexapod_workspace/boundary", schema, fields, stamp, stamp)
+            writer.finish()
+
+    n = args.points
+    print(
+        f"recording one {n}-point PointCloud2 ({24 * n / 1e6:.1f} MB), median of "
+        f"{args.repeat}, into {workdir}"
+    )
+    t_ours = timed(ours, args.repeat)
+    t_write = timed(ours_write_only, args.repeat)
+    t_rosbags = timed(rosbags_writer, args.repeat)
+    print(f"  ours (dict -> CDR -> MCAP, finished file): {t_ours:8.1f} ms")
+    print(f"    of which LogWriter (CDR bytes -> disk):  {t_write:8.1f} ms")
+    print(
+        f"  rosbags rosbag2 Writer (same CDR bytes):   {t_rosbags:8.1f} ms   "
+        f"ours/rosbags = {t_ours / t_rosbags:.2f}"
+    )
+    if n <= 100_000:
+        t_mcap_ros2 = timed(mcap_ros2_writer, args.repeat)
+        print(
+            f"  mcap_ros2 Writer (its own CDR encoder):    {t_mcap_ros2:8.1f} ms   "
+            f"ours/mcap_ros2 = {t_ours / t_mcap_ros2:.2f}"
+        )
+    else:
+        start = time.perf_counter()
+        mcap_ros2_writer(0)
+        t_mcap_ros2 = (time.perf_counter() - start) * 1e3
+        print(
+            f"  mcap_ros2 Writer (its own CDR encoder, 1 run): {t_mcap_ros2:8.1f} ms   "
+            f"ours/mcap_ros2 = {t_ours / t_mcap_ros2:.3f}"
+        )
+
+    service_impact(args.repeat, workdir)
+
+
+def service_impact(repeat: int, workdir: Path) -> None:
+    """Service time with and without recording, the way the node records (same run).
+
+    Both variants compute the result and build its message objects (rosbags objects stand in for
+    the rclpy messages the node publishes anyway). Recording adds serialising them (rclpy's
+    serialize_message in the node, rosbags' serialize_cdr here) and LogWriter.write on the
+    node's one log per run, in background mode. Uses the projected workspace when the core has
+    it, else a CheckPoses batch of 10^4 poses; plus one 10^6-point cloud.
+    """
+    from hexapod_workspace import constraints
+    from hexapod_workspace._resources import example_config_path
+    from hexapod_workspace.manipulator import Manipulator
+
+    manipulator = Manipulator.from_params_file(example_config_path())
+    store = recording.get_typestore()
+    stamp = time.time_ns()
+    try:
+        from hexapod_workspace.projected import projected_workspace
+    except ImportError:
+        projected_workspace = None
+    rng = np.random.default_rng(5)
+    angles = np.column_stack(
+        (
+            rng.uniform(-np.pi, np.pi, 10_000),
+            rng.uniform(0, 0.6, 10_000),
+            rng.uniform(-0.3, 0.3, 10_000),
+        )
+    )
+    big_cloud = messages.pointcloud_fields(
+        rng.normal(size=(1_000_000, 6)), frame_id="base", stamp_ns=stamp
+    )
+
+    def outputs() -> list[tuple[str, str, dict]]:
+        if projected_workspace is not None:
+            workspace = projected_workspace(manipulator, method="torsion_zero", n_phi=360)
+            points = messages.boundary_points(workspace)
+            return [
+                (
+                    "/hexapod_workspace/summary",
+                    "hexapod_workspace_msgs/msg/WorkspaceSummary",
+                    messages.summary_fields(workspace, stamp_ns=stamp, frame_id="base"),
+                ),
+                (
+                    "/hexapod_workspace/boundary",
+                    CLOUD,
+                    messages.pointcloud_fields(points, frame_id="base", stamp_ns=stamp),
+                ),
+            ]
+        result = constraints.check(manipulator, angles)
+        return [
+            (
+                "/hexapod_workspace/check_poses/response",
+                "hexapod_workspace_msgs/srv/CheckPoses_Response",
+                messages.check_poses_response_fields(result),
+            )
+        ]
+
+    def serve(writer: recording.LogWriter | None, produce: Callable[[], list]) -> None:
+        built = [
+            (topic, msgtype, recording.build_message(msgtype, fields))
+            for topic, msgtype, fields in produce()
+        ]
+        if writer is not None:
+            for topic, msgtype, message in built:
+                writer.add_channel(topic, msgtype, recording.RESULT_QOS)
+                writer.write(topic, store.serialize_cdr(message, recording.store_name(msgtype)))
+
+    name = (
+        "projected torsion_zero, 360 rays"
+        if projected_workspace is not None
+        else "check of 10^4 poses; projected workspace not in the core yet"
+    )
+    for label, produce in (
+        (name, outputs),
+        (
+            "publishing one 10^6-point cloud",
+            lambda: [("/hexapod_workspace/boundary", CLOUD, big_cloud)],
+        ),
+    ):
+        without = timed(lambda _, make=produce: serve(None, make), repeat)
+        with recording.LogWriter(workdir / "node_run.mcap", background=True) as writer:
+            with_recording = timed(lambda _, make=produce: serve(writer, make), repeat)
+            start = time.perf_counter()
+            writer.flush()
+            drain = (time.perf_counter() - start) * 1e3
+        print(
+            f"service ({label}): {without:7.1f} ms without recording, {with_recording:7.1f} ms"
+            f" with: ratio {with_recording / without:.3f} (writer thread then needed "
+            f"{drain:.1f} ms more to reach the disk)"
+        )
+
+
+if __name__ == "__main__":
+    main()
