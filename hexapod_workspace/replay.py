@@ -498,6 +498,7 @@ def _publish(
     err: IO[str],
     *,
     allow_network: bool,
+    wait_for_subscribers: float,
 ) -> int:
     """Republish the recorded bytes on their topics at ``rate`` × the recorded pace."""
     value = os.environ.get(_DISCOVERY)
@@ -511,6 +512,7 @@ def _publish(
         return 2
     try:
         import rclpy
+        from rclpy.duration import Duration
         from rclpy.node import Node
     except ImportError as error:
         err.write(f"replay --publish needs rclpy (a ROS 2 environment): {error}\n")
@@ -533,6 +535,11 @@ def _publish(
             topic: node.create_publisher(cls, topic, _qos(summary.contents.topics[topic].qos))
             for topic, cls in classes.items()
         }
+        deadline = time.monotonic() + wait_for_subscribers
+        while any(p.get_subscription_count() == 0 for p in publishers.values()):
+            if time.monotonic() >= deadline:
+                break
+            time.sleep(0.01)
         start_wall = time.monotonic()
         start_log = usable[0].log_time_ns if usable else 0
         for item in usable:
@@ -545,6 +552,8 @@ def _publish(
                 if delay > 0:
                     time.sleep(delay)
             publisher.publish(item.data)  # serialized bytes go out unchanged
+        for publisher in publishers.values():  # let reliable subscribers receive everything
+            publisher.wait_for_all_acked(Duration(seconds=5))
         node.destroy_node()
     finally:
         rclpy.try_shutdown(context=context)
@@ -565,6 +574,7 @@ def run_replay(
     stdout: IO[str] | None = None,
     stderr: IO[str] | None = None,
     allow_network: bool = False,
+    wait_for_subscribers: float = 0.0,
 ) -> int:
     """Report what a log holds; optionally redraw its workspaces and republish it.
 
@@ -585,6 +595,10 @@ def run_replay(
         0 = as fast as possible).
     stdout, stderr : text streams, optional
         Default ``sys.stdout``/``sys.stderr``.
+    allow_network : bool
+        Let ``publish`` run with a discovery range other than LOCALHOST.
+    wait_for_subscribers : float
+        ``publish``: wait up to this many seconds for every topic to have a subscriber.
 
     Returns
     -------
@@ -624,7 +638,14 @@ def run_replay(
             err.write(f"replay: cannot write plots to {plot_dir}: {error.strerror or error}\n")
             return 2
     if publish:
-        return _publish(summary, kept, rate, err, allow_network=allow_network)
+        return _publish(
+            summary,
+            kept,
+            rate,
+            err,
+            allow_network=allow_network,
+            wait_for_subscribers=wait_for_subscribers,
+        )
     return 0
 
 
@@ -669,7 +690,8 @@ def record_results(
     """
     topics, types = messages.TOPICS, messages.TYPES
     stamp = time.time_ns() if stamp_ns is None else int(stamp_ns)
-    with LogWriter(path, flush_interval=0, flush_messages=1 << 30) as writer:
+    # One chunk per message: a damaged file keeps every message before the damage.
+    with LogWriter(path, flush_interval=0, flush_messages=1) as writer:
         for result in results:
             if hasattr(result, "margins"):  # a CheckResult
                 request, response = service_topics(topics["check_poses"])

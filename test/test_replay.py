@@ -1,0 +1,317 @@
+"""Tests of hexapod_workspace.replay: --record then replay, bad logs, plots, republishing."""
+
+from __future__ import annotations
+
+import importlib.util
+import io
+import json
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+from mcap.writer import Writer as RawMcapWriter
+from recording_support import plain, read_with_mcap_ros2, read_with_rosbags
+from rosbags.rosbag2 import StoragePlugin
+from rosbags.rosbag2 import Writer as Rosbag2Writer
+from test_messages import orientation_stub, projected_stub
+
+from hexapod_workspace import constraints, messages, recording
+from hexapod_workspace.replay import record_results, run_replay, summarize_log
+
+HAVE_CORE_WORKSPACES = all(
+    importlib.util.find_spec(f"hexapod_workspace.{name}") is not None
+    for name in ("projected", "orientation", "plotting")
+)
+
+
+def replay(*args: object, **kwargs: object) -> tuple[int, str, str]:
+    out, err = io.StringIO(), io.StringIO()
+    code = run_replay(*args, stdout=out, stderr=err, **kwargs)
+    assert "Traceback" not in err.getvalue()
+    return code, out.getvalue(), err.getvalue()
+
+
+@pytest.fixture
+def check_result(example) -> constraints.CheckResult:
+    angles = np.radians([[0.0, 0.0, 0.0], [30.0, 20.0, 5.0], [45.0, 80.0, 10.0]])
+    return constraints.check(example, angles)
+
+
+def test_record_then_replay_check_and_stub_workspaces(tmp_path: Path, check_result) -> None:
+    path = tmp_path / "cli.mcap"
+    projected, orientation = projected_stub("exact"), orientation_stub()
+    record_results(
+        path,
+        [check_result, projected, orientation],
+        frame_id="base",
+        request_id="study-1",
+        stamp_ns=1_700_000_000_000_000_000,
+    )
+    code, out, err = replay(path, as_json=True)
+    assert code == 0 and err == ""
+    report = json.loads(out)
+    assert report["finished"] and report["problems"] == []
+    assert report["start"] == "2023-11-14T22:13:20.000Z"
+    counts = {t["topic"]: t["count"] for t in report["topics"]}
+    assert counts == {
+        "/hexapod_workspace/check_poses/request": 1,
+        "/hexapod_workspace/check_poses/response": 1,
+        "/hexapod_workspace/workspace_request": 2,
+        "/hexapod_workspace/summary": 2,
+        "/hexapod_workspace/boundary": 2,
+    }
+    (check,) = report["pose_checks"]
+    assert check["n_poses"] == 3 and check["n_reachable"] == int(check_result.reachable.sum())
+    exact, orient = report["workspaces"]
+    assert exact["kind"] == "exact" and exact["request_id"] == "study-1"
+    assert exact["tilt_max_deg"] == pytest.approx(math.degrees(projected.tilt_max))
+    assert exact["psi_min_deg"] is None and exact["n_points"] == 36 and exact["boundary_recorded"]
+    assert orient["kind"] == "orientation" and orient["n_points"] == 24
+    assert orient["psi_max_deg"] == pytest.approx(math.degrees(0.1))
+    code, text, _ = replay(path)
+    assert code == 0
+    assert "workspace results: 2" in text and "pose checks: 1" in text
+    assert f"{int(check_result.reachable.sum())}/3 reachable" in text
+
+
+def test_recorded_cli_messages_equal_what_was_built(tmp_path: Path, check_result) -> None:
+    """The --record log decodes with rosbags and mcap_ros2 to the dicts messages.py built."""
+    path = tmp_path / "cli.mcap"
+    workspace = projected_stub()
+    record_results(path, [check_result, workspace], frame_id="base", stamp_ns=5_000)
+    points = messages.boundary_points(workspace)
+    expected = [
+        messages.check_poses_request_fields(check_result.position, check_result.angles),
+        messages.check_poses_response_fields(check_result),
+        messages.compute_workspace_request_fields(workspace, stamp_ns=7_000, frame_id="base")[
+            "request"
+        ],
+        messages.summary_fields(workspace, stamp_ns=8_000, frame_id="base", n_points=36),
+        messages.pointcloud_fields(points, frame_id="base", stamp_ns=8_000),
+    ]
+    for reader in (read_with_rosbags, read_with_mcap_ros2):
+        assert [plain(message) for _, _, message in reader(path)] == plain(expected)
+
+
+def test_summary_and_cloud_of_one_computation_are_paired(tmp_path: Path) -> None:
+    """A ComputeWorkspace response and the topic summary of the same computation are one
+    result; a cloud arriving before its summary is still attached."""
+    path = tmp_path / "node.mcap"
+    workspace = projected_stub()
+    summary = messages.summary_fields(workspace, stamp_ns=9, frame_id="base")
+    cloud = messages.pointcloud_fields(
+        messages.boundary_points(workspace), frame_id="base", stamp_ns=9
+    )
+    with recording.LogWriter(path) as writer:
+        writer.write_fields("/n/projected_workspace", "sensor_msgs/msg/PointCloud2", cloud, 1)
+        writer.write_fields("/n/workspace_summary", messages.TYPES["summary"], summary, 2)
+        writer.write_fields(
+            "/n/compute_workspace/response",
+            "hexapod_workspace_msgs/srv/ComputeWorkspace_Response",
+            messages.compute_workspace_response_fields(
+                workspace, stamp_ns=9, frame_id="base", summary=summary, boundary=cloud
+            ),
+            3,
+        )
+    log_summary, _ = summarize_log(path)
+    (record,) = log_summary.workspaces
+    assert record.sources == ["/n/workspace_summary", "/n/compute_workspace/response"]
+    np.testing.assert_array_equal(record.points, messages.pointcloud_to_array(cloud))
+
+
+@pytest.mark.skipif(not HAVE_CORE_WORKSPACES, reason="core workspaces/plotting not there yet")
+def test_record_real_workspaces_replay_and_plot(tmp_path: Path, example) -> None:
+    from hexapod_workspace.orientation import orientation_workspace
+    from hexapod_workspace.projected import projected_workspace
+
+    results = [
+        projected_workspace(example, method="torsion_zero", n_phi=72),
+        projected_workspace(example, method="exact", n_phi=72),
+        orientation_workspace(example, n_rays=36, psi_step=math.radians(5)),
+    ]
+    path = record_results(tmp_path / "real.mcap", results, frame_id=example.frame_id)
+    code, out, _ = replay(path, as_json=True, plot_dir=tmp_path / "plots")
+    assert code == 0
+    report = json.loads(out)
+    assert [w["kind"] for w in report["workspaces"]] == ["torsion_zero", "exact", "orientation"]
+    assert report["workspaces"][0]["tilt_min_deg"] == pytest.approx(
+        math.degrees(results[0].tilt_min)
+    )
+    assert report["workspaces"][2]["volume"] == pytest.approx(results[2].volume)
+    plots = sorted(p.name for p in (tmp_path / "plots").glob("*.png"))
+    assert plots == ["workspace_001_projected.png", "workspace_003_orientation.png"]
+
+
+# --------------------------------------------------------------------------- bad logs
+
+
+def test_missing_and_foreign_files_exit_2_with_one_line(tmp_path: Path) -> None:
+    code, out, err = replay(tmp_path / "nope.mcap")
+    assert (code, out) == (2, "") and err.count("\n") == 1 and "no such file" in err
+    junk = tmp_path / "junk.mcap"
+    junk.write_bytes(b"definitely not MCAP")
+    code, _, err = replay(junk)
+    assert code == 2 and "not an MCAP file" in err
+    empty = tmp_path / "empty.mcap"
+    empty.write_bytes(b"")
+    assert replay(empty)[0] == 2
+
+
+def test_truncated_logs(tmp_path: Path, check_result) -> None:
+    path = tmp_path / "cli.mcap"
+    record_results(path, [check_result, projected_stub(), check_result], stamp_ns=1)
+    data = path.read_bytes()
+    head = tmp_path / "head.mcap"
+    head.write_bytes(data[:40])  # magic and header only
+    code, out, err = replay(head)
+    assert code == 2 and out == "" and "nothing usable" in err.splitlines()[-1]
+    half = tmp_path / "half.mcap"
+    half.write_bytes(data[: len(data) // 2])
+    code, out, err = replay(half, as_json=True)
+    assert code == 0 and err.startswith("note: half.mcap: unreadable from about byte")
+    report = json.loads(out)
+    assert not report["finished"] and report["problems"]
+    assert report["message_count"] >= 2
+
+
+def test_unknown_topics_are_skipped_with_a_note(tmp_path: Path) -> None:
+    path = tmp_path / "mixed.mcap"
+    with path.open("wb") as stream:
+        writer = RawMcapWriter(stream)
+        writer.start(profile="ros2")
+        foreign = writer.register_schema("foo_msgs/msg/Bar", "ros2msg", b"int32 a\n")
+        channel = writer.register_channel("/foo", "cdr", foreign)
+        writer.add_message(channel, 1, b"\x00\x01\x00\x00\x07\x00\x00\x00", 1)
+        writer.finish()
+    code, _, err = replay(path)
+    assert code == 2 and "foo_msgs/msg/Bar is unknown" in err and "nothing usable" in err
+    with path.open("wb") as stream:
+        writer = RawMcapWriter(stream)
+        writer.start(profile="ros2")
+        foreign = writer.register_schema("foo_msgs/msg/Bar", "ros2msg", b"int32 a\n")
+        ours = writer.register_schema(
+            messages.TYPES["summary"],
+            "ros2msg",
+            recording.message_definition(messages.TYPES["summary"]).encode(),
+        )
+        foo = writer.register_channel("/foo", "cdr", foreign)
+        summary = writer.register_channel("/s", "cdr", ours)
+        writer.add_message(foo, 1, b"\x00\x01\x00\x00\x07\x00\x00\x00", 1)
+        writer.add_message(
+            summary,
+            2,
+            bytes(
+                recording.serialize(
+                    messages.TYPES["summary"],
+                    messages.summary_fields(projected_stub(), stamp_ns=1, frame_id="base"),
+                )
+            ),
+            2,
+        )
+        writer.finish()
+    code, out, err = replay(path)
+    assert code == 0
+    assert err == "note: /foo: type foo_msgs/msg/Bar is unknown here; 1 message(s) skipped\n"
+    assert "/foo" in out and "workspace results: 1" in out
+
+
+def test_bag_directory_and_bad_rate(tmp_path: Path) -> None:
+    bag = tmp_path / "bag"
+    fields = messages.summary_fields(orientation_stub(), stamp_ns=3, frame_id="base")
+    with Rosbag2Writer(bag, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+        connection = writer.add_connection(
+            "/ws/summary", messages.TYPES["summary"], typestore=recording.get_typestore()
+        )
+        writer.write(connection, 5, recording.serialize(messages.TYPES["summary"], fields))
+    code, out, _ = replay(bag)
+    assert code == 0 and "orientation: psi -5.730..5.730 deg" in out
+    assert replay(bag, rate=-1.0)[0] == 2
+
+
+def test_empty_finished_log_is_fine(tmp_path: Path) -> None:
+    path = tmp_path / "idle.mcap"
+    with recording.LogWriter(path) as writer:
+        writer.add_channel("/hexapod_workspace/summary", messages.TYPES["summary"])
+    code, out, err = replay(path)
+    assert code == 0 and err == "" and "0 messages" in out
+
+
+# --------------------------------------------------------------------------- republishing
+
+HAVE_RCLPY = importlib.util.find_spec("rclpy") is not None
+
+
+@pytest.mark.skipif(HAVE_RCLPY, reason="checks the message given when rclpy is missing")
+def test_publish_without_rclpy_says_so(tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.delenv("ROS_AUTOMATIC_DISCOVERY_RANGE", raising=False)
+    path = tmp_path / "a.mcap"
+    record_results(path, [projected_stub()])
+    code, _, err = replay(path, publish=True)
+    assert code == 2 and "needs rclpy" in err.splitlines()[-1]
+
+
+def test_publish_refuses_network_discovery(tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "SUBNET")
+    path = tmp_path / "a.mcap"
+    record_results(path, [projected_stub()])
+    code, _, err = replay(path, publish=True)
+    assert code == 2 and "refusing" in err
+
+
+@pytest.mark.skipif(
+    not HAVE_RCLPY,
+    reason="rclpy not importable: run under the ROS venv (make test) to exercise replay --publish",
+)
+def test_publish_republishes_recorded_clouds(tmp_path: Path, monkeypatch) -> None:
+    import threading
+
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+    from sensor_msgs.msg import PointCloud2
+
+    monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+    assert os.environ.get("ROS_DOMAIN_ID"), "tests that start rclpy need a test ROS_DOMAIN_ID"
+    path = tmp_path / "clouds.mcap"
+    rng = np.random.default_rng(3)
+    clouds = [
+        messages.pointcloud_fields(rng.normal(size=(100 * (i + 1), 6)), frame_id="base", stamp_ns=i)
+        for i in range(3)
+    ]
+    with recording.LogWriter(path) as writer:
+        for i, cloud in enumerate(clouds):
+            writer.write_fields(
+                "/replay_test/boundary",
+                "sensor_msgs/msg/PointCloud2",
+                cloud,
+                1_000_000 * i,
+                qos=recording.REQUEST_QOS,
+            )
+    context = rclpy.Context()
+    rclpy.init(context=context)
+    received: list[PointCloud2] = []
+    done = threading.Event()
+    try:
+        node = rclpy.create_node("replay_test_listener", context=context)
+
+        def on_cloud(message: PointCloud2) -> None:
+            received.append(message)
+            if len(received) == len(clouds):
+                done.set()
+
+        qos = QoSProfile(
+            depth=10, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE
+        )
+        node.create_subscription(PointCloud2, "/replay_test/boundary", on_cloud, qos)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(node)
+        spinner = threading.Thread(target=executor.spin, daemon=True)
+        spinner.start()
+        code, _, err = replay(path, publish=True, rate=10.0, wait_for_subscribers=60.0)
+        assert code == 0, err
+        assert done.wait(timeout=60), f"received {len(received)} of {len(clouds)}"
+        assert [plain(m) for m in received] == plain(clouds)
+    finally:
+        rclpy.try_shutdown(context=context)
