@@ -81,3 +81,26 @@ def read_with_mcap_ros2(path: Path) -> list[tuple[str, str, Any]]:
         except (McapError, EOFError, ValueError):
             pass
     return out
+
+
+def write_foreign_log(path: Path, ours: list[tuple[str, str, bytes]] = ()) -> None:
+    """A finished MCAP log with one message of a type nobody here knows (/foo,
+    foo_msgs/msg/Bar), then ``ours``: (topic, type, CDR bytes) written with full schemas."""
+    from mcap.writer import Writer
+
+    from hexapod_workspace.recording import message_definition
+
+    with Path(path).open("wb") as stream:
+        writer = Writer(stream)
+        writer.start(profile="ros2")
+        foreign = writer.register_schema("foo_msgs/msg/Bar", "ros2msg", b"int32 a\n")
+        channel = writer.register_channel("/foo", "cdr", foreign)
+        writer.add_message(channel, 1, b"\x00\x01\x00\x00\x07\x00\x00\x00", 1)
+        for time_ns, (topic, msgtype, data) in enumerate(ours, start=2):
+            schema = writer.register_schema(
+                msgtype, "ros2msg", message_definition(msgtype).encode()
+            )
+            writer.add_message(
+                writer.register_channel(topic, "cdr", schema), time_ns, bytes(data), time_ns
+            )
+        writer.finish()

@@ -18,8 +18,7 @@ import numpy as np
 import pytest
 import yaml
 from mcap.reader import make_reader
-from mcap.writer import Writer as RawMcapWriter
-from recording_support import plain, read_with_mcap_ros2, read_with_rosbags
+from recording_support import plain, read_with_mcap_ros2, read_with_rosbags, write_foreign_log
 from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Rosbag2Writer
 from rosbags.rosbag2.metadata import parse_qos
@@ -415,18 +414,7 @@ def test_corrupt_chunk_is_skipped_and_reported(tmp_path: Path) -> None:
 
 def test_unknown_types_are_skipped_with_a_note(tmp_path: Path) -> None:
     path = tmp_path / "foreign.mcap"
-    with path.open("wb") as stream:
-        writer = RawMcapWriter(stream)
-        writer.start(profile="ros2")
-        foreign = writer.register_schema("foo_msgs/msg/Bar", "ros2msg", b"int32 a\n")
-        ours = writer.register_schema(
-            SUMMARY, "ros2msg", recording.message_definition(SUMMARY).encode()
-        )
-        channel_foreign = writer.register_channel("/foo", "cdr", foreign)
-        channel_ours = writer.register_channel("/s", "cdr", ours)
-        writer.add_message(channel_foreign, 1, b"\x00\x01\x00\x00\x07\x00\x00\x00", 1)
-        writer.add_message(channel_ours, 2, recording.serialize(SUMMARY, {"request_id": "k"}), 2)
-        writer.finish()
+    write_foreign_log(path, [("/s", SUMMARY, recording.serialize(SUMMARY, {"request_id": "k"}))])
     contents = recording.read_log(path)
     assert [m.topic for m in contents.messages] == ["/s"]
     assert contents.topics["/foo"].count == 1 and contents.topics["/foo"].decoded == 0

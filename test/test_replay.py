@@ -11,8 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from mcap.writer import Writer as RawMcapWriter
-from recording_support import plain, read_with_mcap_ros2, read_with_rosbags
+from recording_support import plain, read_with_mcap_ros2, read_with_rosbags, write_foreign_log
 from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Rosbag2Writer
 from test_messages import orientation_stub, projected_stub
@@ -178,39 +177,12 @@ def test_truncated_logs(tmp_path: Path, check_result) -> None:
 
 def test_unknown_topics_are_skipped_with_a_note(tmp_path: Path) -> None:
     path = tmp_path / "mixed.mcap"
-    with path.open("wb") as stream:
-        writer = RawMcapWriter(stream)
-        writer.start(profile="ros2")
-        foreign = writer.register_schema("foo_msgs/msg/Bar", "ros2msg", b"int32 a\n")
-        channel = writer.register_channel("/foo", "cdr", foreign)
-        writer.add_message(channel, 1, b"\x00\x01\x00\x00\x07\x00\x00\x00", 1)
-        writer.finish()
+    write_foreign_log(path)
     code, _, err = replay(path)
     assert code == 2 and "foo_msgs/msg/Bar is unknown" in err and "nothing usable" in err
-    with path.open("wb") as stream:
-        writer = RawMcapWriter(stream)
-        writer.start(profile="ros2")
-        foreign = writer.register_schema("foo_msgs/msg/Bar", "ros2msg", b"int32 a\n")
-        ours = writer.register_schema(
-            messages.TYPES["summary"],
-            "ros2msg",
-            recording.message_definition(messages.TYPES["summary"]).encode(),
-        )
-        foo = writer.register_channel("/foo", "cdr", foreign)
-        summary = writer.register_channel("/s", "cdr", ours)
-        writer.add_message(foo, 1, b"\x00\x01\x00\x00\x07\x00\x00\x00", 1)
-        writer.add_message(
-            summary,
-            2,
-            bytes(
-                recording.serialize(
-                    messages.TYPES["summary"],
-                    messages.summary_fields(projected_stub(), stamp_ns=1, frame_id="base"),
-                )
-            ),
-            2,
-        )
-        writer.finish()
+    summary = messages.summary_fields(projected_stub(), stamp_ns=1, frame_id="base")
+    summary_type = messages.TYPES["summary"]
+    write_foreign_log(path, [("/s", summary_type, recording.serialize(summary_type, summary))])
     code, out, err = replay(path)
     assert code == 0
     assert err == "note: /foo: type foo_msgs/msg/Bar is unknown here; 1 message(s) skipped\n"
