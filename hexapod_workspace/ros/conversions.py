@@ -1,0 +1,121 @@
+"""rclpy messages from the ROS-free field dicts of :mod:`hexapod_workspace.messages`, and back.
+
+:mod:`hexapod_workspace.messages` is the single mapping from core results to message fields
+(nested dicts keyed by ROS field names). This module only moves those dicts into generated rclpy
+message classes (:func:`to_message`) and reads request messages into numpy arrays. No per-point
+Python loop touches a point cloud: ``PointCloud2.data`` is assigned as one
+``array.array("B", bytes)`` (assigning a numpy array or memoryview there takes seconds for 10^6
+points in rclpy).
+
+Units and frames are those of the messages: SI (m, rad), positions in the base frame.
+"""
+
+from __future__ import annotations
+
+import array
+import functools
+import importlib
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from rosidl_parser.definition import AbstractSequence, Array, BasicType, NamespacedType
+
+__all__ = [
+    "angles_from_orientations",
+    "position_from_point",
+    "to_message",
+]
+
+
+@functools.cache
+def _message_class(namespaced: tuple[str, ...]) -> type:
+    """The generated class of a namespaced type, e.g. ``("geometry_msgs", "msg", "Point")``."""
+    *namespaces, name = namespaced
+    return getattr(importlib.import_module(".".join(namespaces)), name)
+
+
+@functools.cache
+def _slots(message_class: type) -> dict[str, Any]:
+    """Field name -> rosidl type of a generated message class."""
+    names = message_class.get_fields_and_field_types().keys()
+    return dict(zip(names, message_class.SLOT_TYPES, strict=True))
+
+
+def _namespaced_class(definition: NamespacedType) -> type:
+    return _message_class((*definition.namespaces, definition.name))
+
+
+def _value(definition: Any, value: Any) -> Any:
+    """Convert one field value from the dict form to what the rclpy message accepts."""
+    if isinstance(definition, NamespacedType):
+        return to_message(_namespaced_class(definition), value)
+    if isinstance(definition, (AbstractSequence, Array)):
+        element = definition.value_type
+        if isinstance(element, NamespacedType):
+            element_class = _namespaced_class(element)
+            return [to_message(element_class, item) for item in value]
+        if isinstance(element, BasicType) and element.typename in ("uint8", "octet"):
+            # the fast path for PointCloud2.data (bytes in the dict form)
+            return array.array("B", bytes(value))
+        if isinstance(value, np.ndarray):
+            return value.tolist()
+        return list(value)
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def to_message(message_class: type, fields: Mapping[str, Any] | Any) -> Any:
+    """Build an rclpy message of ``message_class`` from a field dict.
+
+    Parameters
+    ----------
+    message_class : type
+        A generated message (or service request/response) class, e.g.
+        ``hexapod_workspace_msgs.msg.PoseCheck``.
+    fields : Mapping or message
+        Nested dict keyed by field names, as returned by :mod:`hexapod_workspace.messages`
+        (nested messages as dicts, message sequences as lists of dicts, ``uint8[]`` as
+        ``bytes``). Missing fields keep their defaults. A message instance of the right class is
+        returned unchanged.
+
+    Returns
+    -------
+    message_class instance
+
+    Raises
+    ------
+    KeyError
+        A field the message does not have.
+    """
+    if isinstance(fields, message_class):
+        return fields
+    slots = _slots(message_class)
+    message = message_class()
+    for name, value in fields.items():
+        setattr(message, name, _value(slots[name], value))
+    return message
+
+
+def angles_from_orientations(orientations: Sequence[Any]) -> NDArray[np.float64]:
+    """Tilt-and-Torsion angles of ``TiltTorsion`` messages as an array.
+
+    Parameters
+    ----------
+    orientations : sequence of hexapod_workspace_msgs/msg/TiltTorsion
+        Each with ``phi``, ``theta``, ``psi`` in rad.
+
+    Returns
+    -------
+    ndarray, shape (N, 3)
+        Columns φ, θ, ψ, rad (not validated: NaN stays NaN, the core refuses it).
+    """
+    flat = [value for o in orientations for value in (o.phi, o.theta, o.psi)]
+    return np.array(flat, dtype=np.float64).reshape(-1, 3)
+
+
+def position_from_point(point: Any) -> NDArray[np.float64]:
+    """A ``geometry_msgs/msg/Point`` as an array of shape (3,), m, base frame."""
+    return np.array((point.x, point.y, point.z), dtype=np.float64)

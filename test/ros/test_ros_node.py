@@ -1,0 +1,284 @@
+"""workspace_node over real Fast DDS: services, topics and parameters from another process.
+
+The node runs from the colcon install space with a parameters file (see conftest.py); every
+verdict is compared with the ROS-free core computed here from the same file.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from ros_support import require_ros, running_node
+
+require_ros()
+
+from hexapod_workspace_msgs.msg import CommandedPose, ReachabilityResult, TiltTorsion  # noqa: E402
+from hexapod_workspace_msgs.srv import CheckPoses  # noqa: E402
+from rcl_interfaces.msg import Parameter as ParameterMsg  # noqa: E402
+from rcl_interfaces.msg import ParameterType, ParameterValue  # noqa: E402
+from rcl_interfaces.srv import (  # noqa: E402
+    DescribeParameters,
+    SetParameters,
+    SetParametersAtomically,
+)
+
+from hexapod_workspace import CONSTRAINT_NAMES, Manipulator, check  # noqa: E402
+
+NODE = "/hexapod_workspace"
+#: Small resolutions keep the workspace computations of the tests short.
+NODE_PARAMS = {
+    "resolution.n_phi": 72,
+    "resolution.n_rays": 24,
+    "resolution.psi_step": 0.05,
+    "resolution.tolerance": 1e-4,
+    "check.max_poses": 2000,
+}
+
+
+@pytest.fixture(scope="module")
+def workspace_node(ros_domain, tmp_path_factory):
+    directory = tmp_path_factory.mktemp("workspace_node")
+    with running_node(directory, NODE_PARAMS) as node:
+        yield node
+        print(f"---- node output ({node.log_path})\n{node.output()}")
+
+
+@pytest.fixture(scope="module")
+def model(workspace_node) -> Manipulator:
+    """The manipulator the node was started with, built by the core from the same file."""
+    return Manipulator.from_params_file(workspace_node.params_path)
+
+
+@pytest.fixture(scope="module")
+def client(ros_client, workspace_node):
+    ros_client.client(CheckPoses, f"{NODE}/check_poses")  # waits for discovery
+    return ros_client
+
+
+def sample_angles(count: int, seed: int = 4) -> np.ndarray:
+    """Seeded (φ, θ, ψ) poses, about half of them reachable for the example GPM at home."""
+    rng = np.random.default_rng(seed)
+    return np.column_stack(
+        (
+            rng.uniform(-math.pi, math.pi, count),
+            rng.uniform(0.0, math.radians(60.0), count),
+            rng.uniform(-math.radians(45.0), math.radians(45.0), count),
+        )
+    )
+
+
+def check_request(angles: np.ndarray, position=(0.0, 0.0, -1.3)) -> CheckPoses.Request:
+    request = CheckPoses.Request()
+    request.position.x, request.position.y, request.position.z = (float(v) for v in position)
+    request.orientations = [
+        TiltTorsion(phi=float(p), theta=float(t), psi=float(s)) for p, t, s in angles
+    ]
+    return request
+
+
+def assert_matches_core(response: CheckPoses.Response, expected) -> None:
+    """Every field of every PoseCheck equals the core's verdict (float64 travels exactly)."""
+    assert response.success, response.message
+    assert len(response.results) == len(expected)
+    got_reachable = np.array([r.reachable for r in response.results])
+    np.testing.assert_array_equal(got_reachable, expected.reachable)
+    assert [list(r.violated) for r in response.results] == expected.violated
+    for name in CONSTRAINT_NAMES:
+        got = np.array([getattr(r, f"{name}_margin") for r in response.results])
+        np.testing.assert_array_equal(got, expected.margins[name])
+    got_legs = np.array([r.limiting_leg for r in response.results])
+    np.testing.assert_array_equal(got_legs, expected.limiting_leg)
+    reachable = int(np.count_nonzero(expected.reachable))
+    assert response.message == f"{reachable}/{len(expected)} reachable"
+
+
+# ---------------------------------------------------------------------------- check_poses
+
+
+def test_check_poses_matches_core(client, model):
+    angles = sample_angles(300)
+    expected = check(model, angles, model.position)
+    assert 0 < np.count_nonzero(expected.reachable) < len(expected), "need both verdicts"
+    response = client.call(CheckPoses, f"{NODE}/check_poses", check_request(angles))
+    assert_matches_core(response, expected)
+
+
+def test_check_poses_at_another_position(client, model):
+    angles = sample_angles(50, seed=9)
+    position = (0.2, 0.2, -0.95)
+    expected = check(model, angles, position)
+    response = client.call(CheckPoses, f"{NODE}/check_poses", check_request(angles, position))
+    assert_matches_core(response, expected)
+
+
+def test_check_poses_single_pose_at_the_singular_tilt(client, model):
+    # theta = 0 merges phi and psi: the verdict must not depend on phi there
+    angles = np.array([[0.0, 0.0, 0.1], [2.0, 0.0, 0.1]])
+    response = client.call(CheckPoses, f"{NODE}/check_poses", check_request(angles))
+    assert_matches_core(response, check(model, angles, model.position))
+    assert response.results[0].reachable == response.results[1].reachable
+
+
+@pytest.mark.parametrize(
+    ("angles", "position", "reason"),
+    [
+        (np.zeros((0, 3)), (0.0, 0.0, -1.3), "at least one"),
+        (np.array([[0.0, math.nan, 0.0]]), (0.0, 0.0, -1.3), "finite"),
+        (np.array([[math.inf, 0.1, 0.0]]), (0.0, 0.0, -1.3), "finite"),
+        (np.array([[0.0, 0.1, 0.0]]), (0.0, math.nan, -1.3), "finite"),
+        (np.array([[0.0, 0.1, 0.0]]), (0.0, 0.0, -math.inf), "finite"),
+        (np.zeros((2001, 3)), (0.0, 0.0, -1.3), "at most 2000"),
+    ],
+    ids=["empty", "nan-angle", "inf-angle", "nan-position", "inf-position", "too-many"],
+)
+def test_check_poses_refuses_bad_requests(client, angles, position, reason):
+    response = client.call(CheckPoses, f"{NODE}/check_poses", check_request(angles, position))
+    assert not response.success
+    assert reason in response.message
+    assert len(response.results) == 0
+
+
+def test_node_survives_bad_requests(client, model):
+    # after every refusal above (and here), ordinary requests are still served
+    bad = check_request(np.array([[math.nan, math.nan, math.nan]]))
+    assert not client.call(CheckPoses, f"{NODE}/check_poses", bad).success
+    angles = sample_angles(5)
+    response = client.call(CheckPoses, f"{NODE}/check_poses", check_request(angles))
+    assert_matches_core(response, check(model, angles, model.position))
+
+
+# ---------------------------------------------------------------------------- commanded_pose
+
+
+def commanded(request_id: str, angles, position=(0.0, 0.0, -1.3)) -> CommandedPose:
+    message = CommandedPose(request_id=request_id)
+    message.position.x, message.position.y, message.position.z = (float(v) for v in position)
+    phi, theta, psi = (float(v) for v in angles)
+    message.orientation = TiltTorsion(phi=phi, theta=theta, psi=psi)
+    return message
+
+
+def test_commanded_pose_gets_a_reachability_result(client, model):
+    received = client.collect(ReachabilityResult, f"{NODE}/reachability")
+    publisher = client.publisher(CommandedPose, f"{NODE}/commanded_pose")
+    angles = sample_angles(6, seed=21)
+    expected = check(model, angles, model.position)
+    for k, pose in enumerate(angles):
+        publisher.publish(commanded(f"cmd-{k}", pose))
+    bad = commanded("cmd-nan", (0.0, math.nan, 0.0))
+    publisher.publish(bad)
+    client.spin_until(lambda: len(received) >= 7, what="7 reachability results")
+    by_id = {result.request_id: result for result in received}
+    for k in range(6):
+        result = by_id[f"cmd-{k}"]
+        assert result.success
+        assert result.header.frame_id == model.frame_id
+        assert result.check.reachable == bool(expected.reachable[k])
+        assert list(result.check.violated) == expected.violated[k]
+        assert result.check.leg_length_margin == expected.margins["leg_length"][k]
+        assert result.check.limiting_leg == expected.limiting_leg[k]
+        assert result.orientation.theta == angles[k, 1]
+        assert result.message == (
+            "reachable"
+            if expected.reachable[k]
+            else "unreachable: " + ", ".join(expected.violated[k])
+        )
+    failed = by_id["cmd-nan"]
+    assert not failed.success
+    assert "finite" in failed.message
+    assert math.isnan(failed.check.leg_length_margin)
+
+
+# ---------------------------------------------------------------------------- parameters
+
+
+def double_array(name: str, values) -> ParameterMsg:
+    return ParameterMsg(
+        name=name,
+        value=ParameterValue(
+            type=ParameterType.PARAMETER_DOUBLE_ARRAY, double_array_value=[float(v) for v in values]
+        ),
+    )
+
+
+def set_parameters(client, *parameters: ParameterMsg):
+    request = SetParameters.Request(parameters=list(parameters))
+    return client.call(SetParameters, f"{NODE}/set_parameters", request).results
+
+
+def test_invalid_parameter_update_is_refused_and_verdicts_kept(client, model):
+    angles = sample_angles(200, seed=5)
+    before = client.call(CheckPoses, f"{NODE}/check_poses", check_request(angles))
+    assert_matches_core(before, check(model, angles, model.position))
+
+    # leg_length_min above the current leg_length_max: the whole set is invalid
+    (result,) = set_parameters(client, double_array("limits.leg_length_min", [1.6]))
+    assert not result.successful
+    assert "limits.leg_length_min" in result.reason
+    # wrong length of a joint array
+    (result,) = set_parameters(client, double_array("geometry.base_joints", [0.0] * 17))
+    assert not result.successful
+    assert "geometry.base_joints" in result.reason
+    # wrong type (descriptor) and read-only parameters are refused by rclpy itself
+    text = ParameterMsg(
+        name="limits.leg_diameter",
+        value=ParameterValue(type=ParameterType.PARAMETER_STRING, string_value="thick"),
+    )
+    (result,) = set_parameters(client, text)
+    assert not result.successful
+    frame = ParameterMsg(
+        name="frame_id",
+        value=ParameterValue(type=ParameterType.PARAMETER_STRING, string_value="world"),
+    )
+    (result,) = set_parameters(client, frame)
+    assert not result.successful
+    # an atomic update with one bad member changes nothing
+    atomic = SetParametersAtomically.Request(
+        parameters=[
+            double_array("limits.leg_length_max", [1.45]),
+            double_array("limits.leg_length_min", [1.5]),
+        ]
+    )
+    result = client.call(
+        SetParametersAtomically, f"{NODE}/set_parameters_atomically", atomic
+    ).result
+    assert not result.successful
+    assert "leg_length" in result.reason
+
+    after = client.call(CheckPoses, f"{NODE}/check_poses", check_request(angles))
+    assert_matches_core(after, check(model, angles, model.position))
+
+
+def test_valid_parameter_update_changes_verdicts_and_back(client, model):
+    angles = sample_angles(200, seed=6)
+    shorter = Manipulator.from_mapping(
+        {**model.to_parameters(), "limits.leg_length_max": [1.40]}, warn=False
+    )
+    expected = check(shorter, angles, model.position)
+    assert not np.array_equal(expected.reachable, check(model, angles, model.position).reachable)
+    try:
+        (result,) = set_parameters(client, double_array("limits.leg_length_max", [1.40]))
+        assert result.successful, result.reason
+        response = client.call(CheckPoses, f"{NODE}/check_poses", check_request(angles))
+        assert_matches_core(response, expected)
+    finally:
+        original = model.to_parameters()["limits.leg_length_max"]
+        (result,) = set_parameters(client, double_array("limits.leg_length_max", original))
+        assert result.successful, result.reason
+    response = client.call(CheckPoses, f"{NODE}/check_poses", check_request(angles))
+    assert_matches_core(response, check(model, angles, model.position))
+
+
+def test_parameters_have_descriptors(client):
+    names = ["limits.leg_diameter", "resolution.n_rays", "check.max_poses", "frame_id"]
+    request = DescribeParameters.Request(names=names)
+    descriptors = client.call(DescribeParameters, f"{NODE}/describe_parameters", request)
+    by_name = {d.name: d for d in descriptors.descriptors}
+    assert set(by_name) == set(names)
+    assert all(d.description for d in by_name.values())
+    assert by_name["limits.leg_diameter"].floating_point_range[0].from_value == 0.0
+    assert by_name["resolution.n_rays"].integer_range[0].to_value == 7200
+    assert by_name["check.max_poses"].read_only
+    assert by_name["frame_id"].read_only
