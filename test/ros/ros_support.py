@@ -183,6 +183,12 @@ class RosClient:
             self._clients[name] = client
         return self._clients[name]
 
+    def drop_client(self, name: str) -> None:
+        """Destroy the cached client of ``name`` (its server went away; rediscover next time)."""
+        client = self._clients.pop(name, None)
+        if client is not None:
+            self.node.destroy_client(client)
+
     def call(
         self, service_type: type, name: str, request: Any, timeout: float = CALL_TIMEOUT
     ) -> Any:

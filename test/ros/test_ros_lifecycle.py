@@ -1,0 +1,67 @@
+"""workspace_node as a process: clean stop on SIGINT/SIGTERM, refusal of a bad parameters file."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+
+import pytest
+from ros_support import STOP_TIMEOUT, require_ros, running_node
+
+require_ros()
+
+from hexapod_workspace_msgs.msg import TiltTorsion  # noqa: E402
+from hexapod_workspace_msgs.srv import CheckPoses  # noqa: E402
+
+NODE = "/hexapod_workspace"
+
+
+def serve_one_check(client) -> None:
+    request = CheckPoses.Request(orientations=[TiltTorsion(phi=0.0, theta=0.1, psi=0.0)])
+    request.position.z = -1.3
+    response = client.call(CheckPoses, f"{NODE}/check_poses", request)
+    assert response.success, response.message
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_node_stops_cleanly_on_signal(ros_client, tmp_path, sig):
+    with running_node(tmp_path) as node:
+        serve_one_check(ros_client)
+        ros_client.drop_client(f"{NODE}/check_poses")  # the next node is discovered afresh
+        status = node.stop(sig)
+        output = node.output()
+    assert status == 0, output
+    assert "Traceback" not in output, output
+    assert list((tmp_path / "logs").glob("*.mcap")), "the run's log is missing"
+
+
+@pytest.mark.parametrize(
+    ("overrides", "named"),
+    [
+        ({"limits.leg_length_min": [2.0]}, "limits.leg_length_min"),
+        ({"geometry.base_joints": [0.0, 1.0, 2.0]}, "geometry.base_joints"),
+        ({"limits.leg_diameter": 0}, "limits.leg_diameter"),  # an integer where m is a float
+        ({"resolution.projected_method": "fastest"}, "resolution.projected_method"),
+        ({"resolution.n_rays": 1}, "resolution.n_rays"),
+    ],
+    ids=["lengths", "joints-shape", "int-type", "method", "range"],
+)
+def test_invalid_parameters_file_exits_with_the_reason(ros_domain, tmp_path, overrides, named):
+    with running_node(tmp_path, overrides) as node:
+        try:
+            status = node.process.wait(timeout=STOP_TIMEOUT * 2)
+        except subprocess.TimeoutExpired:
+            pytest.fail(f"node kept running with invalid parameters:\n{node.output()}")
+        output = node.output()
+    assert status == 1, output
+    assert named in output, output
+    assert "Traceback" not in output, output
+
+
+def test_unknown_parameter_is_reported(ros_client, tmp_path):
+    with running_node(tmp_path, {"limits.leg_diamter": 0.05}) as node:
+        serve_one_check(ros_client)
+        ros_client.drop_client(f"{NODE}/check_poses")
+        assert node.stop() == 0
+        output = node.output()
+    assert "limits.leg_diamter" in output, output
