@@ -1,0 +1,60 @@
+"""Launch workspace_node with a parameters file, optionally with RViz2 showing the clouds.
+
+    ros2 launch hexapod_workspace workspace.launch.py
+    ros2 launch hexapod_workspace workspace.launch.py params_file:=/path/to/my_gpm.yaml rviz:=true
+
+Arguments
+---------
+params_file
+    ROS 2 parameters file of the node (default: the packaged example GPM,
+    ``share/hexapod_workspace/config/example_gpm.yaml``).
+rviz
+    ``true`` also starts rviz2 with ``share/hexapod_workspace/config/workspace.rviz``.
+
+DDS discovery follows the environment of the caller (ROS_DOMAIN_ID,
+ROS_AUTOMATIC_DISCOVERY_RANGE); set ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST to keep traffic on
+this machine.
+"""
+
+from __future__ import annotations
+
+from launch_ros.actions import Node
+from launch_ros.substitutions import FindPackageShare
+
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument
+from launch.conditions import IfCondition
+from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
+
+
+def generate_launch_description() -> LaunchDescription:
+    """The node ``hexapod_workspace`` (and rviz2 when ``rviz:=true``)."""
+    share = FindPackageShare("hexapod_workspace")
+    params_file = LaunchConfiguration("params_file")
+    return LaunchDescription(
+        [
+            DeclareLaunchArgument(
+                "params_file",
+                default_value=PathJoinSubstitution([share, "config", "example_gpm.yaml"]),
+                description="Parameters file of workspace_node (geometry, limits, pose, ...).",
+            ),
+            DeclareLaunchArgument(
+                "rviz", default_value="false", description="Start rviz2 with the layout."
+            ),
+            Node(
+                package="hexapod_workspace",
+                executable="workspace_node",
+                name="hexapod_workspace",
+                output="screen",
+                emulate_tty=True,
+                parameters=[params_file],
+            ),
+            Node(
+                package="rviz2",
+                executable="rviz2",
+                name="rviz2",
+                arguments=["-d", PathJoinSubstitution([share, "config", "workspace.rviz"])],
+                condition=IfCondition(LaunchConfiguration("rviz")),
+            ),
+        ]
+    )

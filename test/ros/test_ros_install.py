@@ -1,0 +1,105 @@
+"""The colcon install space as a ROS user gets it: executables, launch file, layouts, interfaces.
+
+``ros2 launch`` itself is not installable from the package index here (no ``launch`` wheels), so
+the launch file is checked statically; the RViz layout's topics are checked against the topics
+the running node really offers.
+"""
+
+from __future__ import annotations
+
+import ast
+import os
+
+import pytest
+import yaml
+from ros_support import INSTALL, NODE_EXECUTABLE, require_ros, running_node
+
+require_ros()
+
+SHARE = INSTALL / "hexapod_workspace" / "share" / "hexapod_workspace"
+NODE = "/hexapod_workspace"
+
+
+def test_executables_are_installed_where_ros2_run_looks():
+    assert NODE_EXECUTABLE.is_file()
+    assert os.access(NODE_EXECUTABLE, os.X_OK)
+    cli = NODE_EXECUTABLE.parent / "hexapod-workspace"
+    assert cli.is_file()
+
+
+def test_package_is_registered_in_the_ament_index():
+    index = INSTALL / "hexapod_workspace" / "share" / "ament_index" / "resource_index"
+    assert (index / "packages" / "hexapod_workspace").is_file()
+    msgs = INSTALL / "hexapod_workspace_msgs" / "share" / "ament_index" / "resource_index"
+    assert (msgs / "packages" / "hexapod_workspace_msgs").is_file()
+    interfaces = (msgs / "rosidl_interfaces" / "hexapod_workspace_msgs").read_text()
+    for name in ("msg/TiltTorsion.msg", "srv/CheckPoses.srv", "srv/ComputeWorkspace.srv"):
+        assert name in interfaces.split()
+
+
+def test_launch_file_names_installed_files():
+    launch_file = SHARE / "launch" / "workspace.launch.py"
+    tree = ast.parse(launch_file.read_text(encoding="utf-8"))
+    functions = {node.name for node in ast.walk(tree) if isinstance(node, ast.FunctionDef)}
+    assert "generate_launch_description" in functions
+    strings = {
+        node.value
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Constant) and isinstance(node.value, str)
+    }
+    assert {"hexapod_workspace", "workspace_node", "example_gpm.yaml", "workspace.rviz"} <= strings
+    assert (SHARE / "config" / "example_gpm.yaml").is_file()
+    assert (SHARE / "config" / "workspace.rviz").is_file()
+
+
+@pytest.fixture(scope="module")
+def node_topics(ros_client, tmp_path_factory):
+    """Topic and service name -> types offered by a running node (seen from this process)."""
+    with running_node(tmp_path_factory.mktemp("install_node")) as node:
+        wanted = f"{NODE}/orientation_workspace"
+
+        def offered() -> dict:
+            return {
+                **dict(ros_client.node.get_topic_names_and_types()),
+                **dict(ros_client.node.get_service_names_and_types()),
+            }
+
+        service = f"{NODE}/compute_projected_workspace"
+        ros_client.spin_until(
+            lambda: {wanted, service} <= set(offered()), what="the node's interfaces", timeout=60.0
+        )
+        topics = offered()
+        node.stop()
+    return topics
+
+
+def test_rviz_layout_shows_the_node_clouds(node_topics):
+    layout = yaml.safe_load((SHARE / "config" / "workspace.rviz").read_text(encoding="utf-8"))
+    displays = layout["Visualization Manager"]["Displays"]
+    clouds = [d for d in displays if d["Class"] == "rviz_default_plugins/PointCloud2"]
+    assert {d["Topic"]["Value"] for d in clouds} == {
+        f"{NODE}/orientation_workspace",
+        f"{NODE}/projected_workspace",
+    }
+    for display in clouds:
+        assert node_topics[display["Topic"]["Value"]] == ["sensor_msgs/msg/PointCloud2"]
+        assert display["Topic"]["Durability Policy"] == "Transient Local"
+        assert display["Channel Name"] in {"phi", "theta", "psi"}
+    assert layout["Visualization Manager"]["Global Options"]["Fixed Frame"] == "base"
+
+
+def test_node_offers_every_interface_of_the_issue(node_topics):
+    expected = {
+        f"{NODE}/orientation_workspace": "sensor_msgs/msg/PointCloud2",
+        f"{NODE}/projected_workspace": "sensor_msgs/msg/PointCloud2",
+        f"{NODE}/workspace_summary": "hexapod_workspace_msgs/msg/WorkspaceSummary",
+        f"{NODE}/reachability": "hexapod_workspace_msgs/msg/ReachabilityResult",
+        f"{NODE}/workspace_request": "hexapod_workspace_msgs/msg/WorkspaceRequest",
+        f"{NODE}/commanded_pose": "hexapod_workspace_msgs/msg/CommandedPose",
+        f"{NODE}/check_poses": "hexapod_workspace_msgs/srv/CheckPoses",
+        f"{NODE}/compute_workspace": "hexapod_workspace_msgs/srv/ComputeWorkspace",
+        f"{NODE}/compute_orientation_workspace": "std_srvs/srv/Trigger",
+        f"{NODE}/compute_projected_workspace": "std_srvs/srv/Trigger",
+    }
+    for topic, type_name in expected.items():
+        assert node_topics.get(topic) == [type_name], topic
