@@ -25,7 +25,8 @@ from sensor_msgs.msg import PointCloud2, PointField  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 
 from hexapod_workspace import Manipulator, messages  # noqa: E402
-from hexapod_workspace.projected import projected_workspace  # noqa: E402
+
+projected_workspace = pytest.importorskip("hexapod_workspace.projected").projected_workspace
 
 NODE = "/hexapod_workspace"
 N_PHI, N_RAYS, PSI_STEP, TOLERANCE = 72, 24, 0.05, 1e-4

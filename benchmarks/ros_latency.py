@@ -1,0 +1,210 @@
+"""Round-trip time of ~/check_poses from a client in another process, idle and under load.
+
+Starts workspace_node from the colcon install space (``make ros``) in its own process, in a
+DDS domain of its own with ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST, and measures from an rclpy
+client in this process:
+
+1. one pose per request (goal: median <= 2 ms);
+2. 1000 poses per request, against the core's ``check`` of the same 1000 poses in this process
+   (the ratio is the cost of ROS: messages, DDS, executor);
+3. one pose per request while a 3-D orientation workspace is being computed by the node (goal:
+   median <= 2 ms too), against the idle median of step 1.
+
+Run it in the ROS environment::
+
+    tools/with_ros_env.sh python benchmarks/ros_latency.py [--samples 500]
+
+Prints medians and 95th percentiles in ms, and the ratios; exits 1 when a goal is missed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+NODE_EXECUTABLE = (
+    REPO / "install" / "hexapod_workspace" / "lib" / "hexapod_workspace" / "workspace_node"
+)
+GOAL_MS = 2.0
+NODE = "/hexapod_workspace"
+
+
+def percentiles(samples_s: list[float]) -> tuple[float, float]:
+    """Median and 95th percentile in ms."""
+    values = np.asarray(samples_s) * 1e3
+    return float(np.median(values)), float(np.percentile(values, 95))
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the benchmark; return 0 when every goal is met."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--samples", type=int, default=500, help="1-pose calls per phase")
+    parser.add_argument("--batch-samples", type=int, default=50, help="1000-pose calls")
+    parser.add_argument(
+        "--node-arg",
+        action="append",
+        default=[],
+        metavar="ARG",
+        help="extra --ros-args argument of the node, e.g. --node-arg=-p "
+        "--node-arg=recording.enabled:=false",
+    )
+    args = parser.parse_args(argv)
+    if not NODE_EXECUTABLE.is_file():
+        print(f"{NODE_EXECUTABLE} missing: run `make ros` first", file=sys.stderr)
+        return 2
+
+    import domain_coordinator
+
+    with domain_coordinator.domain_id() as domain, tempfile.TemporaryDirectory() as tmp:
+        os.environ["ROS_DOMAIN_ID"] = str(domain)
+        os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+        log = Path(tmp) / "node.log"
+        with log.open("wb") as out:
+            node = subprocess.Popen(
+                [
+                    str(NODE_EXECUTABLE),
+                    "--ros-args",
+                    "--params-file",
+                    str(REPO / "config" / "example_gpm.yaml"),
+                    "-p",
+                    f"recording.directory:={tmp}",
+                    *args.node_arg,
+                ],
+                stdout=out,
+                stderr=subprocess.STDOUT,
+                env=dict(os.environ),
+            )
+        try:
+            return run(args, domain)
+        finally:
+            if node.poll() is None:
+                node.send_signal(signal.SIGINT)
+                try:
+                    node.wait(timeout=30)
+                except subprocess.TimeoutExpired:
+                    node.kill()
+                    node.wait()
+
+
+def run(args: argparse.Namespace, domain: int) -> int:
+    import rclpy
+    from hexapod_workspace_msgs.msg import TiltTorsion, WorkspaceRequest
+    from hexapod_workspace_msgs.srv import CheckPoses, ComputeWorkspace
+    from rclpy.executors import SingleThreadedExecutor
+
+    from hexapod_workspace import Manipulator, check
+    from hexapod_workspace._resources import example_config_path
+
+    rclpy.init(domain_id=domain)
+    client_node = rclpy.create_node(f"latency_client_{os.getpid()}")
+    # The client spins in a thread of its own and calls synchronously, as a controller would
+    # (spin_until_future_complete per call adds several ms of client-side overhead in rclpy).
+    executor = SingleThreadedExecutor()
+    executor.add_node(client_node)
+    spinner = threading.Thread(target=executor.spin, name="client-spin", daemon=True)
+    spinner.start()
+    checks = client_node.create_client(CheckPoses, f"{NODE}/check_poses")
+    computes = client_node.create_client(ComputeWorkspace, f"{NODE}/compute_workspace")
+    try:
+        if not (checks.wait_for_service(timeout_sec=60) and computes.wait_for_service(60)):
+            print("node services not discovered within 60 s", file=sys.stderr)
+            return 2
+
+        def timed(request) -> float:
+            start = time.perf_counter()
+            response = checks.call(request, timeout_sec=60.0)
+            elapsed = time.perf_counter() - start
+            if response is None or not response.success:
+                raise RuntimeError(f"check_poses failed: {response}")
+            return elapsed
+
+        one = CheckPoses.Request(orientations=[TiltTorsion(phi=0.3, theta=0.2, psi=0.1)])
+        one.position.z = -1.3
+        rng = np.random.default_rng(1)
+        angles = np.column_stack(
+            (
+                rng.uniform(-math.pi, math.pi, 1000),
+                rng.uniform(0.0, 0.8, 1000),
+                rng.uniform(-0.5, 0.5, 1000),
+            )
+        )
+        batch = CheckPoses.Request(
+            orientations=[TiltTorsion(phi=p, theta=t, psi=s) for p, t, s in angles.tolist()]
+        )
+        batch.position.z = -1.3
+
+        for _ in range(50):  # warm-up (discovery of the reply path, first allocations)
+            timed(one)
+        idle = [timed(one) for _ in range(args.samples)]
+        batched = [timed(batch) for _ in range(args.batch_samples)]
+        manipulator = Manipulator.from_params_file(example_config_path())
+        core = []
+        for _ in range(args.batch_samples):
+            start = time.perf_counter()
+            check(manipulator, angles, (0.0, 0.0, -1.3))
+            core.append(time.perf_counter() - start)
+
+        # a 3-D orientation workspace, fine enough to take several seconds
+        request = WorkspaceRequest(
+            kind=WorkspaceRequest.ORIENTATION, n_rays=360, psi_step=0.005, tolerance=1e-7
+        )
+        request.position.z = -1.3
+        long_call = computes.call_async(ComputeWorkspace.Request(request=request))
+        time.sleep(0.5)  # let the request reach the node
+        loaded: list[float] = []
+        while not long_call.done() and len(loaded) < args.samples:
+            sample = timed(one)
+            if not long_call.done():
+                loaded.append(sample)
+        computing_start = time.perf_counter()
+        deadline = computing_start + 900.0
+        while not long_call.done() and time.perf_counter() < deadline:
+            time.sleep(0.05)
+        remaining = time.perf_counter() - computing_start
+        summary = long_call.result().summary if long_call.done() else None
+    finally:
+        executor.shutdown()
+        spinner.join(timeout=10)
+        client_node.destroy_node()
+        rclpy.try_shutdown()
+
+    idle_med, idle_p95 = percentiles(idle)
+    batch_med, batch_p95 = percentiles(batched)
+    core_med, _ = percentiles(core)
+    print(f"check_poses, 1 pose, idle:        median {idle_med:7.3f} ms  p95 {idle_p95:7.3f} ms")
+    print(
+        f"check_poses, 1000 poses, idle:    median {batch_med:7.3f} ms  p95 {batch_p95:7.3f} ms"
+        f"  (core check in-process {core_med:.3f} ms; ratio {batch_med / core_med:.1f}x)"
+    )
+    ok = idle_med <= GOAL_MS
+    if loaded:
+        load_med, load_p95 = percentiles(loaded)
+        print(
+            f"check_poses, 1 pose, during 3-D:  median {load_med:7.3f} ms  p95 {load_p95:7.3f} ms"
+            f"  ({len(loaded)} calls; ratio to idle {load_med / idle_med:.2f}x)"
+        )
+        ok = ok and load_med <= GOAL_MS
+    else:
+        print("check_poses during 3-D: the computation ended before the first check")
+    if summary is not None:
+        print(
+            f"3-D workspace: {summary.message} (success={summary.success}, "
+            f"{summary.elapsed:.1f} s in the node; {remaining:.1f} s left after the checks)"
+        )
+    print(f"goal (median <= {GOAL_MS} ms, idle and during 3-D): {'met' if ok else 'MISSED'}")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
