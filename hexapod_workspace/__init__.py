@@ -19,6 +19,14 @@ from .errors import (
     UnreachableReferenceError,
 )
 from .manipulator import HomePoseWarning, Manipulator
+from .orientation import (
+    OrientationSlice,
+    OrientationWorkspace,
+    TorsionRange,
+    orientation_workspace,
+    torsion_range,
+)
+from .projected import ProjectedWorkspace, projected_workspace
 
 __version__ = "0.1.0"
 
@@ -32,8 +40,15 @@ __all__ = [
     "InputError",
     "LogReadError",
     "Manipulator",
+    "OrientationSlice",
+    "OrientationWorkspace",
+    "ProjectedWorkspace",
     "RecordingError",
     "ResolutionError",
+    "TorsionRange",
     "UnreachableReferenceError",
     "check",
+    "orientation_workspace",
+    "projected_workspace",
+    "torsion_range",
 ]

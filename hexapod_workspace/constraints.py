@@ -262,7 +262,7 @@ def pose_margins(
     margins = np.empty((4, count))
     legs = np.zeros((4, count), dtype=np.int64)
     pairs = np.zeros((count, 2), dtype=np.int64)
-    model = _ChunkModel(manipulator, interference)
+    model = _chunk_model(manipulator, interference)
     for start in range(0, count, CHUNK):
         stop = min(start + CHUNK, count)
         model.evaluate(
@@ -273,6 +273,15 @@ def pose_margins(
             pairs[start:stop],
         )
     return PoseMargins(margins, legs, pairs)
+
+
+def _chunk_model(manipulator: Manipulator, interference: bool) -> _ChunkModel:
+    """The chunk model of a manipulator, cached on the (immutable) manipulator object."""
+    cache = manipulator.__dict__.setdefault("_chunk_models", {})
+    model = cache.get(interference)
+    if model is None:
+        model = cache[interference] = _ChunkModel(manipulator, interference)
+    return model
 
 
 class _ChunkModel:
@@ -499,7 +508,7 @@ def check(
     margins = np.empty((4, count))
     legs = np.zeros((4, count), dtype=np.int64)
     pairs = np.zeros((count, 2), dtype=np.int64)
-    model = _ChunkModel(manipulator, interference=True)
+    model = _chunk_model(manipulator, interference=True)
     positions = np.broadcast_to(position, (CHUNK, 3))
     for start in range(0, count, CHUNK):
         stop = min(start + CHUNK, count)

@@ -1,0 +1,490 @@
+"""3-D orientation workspace (ψ slices in the cylindrical picture) and torsion ranges.
+
+Cylindrical picture (DESIGN.md section 1): x = θ cos φ, y = θ sin φ, z = ψ. The orientation
+workspace at a position is the set of reachable (x, y, ψ) connected to the reference
+orientation (0, 0, 0). It is computed as in Bonev & Ryu, with every boundary located to a
+tolerance by the certified search of :mod:`hexapod_workspace.search`:
+
+1. The ψ = 0 slice: ``n_rays`` rays from the origin, then again from the area centroid of
+   that first polygon.
+2. Slices ψ = ±Δψ, ±2Δψ, ... upward and downward: rays from the area centroid of the
+   previous slice. When that centroid is unreachable in the new slice, points of the previous
+   slice pulled halfway towards its centroid are tried as centres (the most comfortable one,
+   largest relative margin, is used); a slice with no reachable centre is empty and ends the
+   march.
+3. ψmax (ψmin) is located to the tolerance: from the centre and the pulled points of the last
+   non-empty slice, the torsion is increased (decreased) until the first violation, and the
+   best of those is refined by a shrinking pattern search over (x, y).
+
+Volume: the solid's volume in the cylindrical coordinates (rad³), ∫ area(ψ) dψ by the
+trapezoid rule over the slices, with cones to ψmin and ψmax.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .constraints import relative_margins
+from .errors import InputError, ResolutionError
+from .manipulator import Manipulator
+from .projected import (
+    reference_torsion_interval,
+    require_reachable_reference,
+    validate_position,
+    validate_rays,
+    validate_tolerance,
+)
+from .search import RaySearch
+
+__all__ = [
+    "MAX_SLICES",
+    "OrientationSlice",
+    "OrientationWorkspace",
+    "TorsionRange",
+    "orientation_workspace",
+    "torsion_range",
+]
+
+#: Bounds on the slice step Δψ, rad.
+MIN_PSI_STEP, MAX_PSI_STEP = 1e-4, 0.5
+#: Largest number of slices one computation may produce (both directions together).
+MAX_SLICES = 20_000
+#: Largest number of boundary points (slices × rays) one computation may produce.
+MAX_POINTS = 5_000_000
+#: Pattern-search rounds when refining ψmax / ψmin.
+PSI_LIMIT_ROUNDS = 24
+
+Progress = Callable[[float], None]
+
+
+@dataclass(frozen=True)
+class OrientationSlice:
+    """One ψ slice of the orientation workspace.
+
+    Attributes
+    ----------
+    psi : float
+        Torsion of the slice, rad.
+    center : ndarray, shape (2,)
+        Ray origin in the cylindrical xy-plane (θ cos φ, θ sin φ), rad.
+    phi, theta : ndarray, shape (n_rays,)
+        Boundary points as T&T azimuth and tilt, rad (reachable; the first violation along the
+        ray lies within the tolerance beyond).
+    """
+
+    psi: float
+    center: NDArray[np.float64]
+    phi: NDArray[np.float64]
+    theta: NDArray[np.float64]
+
+    def xy(self) -> NDArray[np.float64]:
+        """Boundary points in the cylindrical xy-plane (θ cos φ, θ sin φ); shape (n, 2), rad."""
+        return np.column_stack([self.theta * np.cos(self.phi), self.theta * np.sin(self.phi)])
+
+    def area(self) -> float:
+        """Area of the boundary polygon in the cylindrical xy-plane, rad²."""
+        return float(_polygon_area_centroid(self.xy())[0])
+
+
+@dataclass(frozen=True)
+class OrientationWorkspace:
+    """The 3-D orientation workspace at one position.
+
+    Attributes
+    ----------
+    position : ndarray, shape (3,)
+        Tool-tip position, base frame, m.
+    slices : list of OrientationSlice
+        Ordered by increasing ψ.
+    psi_min, psi_max : float
+        Lowest and highest reachable torsion connected to the reference, rad (to tolerance).
+    volume : float
+        Volume of the solid in cylindrical coordinates, rad³.
+    n_rays : int
+    psi_step : float
+        Δψ, rad.
+    tolerance : float
+        Boundary tolerance, rad.
+    elapsed : float
+        Computation time, s.
+    evaluations : int
+        Poses evaluated.
+    """
+
+    position: NDArray[np.float64]
+    slices: list[OrientationSlice]
+    psi_min: float
+    psi_max: float
+    volume: float
+    n_rays: int
+    psi_step: float
+    tolerance: float
+    elapsed: float
+    evaluations: int = 0
+
+    def boundary_points(self) -> NDArray[np.float64]:
+        """All boundary points; shape (M, 6), columns x, y, z, φ, θ, ψ (rad).
+
+        x, y, z is the cylindrical picture: (θ cos φ, θ sin φ, ψ).
+        """
+        if not self.slices:
+            return np.zeros((0, 6))
+        blocks = []
+        for piece in self.slices:
+            xy = piece.xy()
+            psi = np.full(piece.phi.shape, piece.psi)
+            blocks.append(np.column_stack([xy, psi, piece.phi, piece.theta, psi]))
+        return np.concatenate(blocks)
+
+
+@dataclass(frozen=True)
+class TorsionRange:
+    """Feasible torsion angles for one tool direction.
+
+    Attributes
+    ----------
+    position : ndarray, shape (3,)
+        m, base frame.
+    phi, theta : float
+        The tool direction, rad.
+    intervals : ndarray, shape (k, 2)
+        Feasible [ψ_lo, ψ_hi] intervals in [−π, π], rad, increasing; ends reachable, the first
+        violation beyond each end within the tolerance. An interval touching both −π and π is
+        reported as two pieces (and as [−π, π] when every torsion is feasible).
+    tolerance : float
+        rad.
+    """
+
+    position: NDArray[np.float64]
+    phi: float
+    theta: float
+    intervals: NDArray[np.float64]
+    tolerance: float
+
+
+# ---------------------------------------------------------------------------- geometry helpers
+def _polygon_area_centroid(xy: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
+    """Area and area centroid of a closed polygon given by its vertices (n, 2) in order."""
+    x, y = xy[:, 0], xy[:, 1]
+    x_next, y_next = np.roll(x, -1), np.roll(y, -1)
+    cross = x * y_next - x_next * y
+    area = 0.5 * float(cross.sum())
+    if abs(area) < 1e-300:
+        return 0.0, xy.mean(axis=0)
+    cx = float(((x + x_next) * cross).sum()) / (6.0 * area)
+    cy = float(((y + y_next) * cross).sum()) / (6.0 * area)
+    return abs(area), np.array([cx, cy])
+
+
+def _xy_to_angles(x: NDArray, y: NDArray, psi: NDArray | float) -> NDArray[np.float64]:
+    """T&T angles (n, 3) of cylindrical points (x, y) at torsion psi."""
+    theta = np.hypot(x, y)
+    phi = np.where(theta > 0.0, np.arctan2(y, x), 0.0)
+    return np.column_stack([phi, theta, np.broadcast_to(psi, theta.shape)])
+
+
+def _ray_ends(center: NDArray[np.float64], directions: NDArray[np.float64]) -> NDArray:
+    """Parameter where each ray c + s·u leaves the disk θ ≤ π; shape (n,)."""
+    cu = directions @ center
+    return -cu + np.sqrt(np.maximum(cu * cu - center @ center + math.pi**2, 0.0))
+
+
+# ---------------------------------------------------------------------------- the computation
+class _Slicer:
+    """Computes slices for one manipulator, position and resolution."""
+
+    def __init__(self, search: RaySearch, n_rays: int, tolerance: float) -> None:
+        self.search = search
+        self.n_rays = n_rays
+        self.tolerance = tolerance
+        gamma = 2.0 * math.pi * np.arange(n_rays) / n_rays
+        self.directions = np.column_stack([np.cos(gamma), np.sin(gamma)])
+
+    def slices(
+        self, centers: NDArray[np.float64], psis: NDArray[np.float64]
+    ) -> list[OrientationSlice]:
+        """Slices at torsions ``psis`` (k,) with ray origins ``centers`` (k, 2), in one batch."""
+        count = psis.size
+        n = self.n_rays
+        ends = np.concatenate([_ray_ends(c, self.directions) for c in centers])
+
+        def angles_at(rays: NDArray[np.int64], s: NDArray[np.float64]) -> NDArray[np.float64]:
+            which, k = np.divmod(rays, n)
+            x = centers[which, 0] + s * self.directions[k, 0]
+            y = centers[which, 1] + s * self.directions[k, 1]
+            return _xy_to_angles(x, y, psis[which])
+
+        found = self.search.first_violation(angles_at, count * n, ends, self.tolerance)
+        result = []
+        for index in range(count):
+            s = found.feasible[index * n : (index + 1) * n]
+            xy = centers[index] + s[:, None] * self.directions
+            theta = np.hypot(xy[:, 0], xy[:, 1])
+            phi = np.where(theta > 0.0, np.arctan2(xy[:, 1], xy[:, 0]), 0.0)
+            result.append(OrientationSlice(float(psis[index]), centers[index].copy(), phi, theta))
+        return result
+
+    def best_center(self, previous: OrientationSlice, psi: float) -> NDArray[np.float64] | None:
+        """Ray origin for a new slice at ``psi`` next to ``previous`` (None: slice empty)."""
+        _, centroid = _polygon_area_centroid(previous.xy())
+        candidates = np.vstack([centroid, 0.5 * (previous.xy() + centroid)])
+        margins = self.search.margins(_xy_to_angles(candidates[:, 0], candidates[:, 1], psi))
+        feasible = np.all(margins >= 0.0, axis=0)
+        if feasible[0]:
+            return centroid
+        if not np.any(feasible):
+            return None
+        comfort = relative_margins(self.search.manipulator, margins).min(axis=0)
+        comfort[~feasible] = -np.inf
+        return candidates[int(np.argmax(comfort))]
+
+    def torsion_limit(self, last: OrientationSlice, sign: float) -> tuple[float, NDArray]:
+        """ψmax (sign +1) or ψmin (−1) beyond the last non-empty slice, and where it is."""
+        _, centroid = _polygon_area_centroid(last.xy())
+        candidates = np.vstack([last.center, centroid, 0.5 * (last.xy() + centroid)])
+        top = self._torsion_tops(candidates, last.psi, sign)
+        best = int(np.argmax(sign * top))
+        point, value = candidates[best], top[best]
+        # Shrinking pattern search over (x, y) for the extreme torsion.
+        step = 0.25 * float(np.sqrt(max(last.area(), 1e-12)))
+        pattern = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
+        for _ in range(PSI_LIMIT_ROUNDS):
+            trial = point + step * pattern
+            tops = self._torsion_tops(trial, last.psi, sign)
+            k = int(np.argmax(sign * tops))
+            if sign * tops[k] > sign * value:
+                point, value = trial[k], tops[k]
+            else:
+                step *= 0.5
+            if step < self.tolerance:
+                break
+        return float(value), point
+
+    def _torsion_tops(
+        self, points: NDArray[np.float64], psi_start: float, sign: float
+    ) -> NDArray[np.float64]:
+        """For points (n, 2) feasible at psi_start, the torsion where feasibility ends going
+        in direction ``sign``; points infeasible at psi_start get psi_start."""
+
+        def angles_at(rays: NDArray[np.int64], s: NDArray[np.float64]) -> NDArray[np.float64]:
+            return _xy_to_angles(points[rays, 0], points[rays, 1], psi_start + sign * s)
+
+        found = self.search.first_violation(
+            angles_at, points.shape[0], math.pi - sign * psi_start, self.tolerance
+        )
+        reach = np.where(found.start_feasible, found.feasible, 0.0)
+        return psi_start + sign * reach
+
+
+def orientation_workspace(
+    manipulator: Manipulator,
+    position: ArrayLike | None = None,
+    *,
+    n_rays: int = 180,
+    psi_step: float = math.radians(1.0),
+    tolerance: float = 1e-5,
+    progress: Progress | None = None,
+) -> OrientationWorkspace:
+    """Compute the 3-D orientation workspace at a position (see the module documentation).
+
+    Parameters
+    ----------
+    manipulator : Manipulator
+    position : array_like, shape (3,), optional
+        Tool-tip position OC, base frame, m (default ``manipulator.position``).
+    n_rays : int
+        Rays per slice, 3 to 7200.
+    psi_step : float
+        Slice step Δψ, rad, 1e-4 to 0.5.
+    tolerance : float
+        Boundary tolerance, rad (1e-12 to 0.1).
+    progress : callable, optional
+        Called with an estimate of the completed fraction in [0, 1].
+
+    Returns
+    -------
+    OrientationWorkspace
+
+    Raises
+    ------
+    UnreachableReferenceError
+        The reference orientation is unreachable at the position.
+    ResolutionError
+        A resolution out of bounds, or more than 5·10⁶ boundary points.
+    """
+    started = time.perf_counter()
+    n_rays = validate_rays(n_rays, "n_rays")
+    tolerance = validate_tolerance(tolerance)
+    step = float(psi_step)
+    if not (math.isfinite(step) and MIN_PSI_STEP <= step <= MAX_PSI_STEP):
+        msg = f"psi_step: expected {MIN_PSI_STEP:g} to {MAX_PSI_STEP:g} rad, got {psi_step!r}"
+        raise ResolutionError(msg)
+    max_slices = int(2.0 * math.pi / step) + 1
+    if max_slices * n_rays > MAX_POINTS:
+        msg = (
+            f"n_rays × slices: up to {max_slices} slices of {n_rays} rays exceed "
+            f"{MAX_POINTS} boundary points; use fewer rays or a larger psi_step"
+        )
+        raise ResolutionError(msg)
+    position = validate_position(manipulator, position)
+    search = RaySearch(manipulator, position)
+    require_reachable_reference(search)
+    slicer = _Slicer(search, n_rays, tolerance)
+    # Expected span, for the progress estimate only.
+    if progress:
+        low, high = reference_torsion_interval(search, max(tolerance, 1e-3))
+        expected = max((high - low) / step, 1.0)
+
+    first = slicer.slices(np.zeros((1, 2)), np.zeros(1))[0]
+    _, centroid = _polygon_area_centroid(first.xy())
+    middle = slicer.slices(centroid[None, :], np.zeros(1))[0]
+    upper: list[OrientationSlice] = [middle]
+    lower: list[OrientationSlice] = [middle]
+    growing = {1.0: True, -1.0: True}
+    while any(growing.values()):
+        centers, psis, signs = [], [], []
+        for sign, stack in ((1.0, upper), (-1.0, lower)):
+            if not growing[sign]:
+                continue
+            psi = stack[-1].psi + sign * step
+            if abs(psi) > math.pi:
+                growing[sign] = False
+                continue
+            center = slicer.best_center(stack[-1], psi)
+            if center is None:
+                growing[sign] = False
+                continue
+            centers.append(center)
+            psis.append(psi)
+            signs.append(sign)
+        if not centers:
+            break
+        for sign, piece in zip(
+            signs, slicer.slices(np.array(centers), np.array(psis)), strict=True
+        ):
+            (upper if sign > 0 else lower).append(piece)
+        if progress:
+            progress(min(0.95, (len(upper) + len(lower)) / expected))
+    psi_max, _ = slicer.torsion_limit(upper[-1], 1.0)
+    psi_min, _ = slicer.torsion_limit(lower[-1], -1.0)
+    slices = lower[:0:-1] + upper
+    areas = np.array([piece.area() for piece in slices])
+    psis = np.array([piece.psi for piece in slices])
+    volume = float(np.trapezoid(areas, psis)) if len(slices) > 1 else 0.0
+    # Cones from the end slices to the extreme torsions (area shrinking to zero).
+    volume += 0.5 * areas[-1] * (psi_max - psis[-1]) + 0.5 * areas[0] * (psis[0] - psi_min)
+    if progress:
+        progress(1.0)
+    return OrientationWorkspace(
+        position=position,
+        slices=slices,
+        psi_min=psi_min,
+        psi_max=psi_max,
+        volume=volume,
+        n_rays=n_rays,
+        psi_step=step,
+        tolerance=tolerance,
+        elapsed=time.perf_counter() - started,
+        evaluations=search.evaluations,
+    )
+
+
+def torsion_range(
+    manipulator: Manipulator,
+    phi: float,
+    theta: float,
+    position: ArrayLike | None = None,
+    *,
+    tolerance: float = 1e-6,
+) -> TorsionRange:
+    """Feasible torsion intervals for one tool direction (what a 5-axis controller needs).
+
+    The whole circle ψ ∈ [−π, π] is scanned with certified steps in both directions: from a
+    feasible point no violation can occur within the certified step, and from a violated point
+    the most violated constraint cannot recover within |m_c| / L_c either, so no interval
+    wider than ``h_min`` (1e-3 rad) is missed. Each transition is bisected to the tolerance.
+
+    Parameters
+    ----------
+    manipulator : Manipulator
+    phi, theta : float
+        Tool direction (azimuth, tilt), rad.
+    position : array_like, shape (3,), optional
+        m, base frame (default ``manipulator.position``).
+    tolerance : float
+        rad.
+
+    Returns
+    -------
+    TorsionRange
+    """
+    tolerance = validate_tolerance(tolerance)
+    position = validate_position(manipulator, position)
+    values = np.array([phi, theta], dtype=np.float64)
+    if not np.all(np.isfinite(values)):
+        msg = f"direction: expected finite (phi, theta), got {values.tolist()}"
+        raise InputError(msg)
+    if not 0.0 <= theta <= math.pi:
+        msg = f"direction: expected theta in [0, pi] rad, got {theta!r}"
+        raise InputError(msg)
+    search = RaySearch(manipulator, position)
+
+    def margins_at(psi: NDArray[np.float64]) -> NDArray[np.float64]:
+        angles = np.column_stack([np.full(psi.size, phi), np.full(psi.size, theta), psi])
+        return search.margins(angles)
+
+    # Scan: sample points and their feasibility, with certified spacing.
+    samples, states = [], []
+    psi = -math.pi
+    while True:
+        margins = margins_at(np.array([psi]))
+        ok = bool(np.all(margins >= 0.0))
+        samples.append(psi)
+        states.append(ok)
+        if psi >= math.pi:
+            break
+        if ok:
+            step = float(search.certified_step(margins)[0])
+        else:
+            pose = np.array([[phi, theta, psi]])
+            step = float(search.recovery_step(pose, margins)[0])
+        psi = min(psi + float(np.clip(step, search.min_step, 0.25)), math.pi)
+    samples_array = np.array(samples)
+    states_array = np.array(states)
+    # Bisect every transition to the tolerance.
+    change = np.flatnonzero(states_array[1:] != states_array[:-1])
+    low = samples_array[change]
+    high = samples_array[change + 1]
+    rising = ~states_array[change]  # infeasible -> feasible
+    while change.size and np.max(high - low) > tolerance:
+        middle = 0.5 * (low + high)
+        ok = np.all(margins_at(middle) >= 0.0, axis=0)
+        # Keep the transition inside [low, high]: the side matching the start state moves.
+        move_low = ok != rising
+        low = np.where(move_low, middle, low)
+        high = np.where(move_low, high, middle)
+    # Feasible ends: for a rising edge the feasible side is high, for a falling edge low.
+    edges = np.where(rising, high, low)
+    intervals = []
+    start = -math.pi if states_array[0] else None
+    for edge, up in zip(edges, rising, strict=True):
+        if up:
+            start = float(edge)
+        elif start is not None:
+            intervals.append((start, float(edge)))
+            start = None
+    if start is not None:
+        intervals.append((start, math.pi))
+    return TorsionRange(
+        position=position,
+        phi=float(phi),
+        theta=float(theta),
+        intervals=np.array(intervals, dtype=np.float64).reshape(-1, 2),
+        tolerance=tolerance,
+    )

@@ -1,0 +1,376 @@
+"""Projected orientation workspace: the set of attainable tool directions at a position.
+
+Two methods:
+
+``torsion_zero``
+    Bonev & Ryu's approximation. For n_phi azimuths φ_k = k·2π/n_phi, the first tilt θ along
+    the ray from θ = 0 at torsion ψ = 0 where a constraint is violated. Located to the
+    tolerance with the Lipschitz-certified march + bisection of :mod:`hexapod_workspace.search`
+    (no 0.1° walk; why no thin violated band is stepped over is explained there).
+``exact``
+    The true shadow of the orientation workspace, which the paper leaves open: for each φ the
+    largest θ such that some ψ makes (φ, θ, ψ) reachable *and connected to the reference
+    orientation*. Connected here means reachable from the reference along a path that first
+    turns about the tool axis at θ = 0 (within the torsion interval of the reference) and then
+    tilts at constant (φ, ψ). For each φ the boundary tilt θ_b(ψ) of such paths is computed on
+    a grid of ψ over that torsion interval (ψ = 0 included, so ``exact`` ≥ ``torsion_zero``
+    everywhere by construction), then the best grid cell is refined by golden-section search
+    on ψ. Points of the workspace that are only reachable along other paths (a slice that is
+    not star-shaped about θ = 0) are not counted, so the result is a certified lower bound of
+    the shadow, exact for workspaces whose constant-(φ, ψ) sections are intervals.
+
+Every reported point (φ, θ, ψ) satisfies all four constraints; the first violation along its
+ray lies within the tolerance beyond it.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .constraints import CONSTRAINT_NAMES
+from .errors import InputError, ResolutionError, UnreachableReferenceError
+from .manipulator import Manipulator
+from .search import RaySearch
+
+__all__ = [
+    "MAX_RAYS",
+    "METHODS",
+    "ProjectedWorkspace",
+    "projected_workspace",
+    "reference_torsion_interval",
+    "require_reachable_reference",
+    "validate_position",
+    "validate_rays",
+    "validate_tolerance",
+]
+
+METHODS = ("torsion_zero", "exact")
+#: Bounds on resolutions accepted by every workspace function.
+MIN_RAYS, MAX_RAYS = 3, 7200
+MIN_TOLERANCE, MAX_TOLERANCE = 1e-12, 0.1
+#: ψ samples per azimuth for the ``exact`` method before golden-section refinement.
+EXACT_PSI_SAMPLES = 13
+#: Golden-section iterations on ψ for the ``exact`` method.
+EXACT_GOLDEN_STEPS = 18
+#: Boundary tolerance while ranking ψ values in the ``exact`` method, rad.
+COARSE_TOLERANCE = 1e-5
+
+Progress = Callable[[float], None]
+
+
+def validate_rays(count: int, name: str) -> int:
+    """Check a ray count (``n_phi``, ``n_rays``) against [3, 7200]."""
+    if isinstance(count, bool) or not isinstance(count, (int, np.integer)):
+        msg = f"{name}: expected an integer, got {count!r}"
+        raise ResolutionError(msg)
+    if not MIN_RAYS <= count <= MAX_RAYS:
+        msg = f"{name}: expected {MIN_RAYS} to {MAX_RAYS} rays, got {count}"
+        raise ResolutionError(msg)
+    return int(count)
+
+
+def validate_tolerance(tolerance: float, name: str = "tolerance") -> float:
+    """Check a boundary tolerance (rad) against [1e-12, 0.1]."""
+    value = float(tolerance)
+    if not (math.isfinite(value) and MIN_TOLERANCE <= value <= MAX_TOLERANCE):
+        msg = f"{name}: expected {MIN_TOLERANCE:g} to {MAX_TOLERANCE:g} rad, got {tolerance!r}"
+        raise ResolutionError(msg)
+    return value
+
+
+def validate_position(manipulator: Manipulator, position: ArrayLike | None) -> NDArray:
+    """The position to use (default ``manipulator.position``), checked: shape (3,), finite."""
+    if position is None:
+        return np.array(manipulator.position)
+    array = np.asarray(position, dtype=np.float64)
+    if array.shape != (3,) or not np.all(np.isfinite(array)):
+        msg = f"position: expected 3 finite values (x, y, z) in m, got {np.ravel(array).tolist()}"
+        raise InputError(msg)
+    return array
+
+
+@dataclass(frozen=True)
+class ProjectedWorkspace:
+    """The projected orientation workspace (attainable tool directions) at one position.
+
+    Attributes
+    ----------
+    method : str
+        ``"torsion_zero"`` or ``"exact"``.
+    position : ndarray, shape (3,)
+        Tool-tip position, base frame, m.
+    phi : ndarray, shape (n,)
+        Azimuths φ_k = k·2π/n, rad.
+    theta : ndarray, shape (n,)
+        Boundary tilt per azimuth, rad: reachable, with the first violation within
+        ``tolerance`` beyond it (π when the ray never meets a violation).
+    psi : ndarray, shape (n,)
+        Torsion of the boundary point, rad (0 for ``torsion_zero``).
+    limiting : list of str
+        Constraint violated just beyond each boundary point ("" when none).
+    tilt_min, tilt_max : float
+        Min and max of ``theta`` (the paper's θmin, θmax), rad.
+    solid_angle : float
+        Solid angle of the attainable approach directions, ∫ (1 − cos θ_b(φ)) dφ, sr.
+    tolerance : float
+        Boundary tolerance, rad.
+    elapsed : float
+        Computation time, s.
+    evaluations : int
+        Poses evaluated.
+    gap : ndarray, shape (n,) or None
+        ``exact`` only: exact θ minus the torsion-zero θ per azimuth (≥ 0), rad.
+    """
+
+    method: str
+    position: NDArray[np.float64]
+    phi: NDArray[np.float64]
+    theta: NDArray[np.float64]
+    psi: NDArray[np.float64]
+    limiting: list[str]
+    tilt_min: float
+    tilt_max: float
+    solid_angle: float
+    tolerance: float
+    elapsed: float
+    evaluations: int = 0
+    gap: NDArray[np.float64] | None = field(default=None)
+
+    @property
+    def n_phi(self) -> int:
+        """Number of azimuths."""
+        return int(self.phi.shape[0])
+
+    def approach_vectors(self) -> NDArray[np.float64]:
+        """Unit approach vectors of the boundary directions, base frame; shape (n, 3)."""
+        sin_theta = np.sin(self.theta)
+        return np.column_stack(
+            [np.cos(self.phi) * sin_theta, np.sin(self.phi) * sin_theta, np.cos(self.theta)]
+        )
+
+
+def _solid_angle(theta: NDArray[np.float64]) -> float:
+    """∫_0^{2π} ∫_0^{θ_b(φ)} sin θ dθ dφ for equally spaced φ (rectangle rule, exact for the
+    periodic trapezoid)."""
+    return float(2.0 * math.pi * np.mean(1.0 - np.cos(theta)))
+
+
+def require_reachable_reference(search: RaySearch) -> None:
+    """Raise :class:`UnreachableReferenceError` unless (0, 0, 0) is reachable at the position."""
+    margins = search.margins(np.zeros((1, 3)))
+    if np.any(margins < 0.0):
+        names = [CONSTRAINT_NAMES[k] for k in np.flatnonzero(margins[:, 0] < 0.0)]
+        x, y, z = search.position
+        msg = (
+            f"the reference orientation (phi, theta, psi) = (0, 0, 0) is unreachable at position "
+            f"({x:g}, {y:g}, {z:g}) m ({', '.join(names)} violated): the workspace is empty"
+        )
+        raise UnreachableReferenceError(msg)
+
+
+def reference_torsion_interval(search: RaySearch, tolerance: float) -> tuple[float, float]:
+    """The torsion interval [ψ_lo, ψ_hi] at θ = 0 that contains the reference ψ = 0.
+
+    Raises
+    ------
+    UnreachableReferenceError
+        When the reference orientation (0, 0, 0) is itself unreachable.
+    """
+    require_reachable_reference(search)
+    directions = np.array([1.0, -1.0])
+
+    def angles_at(rays: NDArray[np.int64], s: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.column_stack([np.zeros(rays.size), np.zeros(rays.size), directions[rays] * s])
+
+    found = search.first_violation(angles_at, 2, math.pi, tolerance)
+    return -float(found.feasible[1]), float(found.feasible[0])
+
+
+def projected_workspace(
+    manipulator: Manipulator,
+    position: ArrayLike | None = None,
+    *,
+    method: str = "torsion_zero",
+    n_phi: int = 360,
+    tolerance: float = 1e-6,
+    progress: Progress | None = None,
+) -> ProjectedWorkspace:
+    """Compute the projected orientation workspace at a position.
+
+    Parameters
+    ----------
+    manipulator : Manipulator
+    position : array_like, shape (3,), optional
+        Tool-tip position OC, base frame, m (default ``manipulator.position``).
+    method : {"torsion_zero", "exact"}
+        See the module documentation.
+    n_phi : int
+        Number of azimuths φ_k = k·360°/n_phi, 3 to 7200.
+    tolerance : float
+        Boundary tolerance, rad (1e-12 to 0.1).
+    progress : callable, optional
+        Called with the completed fraction in [0, 1].
+
+    Returns
+    -------
+    ProjectedWorkspace
+
+    Raises
+    ------
+    UnreachableReferenceError
+        The reference orientation is unreachable at the position.
+    ResolutionError
+        ``n_phi`` or ``tolerance`` out of bounds.
+    InputError
+        Unknown method, bad position.
+    """
+    started = time.perf_counter()
+    if method not in METHODS:
+        msg = f"method: expected one of {', '.join(METHODS)}, got {method!r}"
+        raise InputError(msg)
+    n_phi = validate_rays(n_phi, "n_phi")
+    tolerance = validate_tolerance(tolerance)
+    position = validate_position(manipulator, position)
+    search = RaySearch(manipulator, position)
+    require_reachable_reference(search)
+    phi = 2.0 * math.pi * np.arange(n_phi) / n_phi
+
+    def tilt_rays(psi: NDArray[np.float64]):
+        def angles_at(rays: NDArray[np.int64], s: NDArray[np.float64]) -> NDArray[np.float64]:
+            return np.column_stack([phi[rays % n_phi], s, psi[rays]])
+
+        return angles_at
+
+    zero = np.zeros(n_phi)
+    base = search.first_violation(tilt_rays(zero), n_phi, math.pi, tolerance)
+    theta, psi, limiting = base.feasible, zero.copy(), base.limiting
+    gap = None
+    if method == "exact":
+        if progress:
+            progress(0.1)
+        torsion = reference_torsion_interval(search, tolerance)
+        theta, psi, limiting = _exact(
+            search, phi, torsion, tolerance, base.feasible, base.limiting, progress
+        )
+        gap = theta - base.feasible
+    if progress:
+        progress(1.0)
+    return ProjectedWorkspace(
+        method=method,
+        position=position,
+        phi=phi,
+        theta=theta,
+        psi=psi,
+        limiting=[CONSTRAINT_NAMES[k] if k >= 0 else "" for k in limiting],
+        tilt_min=float(theta.min()),
+        tilt_max=float(theta.max()),
+        solid_angle=_solid_angle(theta),
+        tolerance=tolerance,
+        elapsed=time.perf_counter() - started,
+        evaluations=search.evaluations,
+        gap=gap,
+    )
+
+
+def _exact(
+    search: RaySearch,
+    phi: NDArray[np.float64],
+    torsion: tuple[float, float],
+    tolerance: float,
+    theta_zero: NDArray[np.float64],
+    limiting_zero: NDArray[np.int64],
+    progress: Progress | None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+    """Max over ψ of the boundary tilt, per azimuth (see the module documentation)."""
+    n_phi = phi.size
+    psi_low, psi_high = torsion
+    # Grid over the reference torsion interval, ψ = 0 included exactly.
+    grid = np.linspace(psi_low, psi_high, EXACT_PSI_SAMPLES)
+    spacing = (psi_high - psi_low) / (EXACT_PSI_SAMPLES - 1)
+    # ψ = 0 exactly (the torsion-zero rays), without a near-duplicate from the linspace.
+    grid = np.sort(np.append(grid[np.abs(grid) > 0.25 * spacing], 0.0))
+
+    # The grid and the golden-section phase only rank ψ values: a coarser tolerance suffices
+    # there; the winner is searched again at full tolerance at the end.
+    coarse = max(tolerance, COARSE_TOLERANCE)
+
+    def boundary(
+        psi: NDArray[np.float64], tol: float = coarse
+    ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+        """Boundary tilt and limiting constraint of rays (phi[k % n_phi], psi[k])."""
+
+        def angles_at(rays: NDArray[np.int64], s: NDArray[np.float64]) -> NDArray[np.float64]:
+            return np.column_stack([phi[rays % n_phi], s, psi[rays]])
+
+        found = search.first_violation(angles_at, psi.size, math.pi, tol)
+        return found.feasible, found.limiting
+
+    others = grid[grid != 0.0]
+    found, found_limits = boundary(np.repeat(others, n_phi))
+    samples = np.empty((grid.size, n_phi))
+    limits = np.empty((grid.size, n_phi), dtype=np.int64)
+    samples[grid != 0.0] = found.reshape(others.size, n_phi)
+    limits[grid != 0.0] = found_limits.reshape(others.size, n_phi)
+    samples[grid == 0.0], limits[grid == 0.0] = theta_zero, limiting_zero
+    if progress:
+        progress(0.5)
+    best = samples.argmax(axis=0)
+    columns = np.arange(n_phi)
+    theta = samples[best, columns].copy()
+    psi = grid[best].copy()
+    limiting = limits[best, columns].copy()
+    # Golden-section search for the max of θ_b(ψ) on the neighbouring grid cells.
+    low = grid[np.maximum(best - 1, 0)]
+    high = grid[np.minimum(best + 1, grid.size - 1)]
+    ratio = (math.sqrt(5.0) - 1.0) / 2.0
+    left = high - ratio * (high - low)
+    right = low + ratio * (high - low)
+    theta_left, limit_left = boundary(left)
+    theta_right, limit_right = boundary(right)
+    for step in range(EXACT_GOLDEN_STEPS):
+        for candidate, value, limit in (
+            (left, theta_left, limit_left),
+            (right, theta_right, limit_right),
+        ):
+            better = value > theta
+            theta = np.where(better, value, theta)
+            psi = np.where(better, candidate, psi)
+            limiting = np.where(better, limit, limiting)
+        go_right = theta_left < theta_right
+        low = np.where(go_right, left, low)
+        high = np.where(go_right, high, right)
+        new_left = np.where(go_right, right, high - ratio * (high - low))
+        new_right = np.where(go_right, low + ratio * (high - low), left)
+        keep_left = np.where(go_right, theta_right, theta_left)
+        keep_limit = np.where(go_right, limit_right, limit_left)
+        # Only one new point per iteration: the other is reused.
+        fresh = np.where(go_right, new_right, new_left)
+        theta_fresh, limit_fresh = boundary(fresh)
+        theta_left = np.where(go_right, keep_left, theta_fresh)
+        limit_left = np.where(go_right, keep_limit, limit_fresh)
+        theta_right = np.where(go_right, theta_fresh, keep_left)
+        limit_right = np.where(go_right, limit_fresh, keep_limit)
+        left, right = new_left, new_right
+        if progress:
+            progress(0.5 + 0.5 * (step + 1) / EXACT_GOLDEN_STEPS)
+    for candidate, value, limit in (
+        (left, theta_left, limit_left),
+        (right, theta_right, limit_right),
+    ):
+        better = value > theta
+        theta = np.where(better, value, theta)
+        psi = np.where(better, candidate, psi)
+        limiting = np.where(better, limit, limiting)
+    # Full tolerance at the winning torsion (ψ = 0 keeps its torsion-zero result).
+    refine = psi != 0.0
+    if tolerance < coarse and np.any(refine):
+        theta_fine, limit_fine = boundary(psi, tolerance)
+        theta = np.where(refine, theta_fine, theta)
+        limiting = np.where(refine, limit_fine, limiting)
+    return theta, psi, limiting
