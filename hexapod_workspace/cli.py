@@ -24,8 +24,10 @@ from numpy.typing import NDArray
 from . import __version__
 from ._resources import example_config_path
 from .constraints import CONSTRAINT_NAMES, CheckResult, check
-from .errors import HexapodWorkspaceError, InputError
+from .errors import HexapodWorkspaceError, InputError, UnreachableReferenceError
 from .manipulator import Manipulator
+from .orientation import OrientationWorkspace, orientation_workspace, torsion_range
+from .projected import ProjectedWorkspace, projected_workspace
 
 __all__ = ["main", "read_poses_file"]
 
@@ -50,6 +52,64 @@ def _finite(values: Sequence[float], what: str) -> NDArray[np.float64]:
         msg = f"{what}: expected finite numbers, got {array.tolist()}"
         raise CliError(msg)
     return array
+
+
+class ProgressBar:
+    """A one-line progress bar on stderr, drawn only when stderr is a terminal."""
+
+    def __init__(self, label: str, *, stream: TextIO | None = None) -> None:
+        self.stream = sys.stderr if stream is None else stream
+        self.enabled = bool(getattr(self.stream, "isatty", lambda: False)())
+        self.label = label
+        self.shown = -1
+
+    def __call__(self, fraction: float) -> None:
+        if not self.enabled:
+            return
+        percent = int(100 * min(max(fraction, 0.0), 1.0))
+        if percent == self.shown:
+            return
+        self.shown = percent
+        filled = percent * 30 // 100
+        self.stream.write(f"\r{self.label} [{'#' * filled}{'.' * (30 - filled)}] {percent:3d}%")
+        if percent >= 100:
+            self.stream.write("\n")
+        self.stream.flush()
+
+
+def _degrees(values: Any) -> Any:
+    """Radians to degrees as plain Python floats (lists for arrays)."""
+    converted = np.degrees(values)
+    return converted.tolist() if isinstance(converted, np.ndarray) else float(converted)
+
+
+def _tolerance(options: argparse.Namespace, default_rad: float) -> float:
+    if options.tol_deg is None:
+        return default_rad
+    return math.radians(_finite([options.tol_deg], "--tol-deg")[0])
+
+
+def _record(options: argparse.Namespace, manipulator: Manipulator, results: list) -> None:
+    """Write ``--record FILE`` (rosbag2-form MCAP) when asked."""
+    if getattr(options, "record", None):
+        from .replay import record_results
+
+        path = record_results(options.record, results, frame_id=manipulator.frame_id)
+        print(f"{PROG}: recorded {len(results)} result(s) to {path}", file=sys.stderr)
+
+
+def _unreachable(error: UnreachableReferenceError, position: Any, options, out: TextIO) -> int:
+    """Report an empty workspace: exit 1, the reason on stderr (and in the JSON result)."""
+    reason = " ".join(str(error).split())
+    if options.json:
+        document = {
+            "position": np.asarray(position, dtype=float).tolist(),
+            "reference_reachable": False,
+            "reason": reason,
+        }
+        out.write(json.dumps(document) + "\n")
+    print(f"{PROG}: {reason}", file=sys.stderr)
+    return 1
 
 
 def load_manipulator(options: argparse.Namespace) -> Manipulator:
@@ -263,6 +323,212 @@ def cmd_check(options: argparse.Namespace, out: TextIO) -> int:
     return 0 if bool(np.all(result.reachable)) else 1
 
 
+# ---------------------------------------------------------------------------- workspaces
+def projected_to_json(workspace: ProjectedWorkspace) -> dict[str, Any]:
+    """The JSON document of a projected workspace (angles in degrees)."""
+    document: dict[str, Any] = {
+        "method": workspace.method,
+        "position": workspace.position.tolist(),
+        "reference_reachable": True,
+        "phi_deg": _degrees(workspace.phi),
+        "theta_deg": _degrees(workspace.theta),
+        "psi_deg": _degrees(workspace.psi),
+        "limiting": workspace.limiting,
+        "tilt_min_deg": _degrees(workspace.tilt_min),
+        "tilt_max_deg": _degrees(workspace.tilt_max),
+        "solid_angle_sr": workspace.solid_angle,
+        "tolerance_deg": _degrees(workspace.tolerance),
+        "elapsed_s": workspace.elapsed,
+    }
+    if workspace.gap is not None:
+        document["torsion_zero_gap_deg"] = _degrees(workspace.gap)
+        document["torsion_zero_gap_max_deg"] = _degrees(float(workspace.gap.max()))
+        document["torsion_zero_gap_mean_deg"] = _degrees(float(workspace.gap.mean()))
+    return document
+
+
+def _projected_text(workspace: ProjectedWorkspace, out: TextIO) -> None:
+    x, y, z = workspace.position
+    out.write(
+        f"projected orientation workspace ({workspace.method}) at ({x:.4f}, {y:.4f}, {z:.4f}) m\n"
+        f"  azimuths: {workspace.n_phi}, tolerance {math.degrees(workspace.tolerance):.2e} deg, "
+        f"{workspace.elapsed * 1e3:.1f} ms\n"
+        f"  tilt range: {math.degrees(workspace.tilt_min):.4f} .. "
+        f"{math.degrees(workspace.tilt_max):.4f} deg\n"
+        f"  solid angle of attainable directions: {workspace.solid_angle:.5f} sr\n"
+    )
+    if workspace.gap is not None:
+        worst = int(np.argmax(workspace.gap))
+        out.write(
+            f"  torsion_zero lies inside by up to {math.degrees(workspace.gap[worst]):.4f} deg "
+            f"(phi {math.degrees(workspace.phi[worst]):.1f} deg, "
+            f"mean {math.degrees(float(workspace.gap.mean())):.4f} deg)\n"
+        )
+    step = max(1, workspace.n_phi // 12)
+    out.write(f"  {'phi [deg]':>10} {'theta [deg]':>12} {'psi [deg]':>10}  limiting\n")
+    for k in range(0, workspace.n_phi, step):
+        out.write(
+            f"  {math.degrees(workspace.phi[k]):10.2f} {math.degrees(workspace.theta[k]):12.4f} "
+            f"{math.degrees(workspace.psi[k]):10.3f}  {workspace.limiting[k] or '-'}\n"
+        )
+
+
+def cmd_projected(options: argparse.Namespace, out: TextIO) -> int:
+    """``projected``: the projected orientation workspace (attainable tool directions)."""
+    manipulator = load_manipulator(options)
+    tolerance = _tolerance(options, 1e-6)
+    try:
+        workspace = projected_workspace(
+            manipulator,
+            method=options.method,
+            n_phi=options.n_phi,
+            tolerance=tolerance,
+            progress=ProgressBar(f"projected ({options.method})"),
+        )
+    except UnreachableReferenceError as error:
+        return _unreachable(error, manipulator.position, options, out)
+    if options.plot:
+        other = "exact" if options.method == "torsion_zero" else "torsion_zero"
+        overlay = projected_workspace(
+            manipulator,
+            method=other,
+            n_phi=options.n_phi,
+            tolerance=tolerance,
+            progress=ProgressBar(f"projected ({other}, for the plot)"),
+        )
+        from .plotting import plot_projected
+
+        ordered = (
+            [workspace, overlay] if workspace.method == "torsion_zero" else [overlay, workspace]
+        )
+        plot_projected(ordered, options.plot)
+    _record(options, manipulator, [workspace])
+    if options.json:
+        out.write(json.dumps(projected_to_json(workspace)) + "\n")
+    else:
+        _projected_text(workspace, out)
+        if options.plot:
+            out.write(f"  plot: {options.plot}\n")
+    return 0
+
+
+def orientation_to_json(workspace: OrientationWorkspace) -> dict[str, Any]:
+    """The JSON document of a 3-D orientation workspace (angles in degrees)."""
+    return {
+        "position": workspace.position.tolist(),
+        "reference_reachable": True,
+        "psi_min_deg": _degrees(workspace.psi_min),
+        "psi_max_deg": _degrees(workspace.psi_max),
+        "volume": workspace.volume,
+        "volume_unit": "rad^3",
+        "n_rays": workspace.n_rays,
+        "psi_step_deg": _degrees(workspace.psi_step),
+        "tolerance_deg": _degrees(workspace.tolerance),
+        "slices": [
+            {
+                "psi_deg": _degrees(piece.psi),
+                "center_deg": _degrees(piece.center),
+                "phi_deg": _degrees(piece.phi),
+                "theta_deg": _degrees(piece.theta),
+            }
+            for piece in workspace.slices
+        ],
+        "elapsed_s": workspace.elapsed,
+    }
+
+
+def _orientation_text(workspace: OrientationWorkspace, out: TextIO) -> None:
+    x, y, z = workspace.position
+    areas = [piece.area() for piece in workspace.slices]
+    middle = min(range(len(workspace.slices)), key=lambda k: abs(workspace.slices[k].psi))
+    zero = workspace.slices[middle]
+    out.write(
+        f"orientation workspace at ({x:.4f}, {y:.4f}, {z:.4f}) m\n"
+        f"  {len(workspace.slices)} slices of {workspace.n_rays} rays, "
+        f"step {math.degrees(workspace.psi_step):g} deg, "
+        f"tolerance {math.degrees(workspace.tolerance):.2e} deg, {workspace.elapsed:.2f} s\n"
+        f"  torsion range: {math.degrees(workspace.psi_min):.4f} .. "
+        f"{math.degrees(workspace.psi_max):.4f} deg\n"
+        f"  volume (cylindrical coordinates): {workspace.volume:.5f} rad^3\n"
+        f"  psi = 0 slice: tilt {math.degrees(zero.theta.min()):.3f} .. "
+        f"{math.degrees(zero.theta.max()):.3f} deg, area {areas[middle]:.5f} rad^2\n"
+    )
+
+
+def cmd_orientation(options: argparse.Namespace, out: TextIO) -> int:
+    """``orientation``: the 3-D orientation workspace (ψ slices)."""
+    manipulator = load_manipulator(options)
+    step = math.radians(_finite([options.psi_step_deg], "--psi-step-deg")[0])
+    try:
+        workspace = orientation_workspace(
+            manipulator,
+            n_rays=options.n_rays,
+            psi_step=step,
+            tolerance=_tolerance(options, 1e-5),
+            progress=ProgressBar("orientation"),
+        )
+    except UnreachableReferenceError as error:
+        return _unreachable(error, manipulator.position, options, out)
+    if options.plot:
+        from .plotting import plot_orientation
+
+        plot_orientation(workspace, options.plot)
+    _record(options, manipulator, [workspace])
+    if options.json:
+        out.write(json.dumps(orientation_to_json(workspace)) + "\n")
+    else:
+        _orientation_text(workspace, out)
+        if options.plot:
+            out.write(f"  plot: {options.plot}\n")
+    return 0
+
+
+def cmd_torsion_range(options: argparse.Namespace, out: TextIO) -> int:
+    """``torsion-range``: feasible torsion intervals for one tool direction."""
+    manipulator = load_manipulator(options)
+    phi, theta = _finite(options.direction, "--direction")
+    found = torsion_range(
+        manipulator, math.radians(phi), math.radians(theta), tolerance=_tolerance(options, 1e-6)
+    )
+    intervals = np.degrees(found.intervals).tolist()
+    if options.json:
+        document = {"direction_deg": [float(phi), float(theta)], "intervals_deg": intervals}
+        out.write(json.dumps(document) + "\n")
+    else:
+        x, y, z = found.position
+        out.write(
+            f"torsion range for direction phi {phi:g} deg, theta {theta:g} deg "
+            f"at ({x:.4f}, {y:.4f}, {z:.4f}) m\n"
+        )
+        if not intervals:
+            out.write("  no feasible torsion\n")
+        for low, high in intervals:
+            out.write(f"  psi in [{low:.4f}, {high:.4f}] deg\n")
+    return 0 if intervals else 1
+
+
+def cmd_replay(options: argparse.Namespace, out: TextIO) -> int:
+    """``replay``: what a recorded log holds (see :func:`hexapod_workspace.replay.run_replay`)."""
+    from .replay import run_replay
+
+    return run_replay(
+        options.log,
+        as_json=options.json,
+        plot_dir=options.plot,
+        publish=options.publish,
+        rate=options.rate,
+        stdout=out,
+    )
+
+
+def cmd_demo(options: argparse.Namespace, out: TextIO) -> int:
+    """``demo``: the example manipulator end to end (see :mod:`hexapod_workspace.demo`)."""
+    from .demo import run_demo
+
+    manipulator = load_manipulator(options)
+    return run_demo(manipulator, Path(options.out), out=out, as_json=options.json)
+
+
 # ---------------------------------------------------------------------------- parser
 def _add_global_options(parser: argparse.ArgumentParser, *, top: bool) -> None:
     # Global options are accepted before and after the command; after the command they only
@@ -324,7 +590,84 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="F",
         help="CSV file of rows phi_deg,theta_deg,psi_deg (optional header)",
     )
+    sub.add_argument("--record", metavar="FILE", help="also write the result to an MCAP log")
     sub.set_defaults(handler=cmd_check)
+
+    sub = commands.add_parser(
+        "projected",
+        help="projected orientation workspace: the attainable tool directions",
+        description="For n equally spaced azimuths phi, the largest tilt theta the tool can "
+        "reach. torsion_zero follows the paper (psi = 0); exact maximises over the torsion.",
+    )
+    _add_global_options(sub, top=False)
+    sub.add_argument("--method", choices=("torsion_zero", "exact"), default="torsion_zero")
+    sub.add_argument("--n-phi", type=int, default=360, metavar="N", help="azimuths (3-7200)")
+    sub.add_argument("--tol-deg", type=float, metavar="T", help="boundary tolerance, degrees")
+    sub.add_argument("--plot", metavar="FILE.png", help="polar plot, both methods overlaid")
+    sub.add_argument("--record", metavar="FILE", help="also write the result to an MCAP log")
+    sub.set_defaults(handler=cmd_projected)
+
+    sub = commands.add_parser(
+        "orientation",
+        help="3-D orientation workspace (psi slices in the cylindrical picture)",
+        description="Slices psi = const every --psi-step-deg, rays from the centroid of the "
+        "previous slice; psi_min and psi_max located to the tolerance.",
+    )
+    _add_global_options(sub, top=False)
+    sub.add_argument("--n-rays", type=int, default=180, metavar="N", help="rays per slice")
+    sub.add_argument("--psi-step-deg", type=float, default=1.0, metavar="S")
+    sub.add_argument("--tol-deg", type=float, metavar="T", help="boundary tolerance, degrees")
+    sub.add_argument("--plot", metavar="FILE.png", help="surface + top view (paper's Fig. 4/5)")
+    sub.add_argument("--record", metavar="FILE", help="also write the result to an MCAP log")
+    sub.set_defaults(handler=cmd_orientation)
+
+    sub = commands.add_parser(
+        "torsion-range",
+        help="feasible torsion intervals for one tool direction",
+        description="Exit 0 when some torsion is feasible, 1 when none is.",
+    )
+    _add_global_options(sub, top=False)
+    sub.add_argument(
+        "--direction",
+        nargs=2,
+        type=float,
+        required=True,
+        metavar=("PHI", "THETA"),
+        help="tool direction (azimuth, tilt), degrees",
+    )
+    sub.add_argument("--tol-deg", type=float, metavar="T", help="boundary tolerance, degrees")
+    sub.set_defaults(handler=cmd_torsion_range)
+
+    sub = commands.add_parser(
+        "replay",
+        help="what a recorded MCAP log holds (topics, counts, time span, results)",
+        description="Accepts a bare .mcap file or a rosbag2 bag directory. Exit 2 when "
+        "nothing usable can be read.",
+    )
+    _add_global_options(sub, top=False)
+    sub.add_argument("log", metavar="LOG")
+    sub.add_argument("--plot", metavar="DIR", help="redraw the recorded workspaces into DIR")
+    sub.add_argument(
+        "--publish", action="store_true", help="republish the log on ROS topics (needs rclpy)"
+    )
+    sub.add_argument(
+        "--rate",
+        type=float,
+        default=1.0,
+        metavar="R",
+        help="playback speed for --publish (1 = recorded, 0 = as fast as possible)",
+    )
+    sub.set_defaults(handler=cmd_replay)
+
+    sub = commands.add_parser(
+        "demo",
+        help="the example manipulator end to end: results table, plots, MCAP log",
+        description="On the axis (0, 0, -1.3) m and off the axis (0.2, 0.2, -0.95) m: "
+        "projected workspaces (both methods), 3-D orientation workspaces, plots and a log.",
+    )
+    _add_global_options(sub, top=False)
+    sub.add_argument("--out", default="demo_out", metavar="DIR", help="output folder")
+    sub.set_defaults(handler=cmd_demo)
     return parser
 
 
@@ -350,6 +693,10 @@ def main(argv: Sequence[str] | None = None, *, out: TextIO | None = None) -> int
         return 2
     except BrokenPipeError:
         return 0
+    except OSError as error:  # an output file (plot, log, results) cannot be written
+        where = f" {error.filename}" if error.filename else ""
+        print(f"{PROG}: error: cannot write{where}: {error.strerror or error}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return 130

@@ -115,6 +115,8 @@ class OrientationWorkspace:
         Computation time, s.
     evaluations : int
         Poses evaluated.
+    psi_min_point, psi_max_point : ndarray, shape (2,), optional
+        Where in the cylindrical xy-plane (rad) ψmin and ψmax are attained.
     """
 
     position: NDArray[np.float64]
@@ -127,6 +129,8 @@ class OrientationWorkspace:
     tolerance: float
     elapsed: float
     evaluations: int = 0
+    psi_min_point: NDArray[np.float64] | None = None
+    psi_max_point: NDArray[np.float64] | None = None
 
     def boundary_points(self) -> NDArray[np.float64]:
         """All boundary points; shape (M, 6), columns x, y, z, φ, θ, ψ (rad).
@@ -371,8 +375,8 @@ def orientation_workspace(
             (upper if sign > 0 else lower).append(piece)
         if progress:
             progress(min(0.95, (len(upper) + len(lower)) / expected))
-    psi_max, _ = slicer.torsion_limit(upper[-1], 1.0)
-    psi_min, _ = slicer.torsion_limit(lower[-1], -1.0)
+    psi_max, psi_max_point = slicer.torsion_limit(upper[-1], 1.0)
+    psi_min, psi_min_point = slicer.torsion_limit(lower[-1], -1.0)
     slices = lower[:0:-1] + upper
     areas = np.array([piece.area() for piece in slices])
     psis = np.array([piece.psi for piece in slices])
@@ -392,6 +396,8 @@ def orientation_workspace(
         tolerance=tolerance,
         elapsed=time.perf_counter() - started,
         evaluations=search.evaluations,
+        psi_min_point=psi_min_point,
+        psi_max_point=psi_max_point,
     )
 
 
