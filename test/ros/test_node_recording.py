@@ -1,0 +1,212 @@
+"""workspace_node's MCAP log, from a real node process over real Fast DDS.
+
+What the node published, answered and was sent is compared with what its log holds, decoded by
+two independent readers (rosbags with the log's own schemas, mcap + mcap_ros2) and by
+hexapod_workspace.recording. SIGINT must leave a finished log; SIGKILL must keep every message
+flushed before the kill; an unwritable recording directory must not stop the node serving.
+"""
+
+from __future__ import annotations
+
+import math
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from ros_support import DISCOVERY_TIMEOUT, require_ros, running_node, write_params
+
+require_ros()
+
+from hexapod_workspace_msgs.msg import (  # noqa: E402
+    CommandedPose,
+    ReachabilityResult,
+    TiltTorsion,
+    WorkspaceSummary,
+)
+from hexapod_workspace_msgs.srv import CheckPoses, ComputeWorkspace  # noqa: E402
+from sensor_msgs.msg import PointCloud2  # noqa: E402
+from std_srvs.srv import Trigger  # noqa: E402
+
+from hexapod_workspace import messages, recording  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # test/recording_support.py
+from recording_support import plain, read_with_mcap_ros2, read_with_rosbags  # noqa: E402
+
+#: Every test runs its node in its own namespace: fresh service names, so no client of an earlier
+#: node (already stopped or killed) can swallow a request.
+NAMESPACES = {
+    "sigint": "/rec_sigint",
+    "sigkill": "/rec_sigkill",
+    True: "/rec_unwritable",
+    False: "/rec_disabled",
+}
+NODE_PARAMS = {
+    "resolution.n_phi": 36,
+    "resolution.n_rays": 12,
+    "resolution.psi_step": 0.1,
+    "resolution.tolerance": 1e-3,
+}
+
+
+def the_log(directory: Path) -> Path:
+    logs = sorted(directory.glob("*.mcap"))
+    assert len(logs) == 1, f"expected one log per node run in {directory}, found {logs}"
+    assert logs[0].name.startswith("hexapod_workspace_2")  # named by the start time
+    return logs[0]
+
+
+def check_request(angles_deg: list[list[float]]) -> CheckPoses.Request:
+    request = CheckPoses.Request()
+    request.position.z = -1.3
+    request.orientations = [
+        TiltTorsion(phi=float(phi), theta=float(theta), psi=float(psi))
+        for phi, theta, psi in np.radians(angles_deg)
+    ]
+    return request
+
+
+def by_topic(entries: list[tuple[str, str, object]]) -> dict[str, list]:
+    topics: dict[str, list] = {}
+    for topic, _, message in entries:
+        topics.setdefault(topic, []).append(plain(message))
+    return topics
+
+
+def node_args(key: object, directory: Path, overrides: dict | None = None) -> tuple[str, list]:
+    """The node's fully qualified name and the arguments that put it in its own namespace,
+    with its parameters in a file for ``/**`` (the example file is keyed by the bare name)."""
+    namespace = NAMESPACES[key]
+    params = write_params(
+        directory / "params_namespaced.yaml",
+        {"recording.directory": str(directory / "logs"), **NODE_PARAMS, **(overrides or {})},
+    )
+    document = yaml.safe_load(params.read_text(encoding="utf-8"))
+    params.write_text(yaml.safe_dump({"/**": document["hexapod_workspace"]}), encoding="utf-8")
+    return f"{namespace}/hexapod_workspace", [
+        "-r",
+        f"__ns:={namespace}",
+        "--params-file",
+        str(params),
+    ]
+
+
+def stop(node, sig: int = signal.SIGINT, timeout: float = 30.0) -> int:
+    """Stop the node; when it hangs, make it dump every thread's stack (faulthandler) first."""
+    node.process.send_signal(sig)
+    try:
+        return node.process.wait(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        node.process.send_signal(signal.SIGABRT)
+        node.process.wait(timeout=timeout)
+        msg = f"node did not stop within {timeout} s of signal {sig}:\n{node.output()}"
+        raise AssertionError(msg) from None
+
+
+def test_sigint_log_holds_exactly_what_the_node_did(ros_domain, ros_client, tmp_path) -> None:
+    node_name, args = node_args("sigint", tmp_path)
+    with running_node(tmp_path, NODE_PARAMS, args) as node:
+        summaries = ros_client.collect(
+            WorkspaceSummary, f"{node_name}/workspace_summary", transient_local=True
+        )
+        clouds = ros_client.collect(
+            PointCloud2, f"{node_name}/projected_workspace", transient_local=True
+        )
+        verdicts = ros_client.collect(
+            ReachabilityResult, f"{node_name}/reachability", transient_local=True
+        )
+        check = check_request([[0, 0, 0], [30, 20, 5], [45, 80, 10]])
+        check_response = ros_client.call(CheckPoses, f"{node_name}/check_poses", check)
+        compute = ComputeWorkspace.Request()
+        compute.request.request_id = "recording-test"
+        compute.request.kind = messages.PROJECTED_TORSION_ZERO
+        compute.request.position.z = -1.3
+        compute_response = ros_client.call(
+            ComputeWorkspace, f"{node_name}/compute_workspace", compute
+        )
+        trigger_response = ros_client.call(
+            Trigger, f"{node_name}/compute_projected_workspace", Trigger.Request()
+        )
+        command = CommandedPose(request_id="cmd-1")
+        command.position.z = -1.3
+        command.orientation.theta = math.radians(10.0)
+        ros_client.publisher(CommandedPose, f"{node_name}/commanded_pose").publish(command)
+        ros_client.spin_until(
+            lambda: len(verdicts) >= 1 and len(summaries) >= 2 and len(clouds) >= 2,
+            what="the node's results",
+            timeout=DISCOVERY_TIMEOUT,
+        )
+        assert stop(node) == 0, node.output()
+    path = the_log(tmp_path / "logs")
+
+    ours = recording.read_log(path)
+    assert ours.finished and ours.problems == [], ours.problems
+    entries = [(m.topic, m.msgtype, m.message) for m in ours.messages]
+    for reader_entries in (read_with_rosbags(path), read_with_mcap_ros2(path)):
+        assert by_topic(reader_entries) == by_topic(entries)
+
+    recorded = by_topic(entries)
+    assert recorded[f"{node_name}/check_poses/request"] == [plain(check)]
+    assert recorded[f"{node_name}/check_poses/response"] == [plain(check_response)]
+    assert recorded[f"{node_name}/compute_workspace/request"] == [plain(compute)]
+    assert recorded[f"{node_name}/compute_workspace/response"] == [plain(compute_response)]
+    assert recorded[f"{node_name}/compute_projected_workspace/response"] == [
+        plain(trigger_response)
+    ]
+    assert recorded[f"{node_name}/commanded_pose"] == [plain(command)]
+    assert recorded[f"{node_name}/reachability"] == [plain(m) for m in verdicts]
+    assert recorded[f"{node_name}/workspace_summary"] == [plain(m) for m in summaries]
+    assert recorded[f"{node_name}/projected_workspace"] == [plain(m) for m in clouds]
+
+
+def test_sigkill_keeps_what_was_flushed(ros_domain, ros_client, tmp_path) -> None:
+    node_name, args = node_args("sigkill", tmp_path)
+    with running_node(tmp_path, NODE_PARAMS, args) as node:
+        request = check_request([[0, 0, 0], [10, 5, 0]])
+        response = ros_client.call(CheckPoses, f"{node_name}/check_poses", request)
+        log_dir = tmp_path / "logs"
+
+        def flushed() -> bool:  # the flush interval bounds how long this takes
+            logs = list(log_dir.glob("*.mcap"))
+            if len(logs) != 1:
+                return False
+            topics = [m.topic for m in recording.read_log(logs[0]).messages]
+            return f"{node_name}/check_poses/response" in topics
+
+        ros_client.spin_until(
+            flushed, what="the check to reach the log on disk", timeout=DISCOVERY_TIMEOUT
+        )
+        node.stop(signal.SIGKILL)
+    path = the_log(tmp_path / "logs")
+    contents = recording.read_log(path)
+    assert not contents.finished
+    recorded = by_topic([(m.topic, m.msgtype, m.message) for m in contents.messages])
+    assert recorded[f"{node_name}/check_poses/request"] == [plain(request)]
+    assert recorded[f"{node_name}/check_poses/response"] == [plain(response)]
+    assert by_topic(read_with_mcap_ros2(path)) == recorded
+
+
+@pytest.mark.parametrize("enabled", [True, False])
+def test_unwritable_directory_or_disabled_recording_keeps_serving(
+    ros_domain, ros_client, tmp_path, enabled: bool
+) -> None:
+    blocker = tmp_path / "not_a_directory"
+    blocker.write_text("a file where the log folder should be")
+    overrides = {
+        **NODE_PARAMS,
+        "recording.enabled": enabled,
+        "recording.directory": str(blocker / "logs"),
+    }
+    node_name, args = node_args(enabled, tmp_path, overrides)
+    with running_node(tmp_path, overrides, args) as node:
+        response = ros_client.call(
+            CheckPoses, f"{node_name}/check_poses", check_request([[0, 0, 0]])
+        )
+        assert response.success and response.results[0].reachable
+        assert stop(node) == 0, node.output()
+    if enabled:
+        assert "recording off" in node.output()
+    assert not list(tmp_path.rglob("*.mcap"))
