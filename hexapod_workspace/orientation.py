@@ -10,8 +10,9 @@ tolerance by the certified search of :mod:`hexapod_workspace.search`:
 2. Slices ψ = ±Δψ, ±2Δψ, ... upward and downward: rays from the area centroid of the
    previous slice. When that centroid is unreachable in the new slice, points of the previous
    slice pulled halfway towards its centroid are tried as centres (the most comfortable one,
-   largest relative margin, is used); a slice with no reachable centre is empty and ends the
-   march.
+   largest relative margin, is used); when none is reachable, the torsion-limit search of
+   step 3 decides: if some direction of the previous slice still reaches the new torsion, it
+   is the centre, otherwise the slice is empty and ends the march.
 3. ψmax (ψmin) is located to the tolerance: from the centre and the pulled points of the last
    non-empty slice, the torsion is increased (decreased) until the first violation, and the
    best of those is refined by a shrinking pattern search over (x, y).
@@ -351,6 +352,7 @@ def orientation_workspace(
     upper: list[OrientationSlice] = [middle]
     lower: list[OrientationSlice] = [middle]
     growing = {1.0: True, -1.0: True}
+    limits: dict[float, tuple[float, NDArray[np.float64]]] = {}
     while any(growing.values()):
         centers, psis, signs = [], [], []
         for sign, stack in ((1.0, upper), (-1.0, lower)):
@@ -362,8 +364,14 @@ def orientation_workspace(
                 continue
             center = slicer.best_center(stack[-1], psi)
             if center is None:
-                growing[sign] = False
-                continue
+                # No pulled point reaches the next slice: the torsion limit search tells whether
+                # some direction still does (then it is the centre) or the slice is empty.
+                limit, point = slicer.torsion_limit(stack[-1], sign)
+                limits[sign] = (limit, point)
+                if sign * (limit - psi) < 0.0:
+                    growing[sign] = False
+                    continue
+                center = point
             centers.append(center)
             psis.append(psi)
             signs.append(sign)
@@ -375,8 +383,11 @@ def orientation_workspace(
             (upper if sign > 0 else lower).append(piece)
         if progress:
             progress(min(0.95, (len(upper) + len(lower)) / expected))
-    psi_max, psi_max_point = slicer.torsion_limit(upper[-1], 1.0)
-    psi_min, psi_min_point = slicer.torsion_limit(lower[-1], -1.0)
+    for sign, stack in ((1.0, upper), (-1.0, lower)):
+        if sign not in limits or sign * (limits[sign][0] - stack[-1].psi) >= step:
+            limits[sign] = slicer.torsion_limit(stack[-1], sign)
+    psi_max, psi_max_point = limits[1.0]
+    psi_min, psi_min_point = limits[-1.0]
     slices = lower[:0:-1] + upper
     areas = np.array([piece.area() for piece in slices])
     psis = np.array([piece.psi for piece in slices])
