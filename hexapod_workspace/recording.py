@@ -503,7 +503,10 @@ class LogWriter:
             self._closed = True
             if self._file is not None:
                 self._close_file_quietly()
-            msg = f"cannot create MCAP log {self.path}: {err.strerror or err}"
+            reason = err.strerror or str(err)
+            if isinstance(err, FileExistsError):  # mkdir met a file where a folder should be
+                reason = "a file is in the way of its folder"
+            msg = f"cannot create MCAP log {self.path}: {reason}"
             raise RecordingError(msg) from err
         self._queue: queue.Queue[Any] | None = queue.Queue() if background else None
         self._worker: threading.Thread | None = None
