@@ -143,6 +143,33 @@ def test_record_real_workspaces_replay_and_plot(tmp_path: Path, example) -> None
     assert plots == ["workspace_001_projected.png", "workspace_003_orientation.png"]
 
 
+@pytest.mark.skipif(not HAVE_CORE_WORKSPACES, reason="core workspaces/plotting not there yet")
+def test_cli_record_then_replay(tmp_path: Path) -> None:
+    """The console script end to end: projected --record, then replay (text, JSON, plots)."""
+    from cli_support import run_cli
+
+    log = tmp_path / "study.mcap"
+    recorded = run_cli(
+        "--json", "projected", "--method", "exact", "--n-phi", "48", "--record", str(log)
+    )
+    assert recorded.returncode == 0, recorded.stderr
+    live = json.loads(recorded.stdout)
+    replayed = run_cli("replay", str(log), "--json", "--plot", str(tmp_path / "plots"))
+    assert replayed.returncode == 0, replayed.stderr
+    assert "Traceback" not in replayed.stderr
+    (workspace,) = json.loads(replayed.stdout)["workspaces"]
+    assert workspace["kind"] == "exact" and workspace["n_points"] == 48
+    assert workspace["tilt_min_deg"] == pytest.approx(live["tilt_min_deg"])
+    assert workspace["tilt_max_deg"] == pytest.approx(live["tilt_max_deg"])
+    assert workspace["position"] == pytest.approx(live["position"])
+    assert (tmp_path / "plots" / "workspace_001_projected.png").stat().st_size > 0
+    text = run_cli("replay", str(log))
+    assert text.returncode == 0 and "exact: tilt" in text.stdout
+    broken = run_cli("replay", str(tmp_path / "missing.mcap"))
+    assert broken.returncode == 2 and broken.stdout == ""
+    assert "Traceback" not in broken.stderr and len(broken.stderr.splitlines()) == 1
+
+
 # --------------------------------------------------------------------------- bad logs
 
 
