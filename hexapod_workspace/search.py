@@ -55,8 +55,8 @@ __all__ = ["DEFAULT_MIN_STEP", "RaySearch", "RaySearchResult"]
 
 #: Shortest step of the march (rad): below it, steps are no longer Lipschitz-certified.
 DEFAULT_MIN_STEP = 1e-3
-#: Longest step of the march (rad), so that the margins are sampled along the way.
-MAX_STEP = 0.25
+#: Longest step of the march (rad); steps are certified, this only bounds a single jump.
+MAX_STEP = 1.0
 #: Shrink certified steps by this factor so that rounding cannot land on a violated point.
 SAFETY = 1.0 - 1e-9
 
@@ -206,6 +206,9 @@ class RaySearch:
         s = np.broadcast_to(np.asarray(s_start, dtype=np.float64), (count,)).copy()
         feasible = np.full(count, np.nan)
         violated = np.full(count, np.inf)
+        # Signed distance estimates at the feasible and violated ends, for the secant phase.
+        feasible_value = np.zeros(count)
+        violated_value = np.zeros(count)
         limiting = np.full(count, -1, dtype=np.int64)
         start_feasible = np.ones(count, dtype=bool)
         first = np.ones(count, dtype=bool)
@@ -214,25 +217,25 @@ class RaySearch:
         while active.size:
             margins = self.margins(angles_at(active, s[active]))
             bad = np.any(margins < 0.0, axis=0)
+            estimate = self.distance_estimate(margins)
             if np.any(bad):
                 rays = active[bad]
                 violated[rays] = s[rays]
+                violated_value[rays] = estimate[bad]
                 limiting[rays] = self.most_violated(margins[:, bad])
                 start_feasible[rays[first[rays]]] = False
                 bracket.append(rays[~first[rays]])
             good = active[~bad]
             first[active] = False
             feasible[good] = s[good]
+            feasible_value[good] = estimate[~bad]
             step = np.clip(self.certified_step(margins[:, ~bad]), self.min_step, MAX_STEP)
             done = s[good] >= s_end[good]
             s[good] = np.minimum(s[good] + step, s_end[good])
             active = good[~done]
         rays = np.concatenate(bracket) if bracket else np.zeros(0, dtype=np.int64)
         low, high = feasible[rays], violated[rays]
-        low_value = self.distance_estimate(self.margins(angles_at(rays, low))) if rays.size else low
-        high_value = (
-            self.distance_estimate(self.margins(angles_at(rays, high))) if rays.size else high
-        )
+        low_value, high_value = feasible_value[rays], violated_value[rays]
         bisect = np.zeros(rays.size, dtype=bool)
         open_ = np.flatnonzero(high - low > tolerance)
         while open_.size:
