@@ -53,8 +53,8 @@ setup(
         "numpy>=1.24",
         "PyYAML>=5.4",
         "matplotlib>=3.6",
-        "mcap>=1.1",
-        "rosbags>=0.10",
+        "mcap>=1.6",
+        "rosbags>=0.11",
     ],
     zip_safe=False,
     entry_points={
