@@ -316,6 +316,7 @@ def cmd_check(options: argparse.Namespace, out: TextIO) -> int:
         raise CliError(msg)
     degrees = np.concatenate(parts)
     result = check(manipulator, np.radians(degrees))
+    _record(options, manipulator, [result])
     if options.json:
         check_poses_to_json(result, out, degrees)
     else:

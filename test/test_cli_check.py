@@ -158,3 +158,15 @@ def test_unreachable_values_have_no_nan(example):
     assert done.returncode == 1
     margins = json.loads(done.stdout)["poses"][0]["margins"]
     assert all(math.isfinite(v) for v in margins.values())
+
+
+def test_check_record_then_replay(tmp_path):
+    log = tmp_path / "check.mcap"
+    done = run_cli(
+        "check", "--pose", "0", "10", "0", "--pose", "0", "70", "0", "--record", str(log)
+    )
+    assert done.returncode == 1, done.stderr
+    replay = run_cli("replay", str(log))
+    assert replay.returncode == 0, replay.stderr
+    assert "/hexapod_workspace/check_poses/request" in replay.stdout
+    assert "1/2 reachable" in replay.stdout
