@@ -239,10 +239,26 @@ def message_definition(msgtype: str) -> str:
 
 
 @functools.cache
+def _hash_store() -> Typestore:
+    """A store whose service types carry their ROS names (``pkg/srv/X_Request``): the RIHS01
+    hash includes the type name, and :func:`get_typestore` keys them ``pkg/srv/msg/X_Request``."""
+    store = _rosbags_typestore(Stores.ROS2_JAZZY)
+    fielddefs = get_typestore().fielddefs
+    store.register(
+        {k: v for k, v in fielddefs.items() if k.startswith(f"{INTERFACE_PACKAGE}/msg/")}
+    )
+    store.register(
+        {k.replace("/srv/msg/", "/srv/"): v for k, v in fielddefs.items() if "/srv/msg/" in k}
+    )
+    return store
+
+
+@functools.cache
 def type_hash(msgtype: str) -> str:
-    """Return the type's RIHS01 hash (``RIHS01_<64 hex>``), as rosbag2 Jazzy stores it."""
+    """Return the type's RIHS01 hash (``RIHS01_<64 hex>``), as rosbag2 Jazzy stores it (the
+    same value rclpy reports as ``topic_type_hash``)."""
     message_definition(msgtype)  # same KeyError for unknown types
-    return get_typestore().hash_rihs01(store_name(msgtype))
+    return _hash_store().hash_rihs01(msgtype)
 
 
 def qos_profile_text(

@@ -210,3 +210,24 @@ def test_unwritable_directory_or_disabled_recording_keeps_serving(
     if enabled:
         assert "recording off" in node.output()
     assert not list(tmp_path.rglob("*.mcap"))
+
+
+def test_recorded_type_hashes_are_the_ones_rclpy_announces(ros_client) -> None:
+    """topic_type_hash in the channel metadata equals the hash rclpy publishes with."""
+    classes = {
+        "hexapod_workspace_msgs/msg/WorkspaceSummary": WorkspaceSummary,
+        "hexapod_workspace_msgs/msg/ReachabilityResult": ReachabilityResult,
+        "hexapod_workspace_msgs/msg/CommandedPose": CommandedPose,
+        "hexapod_workspace_msgs/srv/CheckPoses_Request": CheckPoses.Request,
+        "hexapod_workspace_msgs/srv/CheckPoses_Response": CheckPoses.Response,
+        "hexapod_workspace_msgs/srv/ComputeWorkspace_Request": ComputeWorkspace.Request,
+        "hexapod_workspace_msgs/srv/ComputeWorkspace_Response": ComputeWorkspace.Response,
+        "std_srvs/srv/Trigger_Request": Trigger.Request,
+        "std_srvs/srv/Trigger_Response": Trigger.Response,
+        "sensor_msgs/msg/PointCloud2": PointCloud2,
+    }
+    for index, (msgtype, message_class) in enumerate(classes.items()):
+        topic = f"/type_hash_check/t{index}"
+        ros_client.node.create_publisher(message_class, topic, 1)
+        (info,) = ros_client.node.get_publishers_info_by_topic(topic)
+        assert recording.type_hash(msgtype) == str(info.topic_type_hash), msgtype
