@@ -558,6 +558,13 @@ def _add_global_options(parser: argparse.ArgumentParser, *, top: bool) -> None:
     )
 
 
+def _add_workspace_options(parser: argparse.ArgumentParser, plot_help: str) -> None:
+    """Options shared by the workspace commands: tolerance, plot and log."""
+    parser.add_argument("--tol-deg", type=float, metavar="T", help="boundary tolerance, degrees")
+    parser.add_argument("--plot", metavar="FILE.png", help=plot_help)
+    parser.add_argument("--record", metavar="FILE", help="also write the result to an MCAP log")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argparse parser of ``hexapod-workspace``."""
     parser = _Parser(
@@ -603,9 +610,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_global_options(sub, top=False)
     sub.add_argument("--method", choices=("torsion_zero", "exact"), default="torsion_zero")
     sub.add_argument("--n-phi", type=int, default=360, metavar="N", help="azimuths (3-7200)")
-    sub.add_argument("--tol-deg", type=float, metavar="T", help="boundary tolerance, degrees")
-    sub.add_argument("--plot", metavar="FILE.png", help="polar plot, both methods overlaid")
-    sub.add_argument("--record", metavar="FILE", help="also write the result to an MCAP log")
+    _add_workspace_options(sub, "polar plot, both methods overlaid")
     sub.set_defaults(handler=cmd_projected)
 
     sub = commands.add_parser(
@@ -617,9 +622,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_global_options(sub, top=False)
     sub.add_argument("--n-rays", type=int, default=180, metavar="N", help="rays per slice")
     sub.add_argument("--psi-step-deg", type=float, default=1.0, metavar="S")
-    sub.add_argument("--tol-deg", type=float, metavar="T", help="boundary tolerance, degrees")
-    sub.add_argument("--plot", metavar="FILE.png", help="surface + top view (paper's Fig. 4/5)")
-    sub.add_argument("--record", metavar="FILE", help="also write the result to an MCAP log")
+    _add_workspace_options(sub, "surface + top view (paper's Fig. 4/5)")
     sub.set_defaults(handler=cmd_orientation)
 
     sub = commands.add_parser(

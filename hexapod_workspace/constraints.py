@@ -66,6 +66,14 @@ def _positions(position: ArrayLike, count: int) -> NDArray[np.float64]:
     raise InputError(msg)
 
 
+def _rotation_batch(rotations: ArrayLike) -> NDArray[np.float64]:
+    array = np.asarray(rotations, dtype=np.float64)
+    if array.ndim != 3 or array.shape[1:] != (3, 3):
+        msg = f"rotations: expected shape (N, 3, 3), got {array.shape}"
+        raise InputError(msg)
+    return array
+
+
 @dataclass(frozen=True)
 class LegKinematics:
     """Inverse kinematics of a batch of poses.
@@ -105,10 +113,7 @@ def inverse_kinematics(
     -------
     LegKinematics
     """
-    rotations = np.asarray(rotations, dtype=np.float64)
-    if rotations.ndim != 3 or rotations.shape[1:] != (3, 3):
-        msg = f"rotations: expected shape (N, 3, 3), got {rotations.shape}"
-        raise InputError(msg)
+    rotations = _rotation_batch(rotations)
     positions = _positions(position, rotations.shape[0])
     platform = positions[:, None, :] + np.einsum(
         "nij,kj->nki", rotations, manipulator.platform_joints
@@ -253,10 +258,7 @@ def pose_margins(
     -------
     PoseMargins
     """
-    rotations = np.asarray(rotations, dtype=np.float64)
-    if rotations.ndim != 3 or rotations.shape[1:] != (3, 3):
-        msg = f"rotations: expected shape (N, 3, 3), got {rotations.shape}"
-        raise InputError(msg)
+    rotations = _rotation_batch(rotations)
     count = rotations.shape[0]
     positions = _positions(position, count)
     margins = np.empty((4, count))

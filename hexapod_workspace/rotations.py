@@ -48,6 +48,14 @@ def _last_axis(values: ArrayLike, size: int, name: str) -> NDArray[np.float64]:
     return array
 
 
+def _matrices(matrix: ArrayLike) -> NDArray[np.float64]:
+    array = np.asarray(matrix, dtype=np.float64)
+    if array.ndim < 2 or array.shape[-2:] != (3, 3):
+        msg = f"matrix: expected an array of shape (..., 3, 3), got shape {array.shape}"
+        raise InputError(msg)
+    return array
+
+
 def wrap_angle(angle: ArrayLike) -> NDArray[np.float64]:
     """Wrap angles into (−π, π].
 
@@ -172,10 +180,7 @@ def matrix_to_tt(matrix: ArrayLike) -> NDArray[np.float64]:
         (φ, θ, ψ) in rad, φ ∈ (−π, π], θ ∈ [0, π], ψ ∈ (−π, π]. On the singularities
         (sin θ < 1e-12) φ = 0 and ψ carries the whole rotation about the tool axis.
     """
-    matrix = np.asarray(matrix, dtype=np.float64)
-    if matrix.ndim < 2 or matrix.shape[-2:] != (3, 3):
-        msg = f"matrix: expected an array of shape (..., 3, 3), got shape {matrix.shape}"
-        raise InputError(msg)
+    matrix = _matrices(matrix)
     r02, r12, r22 = matrix[..., 0, 2], matrix[..., 1, 2], matrix[..., 2, 2]
     sin_theta = np.hypot(r02, r12)
     theta = np.arctan2(sin_theta, r22)
@@ -271,10 +276,7 @@ def matrix_to_quaternion(matrix: ArrayLike) -> NDArray[np.float64]:
     -------
     ndarray, shape (..., 4)
     """
-    matrix = np.asarray(matrix, dtype=np.float64)
-    if matrix.ndim < 2 or matrix.shape[-2:] != (3, 3):
-        msg = f"matrix: expected an array of shape (..., 3, 3), got shape {matrix.shape}"
-        raise InputError(msg)
+    matrix = _matrices(matrix)
     m00, m11, m22 = matrix[..., 0, 0], matrix[..., 1, 1], matrix[..., 2, 2]
     trace = m00 + m11 + m22
     candidates = np.stack(
