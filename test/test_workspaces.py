@@ -354,3 +354,54 @@ def test_absurd_resolutions_are_refused(example, call, message):
 def test_bad_requests_are_refused(example, call):
     with pytest.raises(InputError):
         call(example)
+
+
+def first_root(k0, k1, k2, level):
+    """First theta in (0, pi] with k0 + k1 cos(theta) + k2 sin(theta) = level, else inf.
+
+    Writing k1 cos + k2 sin = A cos(theta - delta): theta = delta +- arccos((level - k0) / A).
+    """
+    amplitude = math.hypot(k1, k2)
+    if amplitude == 0.0 or abs(level - k0) > amplitude:
+        return math.inf
+    delta = math.atan2(k2, k1)
+    spread = math.acos((level - k0) / amplitude)
+    roots = []
+    for base in (delta + spread, delta - spread):
+        for turn in (-2.0, 0.0, 2.0):
+            value = base + turn * math.pi
+            if 1e-12 < value <= math.pi:
+                roots.append(value)
+    return min(roots, default=math.inf)
+
+
+def test_leg_length_boundary_closed_form(example, tz_off):
+    """Along a ray (phi fixed, psi = 0) each squared leg length is exactly
+    K0 + K1 cos(theta) + K2 sin(theta) (R is linear in cos and sin of theta). Where the search
+    reports leg_length as the limiting constraint, its boundary must equal the first root of
+    l_i(theta)^2 = l_min^2 or l_max^2 over the legs (from three samples, solved in closed form)."""
+    from hexapod_workspace.constraints import inverse_kinematics
+    from hexapod_workspace.rotations import tt_to_matrix
+
+    checked = 0
+    for k in np.flatnonzero(np.array(tz_off.limiting) == "leg_length"):
+        phi = tz_off.phi[k]
+        samples = np.array([0.0, math.pi / 2, math.pi])
+        angles = np.column_stack([np.full(3, phi), samples, np.zeros(3)])
+        squared = inverse_kinematics(example, tt_to_matrix(angles), OFF_AXIS).lengths ** 2
+        # l^2(0) = K0 + K1, l^2(pi/2) = K0 + K2, l^2(pi) = K0 - K1.
+        k0 = (squared[0] + squared[2]) / 2.0
+        k1 = (squared[0] - squared[2]) / 2.0
+        k2 = squared[1] - k0
+        # The identity holds at other tilts too (the closed form is exact).
+        probe = np.array([[phi, 0.37, 0.0]])
+        direct = inverse_kinematics(example, tt_to_matrix(probe), OFF_AXIS).lengths[0] ** 2
+        np.testing.assert_allclose(direct, k0 + k1 * math.cos(0.37) + k2 * math.sin(0.37))
+        closed = min(
+            first_root(k0[i], k1[i], k2[i], level)
+            for i in range(6)
+            for level in (example.leg_length_min[i] ** 2, example.leg_length_max[i] ** 2)
+        )
+        assert tz_off.theta[k] <= closed <= tz_off.theta[k] + tz_off.tolerance + 1e-12
+        checked += 1
+    assert checked >= 5
