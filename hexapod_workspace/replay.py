@@ -312,6 +312,17 @@ def _report(summary: LogSummary) -> dict[str, Any]:
     }
 
 
+def _jsonable(value: Any) -> Any:
+    """NaN and infinities (a rejected request's position, a disabled margin) become null."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {key: _jsonable(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [_jsonable(item) for item in value]
+    return value
+
+
 def _print_text(report: dict[str, Any], out: IO[str]) -> None:
     state = "finished" if report["finished"] else "not finished cleanly (read as far as intact)"
     out.write(f"log: {report['log']} ({state})\n")
@@ -439,25 +450,37 @@ def _make(cls: type, **values: Any) -> Any:
     return cls(**{k: v for k, v in values.items() if k in names})
 
 
-def _plot(summary: LogSummary, plot_dir: Path, out: IO[str]) -> list[Path]:
+def _plot(summary: LogSummary, plot_dir: Path, out: IO[str], err: IO[str]) -> list[Path]:
+    """Redraw the recorded workspaces; one that cannot be redrawn is a note, not a failure."""
     from hexapod_workspace import plotting
 
     plot_dir.mkdir(parents=True, exist_ok=True)
     written: list[Path] = []
     projected: dict[tuple[float, ...], list[tuple[int, Any]]] = {}
+
+    def draw(index: int, function: Any, workspace: Any, path: Path) -> None:
+        try:
+            written.append(Path(function(workspace, path)))
+        except (ValueError, IndexError, TypeError, ArithmeticError) as error:
+            err.write(f"note: workspace {index} could not be redrawn ({error})\n")
+
     for index, record in enumerate(summary.workspaces, start=1):
         if not record.summary["success"] or record.points is None or not len(record.points):
             continue
-        workspace = _rebuild(record)
+        try:
+            workspace = _rebuild(record)
+        except (ValueError, IndexError, TypeError, KeyError) as error:
+            err.write(f"note: workspace {index} could not be rebuilt from the log ({error})\n")
+            continue
         if int(record.summary["kind"]) == messages.ORIENTATION:
             path = plot_dir / f"workspace_{index:03d}_orientation.png"
-            written.append(Path(plotting.plot_orientation(workspace, path)))
+            draw(index, plotting.plot_orientation, workspace, path)
         else:  # methods computed at one position are overlaid, like the live command
             key = tuple(np.round(workspace.position, 9))
             projected.setdefault(key, []).append((index, workspace))
     for group in projected.values():
         path = plot_dir / f"workspace_{group[0][0]:03d}_projected.png"
-        written.append(Path(plotting.plot_projected([ws for _, ws in group], path)))
+        draw(group[0][0], plotting.plot_projected, [ws for _, ws in group], path)
     for path in written:
         out.write(f"plot: {path}\n")
     return written
@@ -627,13 +650,13 @@ def run_replay(
         return 2
     report = _report(summary)
     if as_json:
-        json.dump(report, out, indent=1, allow_nan=False)
+        json.dump(_jsonable(report), out, indent=1, allow_nan=False)
         out.write("\n")
     else:
         _print_text(report, out)
     if plot_dir is not None:
         try:
-            _plot(summary, Path(plot_dir), err if as_json else out)
+            _plot(summary, Path(plot_dir), err if as_json else out, err)
         except OSError as error:
             err.write(f"replay: cannot write plots to {plot_dir}: {error.strerror or error}\n")
             return 2

@@ -170,6 +170,25 @@ def test_cli_record_then_replay(tmp_path: Path) -> None:
     assert "Traceback" not in broken.stderr and len(broken.stderr.splitlines()) == 1
 
 
+@pytest.mark.skipif(not HAVE_CORE_WORKSPACES, reason="core workspaces/plotting not there yet")
+def test_plot_redraws_overlaid_methods_and_degenerate_workspaces(tmp_path: Path) -> None:
+    single_point = orientation_stub()
+    single_point.boundary_points = lambda: np.array([[0.1, 0.0, 0.0, 0.0, 0.1, 0.0]])
+    path = record_results(
+        tmp_path / "stubs.mcap",
+        [projected_stub("exact"), projected_stub(), orientation_stub(), single_point],
+    )
+    code, out, err = replay(path, plot_dir=tmp_path / "plots")
+    assert code == 0, err
+    plots = sorted(p.name for p in (tmp_path / "plots").glob("*.png"))
+    assert plots == [
+        "workspace_001_projected.png",
+        "workspace_003_orientation.png",
+        "workspace_004_orientation.png",
+    ]
+    assert out.count("plot: ") == 3
+
+
 # --------------------------------------------------------------------------- bad logs
 
 
@@ -227,6 +246,40 @@ def test_bag_directory_and_bad_rate(tmp_path: Path) -> None:
     code, out, _ = replay(bag)
     assert code == 0 and "orientation: psi -5.730..5.730 deg" in out
     assert replay(bag, rate=-1.0)[0] == 2
+
+
+def test_rejected_requests_with_nan_replay_as_json(tmp_path: Path) -> None:
+    """A node records bad requests too (NaN position): JSON output stays valid (null)."""
+    path = tmp_path / "bad.mcap"
+    nan = float("nan")
+    with recording.LogWriter(path) as writer:
+        writer.write_fields(
+            "/n/check_poses/request",
+            messages.TYPES["check_poses"] + "_Request",
+            messages.check_poses_request_fields([nan, 0, 1], [[0, 0, 0]]),
+            1,
+        )
+        writer.write_fields(
+            "/n/check_poses/response",
+            messages.TYPES["check_poses"] + "_Response",
+            messages.check_poses_response_fields(None, message="NaN"),
+            2,
+        )
+        writer.write_fields(
+            "/n/workspace_summary",
+            messages.TYPES["summary"],
+            messages.summary_fields(
+                None, stamp_ns=3, frame_id="base", kind=0, position=[nan, nan, nan], message="NaN"
+            ),
+            3,
+        )
+    code, out, err = replay(path, as_json=True)
+    assert code == 0, err
+    report = json.loads(out)
+    assert report["pose_checks"][0]["position"] == [None, 0.0, 1.0]
+    assert report["workspaces"][0]["position"] == [None, None, None]
+    code, text, _ = replay(path)
+    assert code == 0 and "failed: NaN" in text
 
 
 def test_empty_finished_log_is_fine(tmp_path: Path) -> None:
