@@ -20,8 +20,10 @@ Topics
     orientation: x, y, z = θ cos φ, θ sin φ, ψ; projected: the unit approach vector),
     ``~/workspace_summary`` (WorkspaceSummary) and ``~/reachability`` (ReachabilityResult).
 
-Workspace computations run in their own mutually exclusive callback group, pose checks in a
-reentrant one, under a multi-threaded executor: a long 3-D computation does not delay checks.
+Workspace requests are served in their own mutually exclusive callback group, pose checks in a
+reentrant one, under a multi-threaded executor; the computation itself runs in a worker process
+(:mod:`hexapod_workspace.ros.worker`), so a long 3-D computation neither blocks nor slows the
+pose checks (it does not hold this interpreter's lock).
 Every request and result is recorded to one MCAP log per run (rosbag2 form), see
 :mod:`hexapod_workspace.recording`; a failure to write turns recording off, the node keeps
 serving. Units: SI (m, rad), positions in the base frame ``frame_id``.
@@ -29,11 +31,13 @@ serving. Units: SI (m, rad), positions in the base frame ``frame_id``.
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import math
 import os
 import sys
 import threading
+import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -84,6 +88,7 @@ from hexapod_workspace.recording import (
 )
 
 from .conversions import angles_from_orientations, position_from_point, to_message
+from .worker import WorkspaceJob, WorkspaceWorker
 
 __all__ = ["NODE_NAME", "WorkspaceNode", "main"]
 
@@ -96,6 +101,9 @@ PROJECTED_METHODS = ("torsion_zero", "exact")
 #: GIL switch interval of the node process, s: a pose check waits at most this long for the
 #: interpreter while a workspace computation runs in another thread (Python's default is 5 ms).
 SWITCH_INTERVAL = 2e-4
+#: Seconds between two writes of the queued messages to the MCAP log (a message reaches the file
+#: within about this plus the writer's flush interval).
+RECORD_PERIOD = 0.2
 
 _MODEL_DESCRIPTIONS = {
     "frame_id": "Base frame: frame_id of every published cloud and result header.",
@@ -310,13 +318,21 @@ def _state_from(values: dict[str, Any], model_names: list[str]) -> _State:
 
 
 class _Recorder:
-    """The node's MCAP log: thread-safe, turns itself off on the first write failure."""
+    """The node's MCAP log: thread-safe, turns itself off on the first write failure.
+
+    A callback only serialises the message and appends it to a queue (microseconds); a thread
+    of the recorder writes the queue to the log every :data:`RECORD_PERIOD` seconds, so that no
+    request waits for the log writer (nor shares the interpreter with it while it is answered).
+    """
 
     def __init__(self, node: Node) -> None:
         self._logger = node.get_logger()
         self._lock = threading.Lock()
         self._writer: LogWriter | None = None
         self._channels: dict[str, tuple[str, str]] = {}
+        self._queue: collections.deque[tuple[str, bytes, int]] = collections.deque()
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
 
     @property
     def path(self) -> Path | None:
@@ -333,42 +349,71 @@ class _Recorder:
             if self._writer is not None:
                 return
             try:
-                writer = LogWriter(run_log_path(directory), on_error=self._failed, background=True)
+                writer = LogWriter(run_log_path(directory), on_error=self._failed)
                 for topic, (msgtype, qos) in self._channels.items():
                     writer.add_channel(topic, msgtype, qos)
             except (RecordingError, OSError) as error:
                 self._logger.error(f"recording off: {error}")
                 return
             self._writer = writer
+            if self._thread is None:
+                self._thread = threading.Thread(
+                    target=self._run, name="hexapod_workspace_recorder", daemon=True
+                )
+                self._thread.start()
         self._logger.info(f"recording to {writer.path}")
 
     def write(self, topic: str, message: Any) -> None:
-        """Record one rclpy message (serialized to CDR) on ``topic`` when recording."""
+        """Queue one rclpy message (serialised to CDR now) for ``topic`` when recording."""
+        if self._writer is not None:
+            self._queue.append((topic, serialize_message(message), time.time_ns()))
+
+    def _run(self) -> None:
+        while not self._stop.wait(RECORD_PERIOD):
+            with self._lock:
+                self._drain_locked()
+
+    def _drain_locked(self) -> None:
+        """Write the queued messages (under ``self._lock``)."""
         writer = self._writer
-        if writer is None:
-            return
-        try:
-            writer.write(topic, serialize_message(message))
-        except (RecordingError, OSError) as error:
-            self._failed(error)
+        while self._queue:
+            topic, data, stamp_ns = self._queue.popleft()
+            if writer is None:
+                continue
+            try:
+                writer.write(topic, data, log_time_ns=stamp_ns)
+            except (RecordingError, OSError) as error:
+                self._logger.error(f"recording off after a write failure: {error}")
+                self._writer = None
+                with contextlib.suppress(RecordingError, OSError):
+                    writer.close()
+                writer = None
 
     def _failed(self, error: Exception) -> None:
-        with self._lock:
-            writer, self._writer = self._writer, None
+        """A background flush of the writer failed: recording off."""
+        writer, self._writer = self._writer, None
         if writer is not None:
             self._logger.error(f"recording off after a write failure: {error}")
             with contextlib.suppress(RecordingError, OSError):
                 writer.close()
 
     def close(self) -> None:
-        """Finish the log (idempotent)."""
+        """Write what is queued and finish the log (idempotent); recording can reopen."""
         with self._lock:
+            self._drain_locked()
             writer, self._writer = self._writer, None
-        if writer is not None:
-            try:
-                writer.close()
-            except (RecordingError, OSError) as error:
-                self._logger.error(f"could not finish the log {writer.path}: {error}")
+            if writer is not None:
+                try:
+                    writer.close()
+                except (RecordingError, OSError) as error:
+                    self._logger.error(f"could not finish the log {writer.path}: {error}")
+
+    def shutdown(self) -> None:
+        """:meth:`close` and stop the recorder thread."""
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=10.0)
+        self.close()
 
 
 def _type_name(message_class: type) -> str:
@@ -400,6 +445,8 @@ class WorkspaceNode(Node):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(NODE_NAME, **kwargs)
         self._recorder = _Recorder(self)
+        self._worker = WorkspaceWorker()
+        self._service_topics: dict[Any, tuple[str, str]] = {}
         specs = _parameter_specs()
         self._parameter_names = [spec.name for spec in specs]
         self._model_names = [s.name for s in specs if s.name in _MODEL_DESCRIPTIONS]
@@ -449,6 +496,7 @@ class WorkspaceNode(Node):
         )
         if self._state.settings.recording_enabled:
             self._recorder.open(self._state.settings.recording_directory)
+        self._worker.start()
         self.get_logger().info(
             f"ready: {self.get_fully_qualified_name()} serving check_poses, compute_workspace, "
             f"compute_orientation_workspace, compute_projected_workspace"
@@ -463,7 +511,9 @@ class WorkspaceNode(Node):
 
     def _service(self, service_class: type, name: str, callback: Any, group: Any) -> Any:
         service = self.create_service(service_class, name, callback, callback_group=group)
-        request_topic, response_topic = service_topics(service.srv_name)
+        # recorded as <resolved service name>/request and /response
+        request_topic, response_topic = service_topics(self.resolve_service_name(name))
+        self._service_topics[service] = (request_topic, response_topic)
         self._recorder.add_channel(request_topic, _type_name(service_class.Request), SERVICE_QOS)
         self._recorder.add_channel(response_topic, _type_name(service_class.Response), SERVICE_QOS)
         return service
@@ -556,7 +606,7 @@ class WorkspaceNode(Node):
     def _on_check_poses(
         self, request: CheckPoses.Request, response: CheckPoses.Response
     ) -> CheckPoses.Response:
-        request_topic, response_topic = service_topics(self._check_service.srv_name)
+        request_topic, response_topic = self._service_topics[self._check_service]
         self._recorder.write(request_topic, request)
         try:
             response = to_message(CheckPoses.Response, self._check_response(self._state, request))
@@ -631,48 +681,27 @@ class WorkspaceNode(Node):
         if not RAYS_RANGE[0] <= rays <= RAYS_RANGE[1]:
             reason = f"n_rays: expected {RAYS_RANGE[0]}..{RAYS_RANGE[1]}, got {rays}"
             return self._publish_failure(reason, failure, n_rays=rays)
+        job = WorkspaceJob(
+            manipulator=state.manipulator,
+            kind=kind,
+            position=position,
+            n_rays=rays,
+            psi_step=psi_step,
+            tolerance=tolerance,
+            stamp_ns=stamp_ns,
+            frame_id=frame_id,
+            request_id=request_id,
+        )
         try:
-            if kind == messages.ORIENTATION:
-                from hexapod_workspace.orientation import orientation_workspace
-
-                workspace = orientation_workspace(
-                    state.manipulator,
-                    position,
-                    n_rays=rays,
-                    psi_step=psi_step,
-                    tolerance=tolerance,
-                )
-            else:
-                from hexapod_workspace.projected import projected_workspace
-
-                workspace = projected_workspace(
-                    state.manipulator,
-                    position,
-                    method=messages.KIND_NAMES[kind],
-                    n_phi=rays,
-                    tolerance=tolerance,
-                )
+            summary_fields, cloud_fields = self._worker.compute(job)
         except UnreachableReferenceError as error:
             return self._publish_failure(
                 str(error), failure, n_rays=rays, tolerance=tolerance, empty_cloud=True
             )
         except InputError as error:
             return self._publish_failure(str(error), failure, n_rays=rays, tolerance=tolerance)
-        points = messages.boundary_points(workspace)
-        cloud = to_message(
-            PointCloud2, messages.pointcloud_fields(points, frame_id=frame_id, stamp_ns=stamp_ns)
-        )
-        summary = to_message(
-            WorkspaceSummary,
-            messages.summary_fields(
-                workspace,
-                stamp_ns=stamp_ns,
-                frame_id=frame_id,
-                request_id=request_id,
-                kind=kind,
-                n_points=points.shape[0],
-            ),
-        )
+        cloud = to_message(PointCloud2, cloud_fields)
+        summary = to_message(WorkspaceSummary, summary_fields)
         self._publish(self._cloud_publishers[kind], cloud)
         self._publish(self._summary_publisher, summary)
         self.get_logger().info(summary.message)
@@ -730,7 +759,7 @@ class WorkspaceNode(Node):
     def _on_compute_workspace(
         self, request: ComputeWorkspace.Request, response: ComputeWorkspace.Response
     ) -> ComputeWorkspace.Response:
-        request_topic, response_topic = service_topics(self._compute_service.srv_name)
+        request_topic, response_topic = self._service_topics[self._compute_service]
         self._recorder.write(request_topic, request)
         summary, cloud = self._workspace_from_request(request.request)
         response = ComputeWorkspace.Response(
@@ -756,7 +785,7 @@ class WorkspaceNode(Node):
         )
 
     def _on_trigger(self, service: Any, kind: int, response: Trigger.Response) -> Any:
-        request_topic, response_topic = service_topics(service.srv_name)
+        request_topic, response_topic = self._service_topics[service]
         self._recorder.write(request_topic, Trigger.Request())
         summary, _ = self._compute_guarded(kind, np.array(self._state.manipulator.position))
         response = Trigger.Response(success=summary.success, message=summary.message)
@@ -781,8 +810,9 @@ class WorkspaceNode(Node):
         return f"internal error: {type(error).__name__}: {error}"
 
     def destroy_node(self) -> None:
-        """Finish the MCAP log, then destroy the node."""
-        self._recorder.close()
+        """Stop the workspace worker, finish the MCAP log, then destroy the node."""
+        self._worker.close()
+        self._recorder.shutdown()
         super().destroy_node()
 
 

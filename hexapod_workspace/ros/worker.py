@@ -1,0 +1,202 @@
+"""Workspace computations in a worker process of the node (ROS-free: numpy and the core only).
+
+A 3-D orientation workspace takes seconds of mostly-Python work. Run in a thread of the node, it
+would share the interpreter lock with the pose checks and delay them; run here, in a spawned
+process, it leaves the node's interpreter to the checks. The node sends one
+:class:`WorkspaceJob` at a time and gets back the ROS-free field dicts of the summary and of the
+boundary cloud (:mod:`hexapod_workspace.messages`), ready to become rclpy messages.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import signal
+import threading
+from dataclasses import dataclass
+from multiprocessing.connection import Connection
+from typing import Any
+
+import numpy as np
+
+from hexapod_workspace import messages
+from hexapod_workspace.errors import HexapodWorkspaceError
+from hexapod_workspace.manipulator import Manipulator
+
+__all__ = ["WorkerError", "WorkspaceJob", "WorkspaceWorker", "compute_fields"]
+
+
+class WorkerError(RuntimeError):
+    """The worker process died or could not be reached (the node restarts it on next use)."""
+
+
+@dataclass(frozen=True)
+class WorkspaceJob:
+    """One workspace computation.
+
+    Attributes
+    ----------
+    manipulator : Manipulator
+    kind : int
+        :data:`messages.ORIENTATION`, :data:`messages.PROJECTED_TORSION_ZERO` or
+        :data:`messages.PROJECTED_EXACT`.
+    position : ndarray, shape (3,)
+        Tool-tip position OC, base frame, m.
+    n_rays : int
+        Rays per ψ slice (orientation) or number of φ samples (projected).
+    psi_step, tolerance : float
+        Slice step and boundary tolerance, rad.
+    stamp_ns : int
+        Stamp of the summary and of the cloud, ns since the epoch.
+    frame_id, request_id : str
+        Header frame and the request's id, copied into the results.
+    """
+
+    manipulator: Manipulator
+    kind: int
+    position: np.ndarray
+    n_rays: int
+    psi_step: float
+    tolerance: float
+    stamp_ns: int
+    frame_id: str
+    request_id: str = ""
+
+
+def compute_fields(job: WorkspaceJob) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Compute a workspace and return its WorkspaceSummary and PointCloud2 field dicts.
+
+    Raises
+    ------
+    HexapodWorkspaceError
+        ``InputError``/``ResolutionError`` for a bad request, ``UnreachableReferenceError``
+        when the reference orientation is unreachable at the position.
+    """
+    if job.kind == messages.ORIENTATION:
+        from hexapod_workspace.orientation import orientation_workspace
+
+        workspace = orientation_workspace(
+            job.manipulator,
+            job.position,
+            n_rays=job.n_rays,
+            psi_step=job.psi_step,
+            tolerance=job.tolerance,
+        )
+    else:
+        from hexapod_workspace.projected import projected_workspace
+
+        workspace = projected_workspace(
+            job.manipulator,
+            job.position,
+            method=messages.KIND_NAMES[job.kind],
+            n_phi=job.n_rays,
+            tolerance=job.tolerance,
+        )
+    points = messages.boundary_points(workspace)
+    summary = messages.summary_fields(
+        workspace,
+        stamp_ns=job.stamp_ns,
+        frame_id=job.frame_id,
+        request_id=job.request_id,
+        kind=job.kind,
+        n_points=points.shape[0],
+    )
+    cloud = messages.pointcloud_fields(points, frame_id=job.frame_id, stamp_ns=job.stamp_ns)
+    return summary, cloud
+
+
+def _serve(connection: Connection) -> None:
+    """Worker process main loop: one job in, ``("ok", result)`` or ``("error", exc)`` out."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the node decides when the worker stops
+    while True:
+        try:
+            job = connection.recv()
+        except (EOFError, OSError):
+            return
+        try:
+            reply: tuple[str, Any] = ("ok", compute_fields(job))
+        except HexapodWorkspaceError as error:
+            reply = ("error", error)
+        except Exception as error:  # a bug: report it, keep serving
+            reply = ("error", WorkerError(f"{type(error).__name__}: {error}"))
+        connection.send(reply)
+
+
+class WorkspaceWorker:
+    """A spawned worker process that computes one :class:`WorkspaceJob` at a time.
+
+    Thread-safe (calls are serialised). The process is started on first use (or by
+    :meth:`start`) and restarted after it dies; :meth:`close` terminates it.
+    """
+
+    def __init__(self) -> None:
+        self._context = multiprocessing.get_context("spawn")
+        self._lock = threading.Lock()
+        self._process: Any = None
+        self._connection: Connection | None = None
+
+    def start(self) -> None:
+        """Start the worker process now (it then imports the core while the node starts)."""
+        with self._lock:
+            self._ensure_started()
+
+    def _ensure_started(self) -> Connection:
+        if self._process is None or not self._process.is_alive() or self._connection is None:
+            self._stop_locked()
+            parent, child = self._context.Pipe()
+            process = self._context.Process(
+                target=_serve, args=(child,), name="hexapod_workspace_worker", daemon=True
+            )
+            process.start()
+            child.close()
+            self._process, self._connection = process, parent
+        return self._connection
+
+    def compute(self, job: WorkspaceJob) -> tuple[dict[str, Any], dict[str, Any]]:
+        """Run ``job`` in the worker; block until done.
+
+        Returns
+        -------
+        (dict, dict)
+            WorkspaceSummary and PointCloud2 field dicts.
+
+        Raises
+        ------
+        HexapodWorkspaceError
+            As :func:`compute_fields`.
+        WorkerError
+            The worker died (it is restarted on the next call) or failed unexpectedly.
+        """
+        with self._lock:
+            connection = self._ensure_started()
+            try:
+                connection.send(job)
+                status, payload = connection.recv()
+            except (EOFError, OSError) as error:
+                self._stop_locked()
+                msg = "the workspace worker process died; it restarts on the next request"
+                raise WorkerError(msg) from error
+        if status == "error":
+            raise payload
+        return payload
+
+    def _stop_locked(self) -> None:
+        process, connection = self._process, self._connection
+        self._process, self._connection = None, None
+        if connection is not None:
+            connection.close()
+        if process is not None:
+            if process.is_alive():
+                process.terminate()
+            process.join(timeout=5.0)
+            if process.is_alive():
+                process.kill()
+                process.join(timeout=5.0)
+
+    def close(self) -> None:
+        """Terminate the worker process (idempotent). A running computation is abandoned."""
+        # not under the lock: a computation in progress holds it; terminate wakes its recv()
+        process = self._process
+        if process is not None and process.is_alive():
+            process.terminate()
+        with self._lock:
+            self._stop_locked()
