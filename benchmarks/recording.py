@@ -37,6 +37,13 @@ def timed(function: Callable[[int], object], repeat: int) -> float:
     return statistics.median(times)
 
 
+def drain_ms(writer: recording.LogWriter) -> float:
+    """How long a background writer still needs to get what was queued onto the disk, ms."""
+    start = time.perf_counter()
+    writer.flush()
+    return (time.perf_counter() - start) * 1e3
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--points", type=int, default=1_000_000)
@@ -195,9 +202,7 @@ def service_impact(repeat: int, workdir: Path) -> None:
         without = timed(lambda _, make=produce: serve(None, make), repeat)
         with recording.LogWriter(workdir / "node_run.mcap", background=True) as writer:
             with_recording = timed(lambda _, make=produce: serve(writer, make), repeat)
-            start = time.perf_counter()
-            writer.flush()
-            drain = (time.perf_counter() - start) * 1e3
+            drain = drain_ms(writer)
         print(
             f"service ({label}): {without:7.1f} ms without recording, {with_recording:7.1f} ms"
             f" with: ratio {with_recording / without:.3f} (writer thread then needed "
@@ -237,9 +242,7 @@ def node_path(points: np.ndarray, repeat: int, workdir: Path) -> None:
             ),
             repeat,
         )
-        start = time.perf_counter()
-        writer.flush()
-        drain = (time.perf_counter() - start) * 1e3
+        drain = drain_ms(writer)
     print(
         f"node path (rclpy, 10^6 points): serialize_message {serialize_ms:.1f} ms; serialize + "
         f"queue (what the callback waits for) {record_ms:.1f} ms; the writer thread then "
