@@ -52,7 +52,8 @@ def main() -> None:
     args = parser.parse_args()
     rng = np.random.default_rng(20261121)
     points = rng.normal(size=(args.points, 6))
-    workdir = Path(tempfile.mkdtemp(prefix="bench-rec-", dir=args.dir))
+    scratch = tempfile.TemporaryDirectory(prefix="bench-rec-", dir=args.dir)  # removed at exit
+    workdir = Path(scratch.name)
     stamp = time.time_ns()
 
     def ours(index: int) -> None:
@@ -127,6 +128,7 @@ def main() -> None:
 
     service_impact(args.repeat, workdir)
     node_path(points, args.repeat, workdir)
+    scratch.cleanup()
 
 
 def service_impact(repeat: int, workdir: Path) -> None:
