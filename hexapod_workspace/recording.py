@@ -20,7 +20,7 @@ when ``flush_messages`` messages are pending, when the oldest pending message is
 or on :meth:`LogWriter.flush`/:meth:`LogWriter.close`. Everything flushed survives a SIGKILL of
 the writing process (it is in the operating system's hands; ``fsync`` is not called, so a power
 cut may lose more). An interrupted file has no summary; :func:`read_log` reads it as far as it
-is intact, and ``mcap recover`` makes it a finished file again.
+is intact, and :func:`recover_log` (or ``mcap recover``) makes it a finished file again.
 
 The type store (:func:`get_typestore`) is rosbags' Jazzy store plus the package's own
 interfaces (``hexapod_workspace_msgs``, parsed from the shipped ``.msg``/``.srv`` files) plus
@@ -89,6 +89,7 @@ __all__ = [
     "message_to_fields",
     "qos_profile_text",
     "read_log",
+    "recover_log",
     "run_log_path",
     "serialize",
     "service_topics",
@@ -1075,4 +1076,42 @@ def read_log(path: str | Path, *, decode: bool = True) -> LogContents:
     """Read a whole log into memory (:attr:`LogContents.messages`); see :func:`iter_log`."""
     contents = LogContents(Path(path))
     contents.messages = list(iter_log(path, contents, decode=decode))
+    return contents
+
+
+def recover_log(source: str | Path, target: str | Path) -> LogContents:
+    """Rewrite what is intact in a damaged or unfinished log as a finished one.
+
+    A log cut short (SIGKILL, power loss, full disk) has no summary, so tools that need one
+    (``ros2 bag play``, rosbags' readers) refuse it; :func:`read_log` and ``mcap_ros2``'s
+    streaming reader read it as far as it is intact. This copies every readable message of a
+    known type, unchanged (same bytes, times, topics, QoS metadata), into ``target`` and finishes
+    it. Like ``mcap recover``, but in the rosbag2 form of :class:`LogWriter`.
+
+    Parameters
+    ----------
+    source : str or Path
+        The damaged log (bare ``.mcap`` or bag directory).
+    target : str or Path
+        The ``.mcap`` file to write (replaced if it exists).
+
+    Returns
+    -------
+    LogContents
+        What was read from ``source`` (topics, counts, problems).
+
+    Raises
+    ------
+    LogReadError
+        ``source`` cannot be read at all.
+    RecordingError
+        ``target`` cannot be written.
+    """
+    contents = LogContents(Path(source))
+    with LogWriter(target, flush_interval=0) as writer:
+        for item in iter_log(source, contents):
+            writer.add_channel(item.topic, item.msgtype, contents.topics[item.topic].qos)
+            writer.write(
+                item.topic, item.data, item.log_time_ns, publish_time_ns=item.publish_time_ns
+            )
     return contents

@@ -344,6 +344,13 @@ def test_sigkill_keeps_every_flushed_message(tmp_path: Path) -> None:
     assert [m.request_id for _, _, m in by_mcap_ros2] == [f"r{i}" for i in range(10)]
     store_decoded = [recording.deserialize(m.msgtype, m.data) for m in contents.messages]
     assert [plain(m) for m in store_decoded] == [plain(m.message) for m in contents.messages]
+    recovered = recording.recover_log(path, tmp_path / "recovered.mcap")
+    assert recovered.problems == contents.problems
+    by_rosbags = read_with_rosbags(tmp_path / "recovered.mcap")  # needs a finished file
+    assert [plain(m) for _, _, m in by_rosbags] == [plain(m.message) for m in contents.messages]
+    again = recording.read_log(tmp_path / "recovered.mcap")
+    assert again.finished and not again.problems
+    assert [m.log_time_ns for m in again.messages] == [m.log_time_ns for m in contents.messages]
 
 
 def test_sigkill_after_the_flush_interval_keeps_messages(tmp_path: Path) -> None:
