@@ -55,13 +55,17 @@ def require_ros() -> None:
     pytest.skip(f"ROS tests skipped: {problem}", allow_module_level=True)
 
 
+_next_domain = [os.getpid() % 100]
+
+
 def domain_selector() -> Callable[[], int]:
-    """Domain ids 1..100 starting from a pid-derived one (domain_coordinator tries up to 100)."""
-    state = {"next": os.getpid() % 100}
+    """Domain ids 1..100, starting from a pid-derived one and never reused by this process
+    (domain_coordinator tries up to 100): a module's stale DDS participants cannot meet the
+    next module's."""
 
     def select() -> int:
-        value = state["next"] % 100 + 1
-        state["next"] += 1
+        value = _next_domain[0] % 100 + 1
+        _next_domain[0] += 1
         return value
 
     return select
@@ -110,8 +114,13 @@ class NodeProcess:
             try:
                 self.process.wait(timeout=timeout)
             except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait(timeout=timeout)
+                # SIGABRT: faulthandler (PYTHONFAULTHANDLER=1) dumps every thread's stack
+                self.process.send_signal(signal.SIGABRT)
+                with contextlib.suppress(subprocess.TimeoutExpired):
+                    self.process.wait(timeout=timeout)
+                if self.process.poll() is None:
+                    self.process.kill()
+                    self.process.wait(timeout=timeout)
                 self.stopped = True
                 msg = f"node did not stop within {timeout} s of signal {sig}:\n{self.output()}"
                 raise AssertionError(msg) from None
@@ -124,6 +133,7 @@ def node_environment() -> dict[str, str]:
     env = dict(os.environ)
     env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     env["PYTHONUNBUFFERED"] = "1"
+    env["PYTHONFAULTHANDLER"] = "1"
     env["RCUTILS_LOGGING_BUFFERED_STREAM"] = "0"
     return env
 
@@ -155,9 +165,13 @@ def running_node(
     try:
         yield node
     finally:
-        if process.poll() is None:
-            process.kill()
-            process.wait(timeout=STOP_TIMEOUT)
+        if process.poll() is None:  # a clean stop leaves no stale DDS participant behind
+            process.send_signal(signal.SIGINT)
+            try:
+                process.wait(timeout=STOP_TIMEOUT)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait(timeout=STOP_TIMEOUT)
 
 
 class RosClient:
