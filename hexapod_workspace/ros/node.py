@@ -809,6 +809,10 @@ class WorkspaceNode(Node):
         self.get_logger().error(f"internal error: {error!r}")
         return f"internal error: {type(error).__name__}: {error}"
 
+    def stop_worker(self) -> None:
+        """Terminate the workspace worker process (a running computation fails at once)."""
+        self._worker.close()
+
     def destroy_node(self) -> None:
         """Stop the workspace worker, finish the MCAP log, then destroy the node."""
         self._worker.close()
@@ -827,6 +831,7 @@ def main(args: list[str] | None = None) -> int:
     sys.setswitchinterval(SWITCH_INTERVAL)
     rclpy.init(args=args)
     node = None
+    executor = None
     status = 0
     try:
         node = WorkspaceNode()
@@ -838,7 +843,16 @@ def main(args: list[str] | None = None) -> int:
     except (ConfigError, ParameterException) as error:
         get_logger(NODE_NAME).fatal(f"invalid parameters: {error}")
         status = 1
+    except Exception:
+        # A signal shuts the context down from under the executor; rclpy then sometimes raises
+        # RCLError ("context is not valid") instead of ExternalShutdownException.
+        if rclpy.ok():
+            raise
     finally:
+        if node is not None:
+            node.stop_worker()  # ends a running computation, which frees its executor thread
+        if executor is not None:
+            executor.shutdown(timeout_sec=10.0)  # joins the executor's threads
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
