@@ -60,7 +60,7 @@ setup(
     entry_points={
         "console_scripts": [
             "hexapod-workspace = hexapod_workspace.cli:main",
-            "workspace_node = hexapod_workspace.ros.node:main",
+            "workspace_node = hexapod_workspace.ros:main",
         ],
     },
 )
