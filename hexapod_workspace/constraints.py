@@ -157,6 +157,12 @@ def segment_distance(
     return np.sqrt(_segment_distance_squared(a, b, c, e, f, rr)).reshape(np.shape(a))
 
 
+def _unit_interval(values: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Clamp to [0, 1] in place (NaN stays NaN); returns ``values``."""
+    np.maximum(values, 0.0, out=values)
+    return np.minimum(values, 1.0, out=values)
+
+
 def _segment_distance_squared(
     a: NDArray[np.float64],
     b: NDArray[np.float64],
@@ -175,12 +181,14 @@ def _segment_distance_squared(
     segments take a guarded path (only for the entries that need it). The squared distance is
     expanded as ``rr + s²a + t²e + 2sc − 2tf − 2stb``, so no 3-vector is formed.
     """
-    a, b, c, e, f, rr = (np.atleast_1d(v) for v in np.broadcast_arrays(a, b, c, e, f, rr))
+    if not a.shape == b.shape == c.shape == e.shape == f.shape == rr.shape or a.ndim == 0:
+        a, b, c, e, f, rr = (np.atleast_1d(v) for v in np.broadcast_arrays(a, b, c, e, f, rr))
+    # np.clip's Python wrapper costs more than the arithmetic at the sizes used here.
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         denom = a * e - b * b
-        s = np.clip((b * f - c * e) / denom, 0.0, 1.0)
-        t = np.clip((b * s + f) / e, 0.0, 1.0)
-        s = np.clip((b * t - c) / a, 0.0, 1.0)
+        s = _unit_interval((b * f - c * e) / denom)
+        t = _unit_interval((b * s + f) / e)
+        s = _unit_interval((b * t - c) / a)
     special = ~(denom > 1e-14 * a * e)  # parallel, point-like, or NaN from 0/0
     if np.any(special):
         s[special], t[special] = _degenerate_parameters(
@@ -378,9 +386,10 @@ class _ChunkModel:
         """
         if np.all(limit == limit[0]):
             leg = cosine.argmin(axis=1)
-            margin_out[:] = limit[0] - np.arccos(np.clip(cosine[rows, leg], -1.0, 1.0))
+            smallest = np.minimum(np.maximum(cosine[rows, leg], -1.0), 1.0)
+            margin_out[:] = limit[0] - np.arccos(smallest)
         else:
-            per_leg = limit - np.arccos(np.clip(cosine, -1.0, 1.0))
+            per_leg = limit - np.arccos(np.minimum(np.maximum(cosine, -1.0), 1.0))
             leg = per_leg.argmin(axis=1)
             margin_out[:] = per_leg[rows, leg]
         leg_out[:] = leg

@@ -164,8 +164,8 @@ def _solid_angle(theta: NDArray[np.float64]) -> float:
 def require_reachable_reference(search: RaySearch) -> None:
     """Raise :class:`UnreachableReferenceError` unless (0, 0, 0) is reachable at the position."""
     margins = search.margins(np.zeros((1, 3)))
-    if np.any(margins < 0.0):
-        names = [CONSTRAINT_NAMES[k] for k in np.flatnonzero(margins[:, 0] < 0.0)]
+    if not np.all(margins >= 0.0):  # NaN (a degenerate leg) counts as violated
+        names = [CONSTRAINT_NAMES[k] for k in np.flatnonzero(~(margins[:, 0] >= 0.0))]
         x, y, z = search.position
         msg = (
             f"the reference orientation (phi, theta, psi) = (0, 0, 0) is unreachable at position "

@@ -125,17 +125,13 @@ class RaySearch:
         length_now = self.length_min + np.maximum(margins[0], 0.0)
         floor = np.maximum(self.length_min, 0.5 * length_now)
         rho = self.rho
-        with np.errstate(divide="ignore", invalid="ignore"):
-            steps = np.stack(
-                [
-                    margins[0] / rho,
-                    margins[1] * floor / rho,
-                    margins[2] / (1.0 + rho / floor),
-                    margins[3] / (2.0 * rho),
-                    0.5 * length_now / rho,
-                ]
-            )
-        return np.nan_to_num(steps.min(axis=0), nan=0.0, posinf=MAX_STEP) * SAFETY
+        # fmin ignores NaN; +inf (interference disabled) never limits.
+        step = np.fmin(margins[0] / rho, margins[1] * floor / rho)
+        np.fmin(step, margins[2] / (1.0 + rho / floor), out=step)
+        np.fmin(step, margins[3] / (2.0 * rho), out=step)
+        np.fmin(step, 0.5 * length_now / rho, out=step)
+        np.fmin(step, MAX_STEP, out=step)
+        return np.fmax(step, 0.0, out=step) * SAFETY
 
     def recovery_step(
         self, angles: NDArray[np.float64], margins: NDArray[np.float64]
@@ -216,7 +212,7 @@ class RaySearch:
         bracket: list[NDArray[np.int64]] = []
         while active.size:
             margins = self.margins(angles_at(active, s[active]))
-            bad = np.any(margins < 0.0, axis=0)
+            bad = ~np.all(margins >= 0.0, axis=0)
             estimate = self.distance_estimate(margins)
             if np.any(bad):
                 rays = active[bad]
@@ -229,7 +225,7 @@ class RaySearch:
             first[active] = False
             feasible[good] = s[good]
             feasible_value[good] = estimate[~bad]
-            step = np.clip(self.certified_step(margins[:, ~bad]), self.min_step, MAX_STEP)
+            step = np.maximum(self.certified_step(margins[:, ~bad]), self.min_step)
             done = s[good] >= s_end[good]
             s[good] = np.minimum(s[good] + step, s_end[good])
             active = good[~done]
@@ -254,7 +250,7 @@ class RaySearch:
             rays_twice = np.concatenate([rays[open_], rays[open_]])
             margins = self.margins(angles_at(rays_twice, probes))
             values = self.distance_estimate(margins)
-            bad = np.any(margins < 0.0, axis=0)
+            bad = ~np.all(margins >= 0.0, axis=0)
             count = open_.size
             minus_bad, plus_bad = bad[:count], bad[count:]
             minus, plus = guess - half, guess + half
