@@ -33,6 +33,7 @@ EXAMPLE_PARAMS = REPO / "config" / "example_gpm.yaml"
 #: Generous: discovery on a loaded 2-core CI machine can take seconds.
 DISCOVERY_TIMEOUT = 60.0
 CALL_TIMEOUT = 120.0
+RESEND_AFTER = 20.0
 STOP_TIMEOUT = 30.0
 
 
@@ -165,6 +166,8 @@ def running_node(
     try:
         yield node
     finally:
+        # shown by pytest when the test fails
+        print(f"---- workspace_node output ({log_path}):\n{node.output()}")
         if process.poll() is None:  # a clean stop leaves no stale DDS participant behind
             process.send_signal(signal.SIGINT)
             try:
@@ -204,15 +207,32 @@ class RosClient:
             self.node.destroy_client(client)
 
     def call(
-        self, service_type: type, name: str, request: Any, timeout: float = CALL_TIMEOUT
+        self,
+        service_type: type,
+        name: str,
+        request: Any,
+        timeout: float = CALL_TIMEOUT,
+        resend_after: float = RESEND_AFTER,
     ) -> Any:
-        """Call a service and wait for the response (spinning this client)."""
-        future = self.client(service_type, name).call_async(request)
-        self.executor.spin_until_future_complete(future, timeout_sec=timeout)
-        if not future.done():
-            msg = f"no response from {name} within {timeout} s"
-            raise AssertionError(msg)
-        return future.result()
+        """Call a service and wait for the response (spinning this client).
+
+        The request is sent again every ``resend_after`` s without an answer (every service of
+        the node is idempotent): a response can be lost while the server has not yet discovered
+        this client's response reader, a known DDS race right after discovery.
+        """
+        client = self.client(service_type, name)
+        deadline = time.monotonic() + timeout
+        while True:
+            future = client.call_async(request)
+            wait = max(0.0, min(resend_after, deadline - time.monotonic()))
+            self.executor.spin_until_future_complete(future, timeout_sec=wait)
+            if future.done():
+                return future.result()
+            client.remove_pending_request(future)
+            if time.monotonic() >= deadline:
+                msg = f"no response from {name} within {timeout} s"
+                raise AssertionError(msg)
+            print(f"no response from {name} within {resend_after} s: request sent again")
 
     def collect(self, message_type: type, topic: str, *, transient_local: bool = False) -> list:
         """Subscribe to ``topic``; received messages are appended to the returned list."""

@@ -42,7 +42,6 @@ def workspace_node(ros_domain, tmp_path_factory):
     directory = tmp_path_factory.mktemp("workspace_node")
     with running_node(directory, NODE_PARAMS) as node:
         yield node
-        print(f"---- node output ({node.log_path})\n{node.output()}")
 
 
 @pytest.fixture(scope="module")
