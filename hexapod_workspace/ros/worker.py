@@ -23,6 +23,8 @@ import numpy as np
 from hexapod_workspace import messages
 from hexapod_workspace.errors import HexapodWorkspaceError
 from hexapod_workspace.manipulator import Manipulator
+from hexapod_workspace.orientation import orientation_workspace
+from hexapod_workspace.projected import projected_workspace
 
 __all__ = ["WORKER_NICENESS", "WorkerError", "WorkspaceJob", "WorkspaceWorker", "compute_fields"]
 
@@ -78,8 +80,6 @@ def compute_fields(job: WorkspaceJob) -> tuple[dict[str, Any], dict[str, Any]]:
         when the reference orientation is unreachable at the position.
     """
     if job.kind == messages.ORIENTATION:
-        from hexapod_workspace.orientation import orientation_workspace
-
         workspace = orientation_workspace(
             job.manipulator,
             job.position,
@@ -88,8 +88,6 @@ def compute_fields(job: WorkspaceJob) -> tuple[dict[str, Any], dict[str, Any]]:
             tolerance=job.tolerance,
         )
     else:
-        from hexapod_workspace.projected import projected_workspace
-
         workspace = projected_workspace(
             job.manipulator,
             job.position,

@@ -24,7 +24,7 @@ from rcl_interfaces.srv import (  # noqa: E402
     SetParametersAtomically,
 )
 
-from hexapod_workspace import CONSTRAINT_NAMES, Manipulator, check  # noqa: E402
+from hexapod_workspace import CONSTRAINT_NAMES, Manipulator, check, recording  # noqa: E402
 
 NODE = "/hexapod_workspace"
 #: Small resolutions keep the workspace computations of the tests short.
@@ -281,3 +281,28 @@ def test_parameters_have_descriptors(client):
     assert by_name["resolution.n_rays"].integer_range[0].to_value == 7200
     assert by_name["check.max_poses"].read_only
     assert by_name["frame_id"].read_only
+
+
+# ---------------------------------------------------------------------------- recording
+
+
+def boolean(name: str, value: bool) -> ParameterMsg:
+    return ParameterMsg(
+        name=name, value=ParameterValue(type=ParameterType.PARAMETER_BOOL, bool_value=value)
+    )
+
+
+def test_recording_switched_off_finishes_the_log_and_on_starts_a_new_one(client, workspace_node):
+    angles = sample_angles(3, seed=8)
+    assert client.call(CheckPoses, f"{NODE}/check_poses", check_request(angles)).success
+    (first,) = sorted(workspace_node.record_dir.glob("*.mcap"))
+    (result,) = set_parameters(client, boolean("recording.enabled", False))
+    assert result.successful, result.reason
+    contents = recording.read_log(first)
+    assert contents.finished, contents.problems
+    assert contents.topics[f"{NODE}/check_poses/request"].count > 0
+    assert contents.topics[f"{NODE}/check_poses/response"].count > 0
+    (result,) = set_parameters(client, boolean("recording.enabled", True))
+    assert result.successful, result.reason
+    logs = sorted(workspace_node.record_dir.glob("*.mcap"))
+    assert len(logs) == 2 and first in logs

@@ -25,8 +25,8 @@ from sensor_msgs.msg import PointCloud2, PointField  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 
 from hexapod_workspace import Manipulator, messages  # noqa: E402
-
-projected_workspace = pytest.importorskip("hexapod_workspace.projected").projected_workspace
+from hexapod_workspace.orientation import orientation_workspace  # noqa: E402
+from hexapod_workspace.projected import projected_workspace  # noqa: E402
 
 NODE = "/hexapod_workspace"
 N_PHI, N_RAYS, PSI_STEP, TOLERANCE = 72, 24, 0.05, 1e-4
@@ -62,16 +62,11 @@ def client(ros_client, workspace_node):
     return ros_client
 
 
-def orientation_workspace_function():
-    module = pytest.importorskip("hexapod_workspace.orientation")
-    return module.orientation_workspace
-
-
 def core_workspace(model, kind, position=HOME, n_rays=0, psi_step=0.0, tolerance=0.0):
     """The core's result for a request with the node's resolution defaults."""
     tolerance = tolerance or TOLERANCE
     if kind == messages.ORIENTATION:
-        return orientation_workspace_function()(
+        return orientation_workspace(
             model,
             position,
             n_rays=n_rays or N_RAYS,
@@ -278,7 +273,6 @@ def test_workspace_request_topic_publishes_results(client, model):
 def test_pose_checks_are_answered_during_a_long_computation(client, model):
     """A 3-D workspace computation (workspace callback group, worker process) does not hold up
     check_poses (check group, multi-threaded executor): checks are answered before it ends."""
-    orientation_workspace_function()
     request = ComputeWorkspace.Request(
         request=workspace_request(messages.ORIENTATION, n_rays=180, psi_step=0.01, tolerance=1e-6)
     )
