@@ -4,7 +4,9 @@ Starts workspace_node from the colcon install space (``make ros``) in its own pr
 DDS domain of its own with ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST, and measures from an rclpy
 client in this process:
 
-1. one pose per request (goal: median <= 2 ms);
+1. one pose per request (goal: median <= 2 ms), against the floor measured in the same run:
+   the cheapest rclpy server of the same service type (single-threaded executor, constant
+   answer) in another process, called alternately with the node;
 2. 1000 poses per request, against the core's ``check`` of the same 1000 poses in this process
    (the ratio is the cost of ROS: messages, DDS, executor);
 3. one pose per request while a 3-D orientation workspace is being computed by the node (goal:
@@ -38,6 +40,27 @@ NODE_EXECUTABLE = (
 )
 GOAL_MS = 2.0
 NODE = "/hexapod_workspace"
+FLOOR = "/latency_floor/check_poses"
+#: The reference measured in the same run: the cheapest rclpy server of the same service type
+#: (single-threaded executor, constant answer, no check), in its own process.
+FLOOR_SERVER = f"""
+import rclpy
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from hexapod_workspace_msgs.srv import CheckPoses
+rclpy.init()
+node = rclpy.create_node("latency_floor")
+node.create_service(CheckPoses, "{FLOOR}", lambda request, response: CheckPoses.Response(
+    success=True, message="1/1 reachable"))
+executor = SingleThreadedExecutor()
+executor.add_node(node)
+try:
+    executor.spin()
+except (KeyboardInterrupt, ExternalShutdownException):
+    pass
+finally:
+    node.destroy_node()
+    rclpy.try_shutdown()
+"""
 
 
 def percentiles(samples_s: list[float]) -> tuple[float, float]:
@@ -85,16 +108,23 @@ def main(argv: list[str] | None = None) -> int:
                 stderr=subprocess.STDOUT,
                 env=dict(os.environ),
             )
+            floor = subprocess.Popen(
+                [sys.executable, "-c", FLOOR_SERVER],
+                stdout=out,
+                stderr=subprocess.STDOUT,
+                env=dict(os.environ),
+            )
         try:
             return run(args, domain)
         finally:
-            if node.poll() is None:
-                node.send_signal(signal.SIGINT)
-                try:
-                    node.wait(timeout=30)
-                except subprocess.TimeoutExpired:
-                    node.kill()
-                    node.wait()
+            for process in (node, floor):
+                if process.poll() is None:
+                    process.send_signal(signal.SIGINT)
+                    try:
+                        process.wait(timeout=30)
+                    except subprocess.TimeoutExpired:
+                        process.kill()
+                        process.wait()
 
 
 def run(args: argparse.Namespace, domain: int) -> int:
@@ -116,14 +146,16 @@ def run(args: argparse.Namespace, domain: int) -> int:
     spinner.start()
     checks = client_node.create_client(CheckPoses, f"{NODE}/check_poses")
     computes = client_node.create_client(ComputeWorkspace, f"{NODE}/compute_workspace")
+    floor_checks = client_node.create_client(CheckPoses, FLOOR)
     try:
-        if not (checks.wait_for_service(timeout_sec=60) and computes.wait_for_service(60)):
-            print("node services not discovered within 60 s", file=sys.stderr)
+        clients = (checks, computes, floor_checks)
+        if not all(client.wait_for_service(timeout_sec=60) for client in clients):
+            print("services not discovered within 60 s", file=sys.stderr)
             return 2
 
-        def timed(request) -> float:
+        def timed(request, client=checks) -> float:
             start = time.perf_counter()
-            response = checks.call(request, timeout_sec=60.0)
+            response = client.call(request, timeout_sec=60.0)
             elapsed = time.perf_counter() - start
             if response is None or not response.success:
                 raise RuntimeError(f"check_poses failed: {response}")
@@ -146,7 +178,11 @@ def run(args: argparse.Namespace, domain: int) -> int:
 
         for _ in range(50):  # warm-up (discovery of the reply path, first allocations)
             timed(one)
-        idle = [timed(one) for _ in range(args.samples)]
+            timed(one, floor_checks)
+        idle, reference = [], []
+        for _ in range(args.samples):  # interleaved: both see the same machine load
+            idle.append(timed(one))
+            reference.append(timed(one, floor_checks))
         batched = [timed(batch) for _ in range(args.batch_samples)]
         manipulator = Manipulator.from_params_file(example_config_path())
         core = []
@@ -180,9 +216,17 @@ def run(args: argparse.Namespace, domain: int) -> int:
         rclpy.try_shutdown()
 
     idle_med, idle_p95 = percentiles(idle)
+    floor_med, floor_p95 = percentiles(reference)
     batch_med, batch_p95 = percentiles(batched)
     core_med, _ = percentiles(core)
-    print(f"check_poses, 1 pose, idle:        median {idle_med:7.3f} ms  p95 {idle_p95:7.3f} ms")
+    print(
+        f"check_poses, 1 pose, idle:        median {idle_med:7.3f} ms  p95 {idle_p95:7.3f} ms"
+        f"  (ratio to the floor {idle_med / floor_med:.2f}x)"
+    )
+    print(
+        f"floor: minimal rclpy server:      median {floor_med:7.3f} ms  p95 {floor_p95:7.3f} ms"
+        "  (same service type, single-threaded, no work)"
+    )
     print(
         f"check_poses, 1000 poses, idle:    median {batch_med:7.3f} ms  p95 {batch_p95:7.3f} ms"
         f"  (core check in-process {core_med:.3f} ms; ratio {batch_med / core_med:.1f}x)"
