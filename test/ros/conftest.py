@@ -13,7 +13,9 @@ from collections.abc import Iterator
 from typing import Any
 
 import pytest
-from ros_support import RosClient, domain_selector
+from ros_support import RosClient, domain_selector, running_node
+
+from hexapod_workspace import Manipulator
 
 
 @pytest.fixture(scope="module")
@@ -56,3 +58,27 @@ def ros_client(ros_context: Any) -> Iterator[RosClient]:
         yield client
     finally:
         client.close()
+
+
+@pytest.fixture(scope="module")
+def workspace_node(ros_domain: int, tmp_path_factory: pytest.TempPathFactory, request) -> Iterator:
+    """The module's workspace_node process, started with the module's ``NODE_PARAMS``
+    (dotted-name overrides of the example parameters file)."""
+    overrides = getattr(request.module, "NODE_PARAMS", {})
+    with running_node(tmp_path_factory.mktemp("workspace_node"), overrides) as node:
+        yield node
+
+
+@pytest.fixture(scope="module")
+def model(workspace_node) -> Manipulator:
+    """The manipulator the node was started with, built by the core from the same file."""
+    return Manipulator.from_params_file(workspace_node.params_path)
+
+
+@pytest.fixture(scope="module")
+def client(ros_client: RosClient, workspace_node) -> RosClient:
+    """``ros_client`` once the module's node serves (its check_poses service is discovered)."""
+    from hexapod_workspace_msgs.srv import CheckPoses
+
+    ros_client.client(CheckPoses, "/hexapod_workspace/check_poses")
+    return ros_client

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 import pytest
-from ros_support import require_ros, running_node
+from ros_support import require_ros
 
 require_ros()
 
@@ -35,25 +35,6 @@ NODE_PARAMS = {
     "resolution.tolerance": 1e-4,
     "check.max_poses": 2000,
 }
-
-
-@pytest.fixture(scope="module")
-def workspace_node(ros_domain, tmp_path_factory):
-    directory = tmp_path_factory.mktemp("workspace_node")
-    with running_node(directory, NODE_PARAMS) as node:
-        yield node
-
-
-@pytest.fixture(scope="module")
-def model(workspace_node) -> Manipulator:
-    """The manipulator the node was started with, built by the core from the same file."""
-    return Manipulator.from_params_file(workspace_node.params_path)
-
-
-@pytest.fixture(scope="module")
-def client(ros_client, workspace_node):
-    ros_client.client(CheckPoses, f"{NODE}/check_poses")  # waits for discovery
-    return ros_client
 
 
 def sample_angles(count: int, seed: int = 4) -> np.ndarray:

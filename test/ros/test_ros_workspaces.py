@@ -11,7 +11,7 @@ import time
 
 import numpy as np
 import pytest
-from ros_support import require_ros, running_node
+from ros_support import require_ros
 
 require_ros()
 
@@ -24,7 +24,7 @@ from hexapod_workspace_msgs.srv import CheckPoses, ComputeWorkspace  # noqa: E40
 from sensor_msgs.msg import PointCloud2, PointField  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 
-from hexapod_workspace import Manipulator, messages  # noqa: E402
+from hexapod_workspace import messages  # noqa: E402
 from hexapod_workspace.orientation import orientation_workspace  # noqa: E402
 from hexapod_workspace.projected import projected_workspace  # noqa: E402
 
@@ -42,24 +42,6 @@ CLOUD_TOPIC = {
     messages.PROJECTED_TORSION_ZERO: f"{NODE}/projected_workspace",
     messages.PROJECTED_EXACT: f"{NODE}/projected_workspace",
 }
-
-
-@pytest.fixture(scope="module")
-def workspace_node(ros_domain, tmp_path_factory):
-    directory = tmp_path_factory.mktemp("workspace_node")
-    with running_node(directory, NODE_PARAMS) as node:
-        yield node
-
-
-@pytest.fixture(scope="module")
-def model(workspace_node) -> Manipulator:
-    return Manipulator.from_params_file(workspace_node.params_path)
-
-
-@pytest.fixture(scope="module")
-def client(ros_client, workspace_node):
-    ros_client.client(ComputeWorkspace, f"{NODE}/compute_workspace")  # waits for discovery
-    return ros_client
 
 
 def core_workspace(model, kind, position=HOME, n_rays=0, psi_step=0.0, tolerance=0.0):
