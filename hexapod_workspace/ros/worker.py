@@ -131,7 +131,7 @@ class WorkspaceWorker:
     """A spawned worker process that computes one :class:`WorkspaceJob` at a time.
 
     Thread-safe (calls are serialised). The process is started on first use (or by
-    :meth:`start`) and restarted after it dies; :meth:`close` terminates it.
+    :meth:`start`) and replaced when it dies; :meth:`close` terminates it for good.
     """
 
     def __init__(self) -> None:
@@ -139,6 +139,7 @@ class WorkspaceWorker:
         self._lock = threading.Lock()
         self._process: Any = None
         self._connection: Connection | None = None
+        self._closed = False
 
     def start(self) -> None:
         """Start the worker process now (it then imports the core while the node starts)."""
@@ -146,6 +147,9 @@ class WorkspaceWorker:
             self._ensure_started()
 
     def _ensure_started(self) -> Connection:
+        if self._closed:
+            msg = "the workspace worker is closed (the node is shutting down)"
+            raise WorkerError(msg)
         if self._process is None or not self._process.is_alive() or self._connection is None:
             self._stop_locked()
             parent, child = self._context.Pipe()
@@ -170,17 +174,21 @@ class WorkspaceWorker:
         HexapodWorkspaceError
             As :func:`compute_fields`.
         WorkerError
-            The worker died (it is restarted on the next call) or failed unexpectedly.
+            The worker died twice on this job (a dead worker is replaced and the job run once
+            more), the worker was closed, or the job failed unexpectedly.
         """
         with self._lock:
-            connection = self._ensure_started()
-            try:
-                connection.send(job)
-                status, payload = connection.recv()
-            except (EOFError, OSError) as error:
-                self._stop_locked()
-                msg = "the workspace worker process died; it restarts on the next request"
-                raise WorkerError(msg) from error
+            for attempt in range(2):  # a job is a pure function: run it again in a new worker
+                connection = self._ensure_started()
+                try:
+                    connection.send(job)
+                    status, payload = connection.recv()
+                    break
+                except (EOFError, OSError) as error:
+                    self._stop_locked()
+                    if attempt == 1 or self._closed:
+                        msg = "the workspace worker process died during the computation"
+                        raise WorkerError(msg) from error
         if status == "error":
             raise payload
         return payload
@@ -200,6 +208,7 @@ class WorkspaceWorker:
 
     def close(self) -> None:
         """Terminate the worker process (idempotent). A running computation is abandoned."""
+        self._closed = True
         # not under the lock: a computation in progress holds it; terminate wakes its recv()
         process = self._process
         if process is not None and process.is_alive():

@@ -7,7 +7,10 @@ ROS-free core computed here with the same parameters file.
 from __future__ import annotations
 
 import math
+import os
+import signal
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -279,3 +282,26 @@ def test_pose_checks_are_answered_during_a_long_computation(client, model):
     client.executor.spin_until_future_complete(long_call, timeout_sec=600.0)
     assert long_call.done()
     assert long_call.result().success, long_call.result().message
+
+
+def worker_pids(node_pid: int) -> list[int]:
+    """Child processes of the node (its workspace worker), from /proc."""
+    children: list[int] = []
+    for task in Path(f"/proc/{node_pid}/task").iterdir():
+        text = (task / "children").read_text().split()
+        children += [int(pid) for pid in text]
+    return children
+
+
+def test_a_killed_worker_process_is_replaced(client, workspace_node):
+    """The computation process dies (OOM killer, a bug): the node keeps serving and starts a
+    new one for the next request."""
+    assert compute(client, workspace_request(messages.PROJECTED_TORSION_ZERO)).success
+    pids = worker_pids(workspace_node.process.pid)
+    assert pids, "the node has no worker process"
+    for pid in pids:
+        os.kill(pid, signal.SIGKILL)
+    response = compute(client, workspace_request(messages.PROJECTED_TORSION_ZERO, request_id="w"))
+    assert response.success, response.message
+    assert response.summary.request_id == "w"
+    assert set(worker_pids(workspace_node.process.pid)).isdisjoint(pids)
