@@ -572,10 +572,12 @@ class WorkspaceNode(Node):
 
     def _apply_parameters(self, parameters: list[Parameter]) -> None:
         """Swap in the new model and settings after an accepted update."""
-        state = _state_from(self._parameter_values(), self._model_names)
+        previous, state = self._state, _state_from(self._parameter_values(), self._model_names)
         self._state = state
         names = ", ".join(parameter.name for parameter in parameters)
         self.get_logger().info(f"parameters updated: {names}")
+        if state.manipulator != previous.manipulator:
+            self._warn_home_pose()
         if state.settings.recording_enabled:
             self._recorder.open(state.settings.recording_directory)
         else:
