@@ -334,11 +334,6 @@ class _Recorder:
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
 
-    @property
-    def path(self) -> Path | None:
-        writer = self._writer
-        return None if writer is None else writer.path
-
     def add_channel(self, topic: str, msgtype: str, qos: str) -> None:
         """Declare a topic recorded in every log (registered when a log opens)."""
         self._channels[topic] = (msgtype, qos)
