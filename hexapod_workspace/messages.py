@@ -69,12 +69,14 @@ POINT_FIELD_NAMES = ("x", "y", "z", "phi", "theta", "psi")
 _FLOAT32 = 7  # sensor_msgs/PointField.FLOAT32
 
 #: Topic and service names the node uses and the CLI records under (the node is named
-#: ``hexapod_workspace``; ``~/boundary`` resolves to ``/hexapod_workspace/boundary``).
+#: ``hexapod_workspace``; ``~/workspace_summary`` resolves to
+#: ``/hexapod_workspace/workspace_summary``).
 TOPICS = {
     "workspace_request": "/hexapod_workspace/workspace_request",
     "commanded_pose": "/hexapod_workspace/commanded_pose",
-    "boundary": "/hexapod_workspace/boundary",
-    "summary": "/hexapod_workspace/summary",
+    "orientation_workspace": "/hexapod_workspace/orientation_workspace",
+    "projected_workspace": "/hexapod_workspace/projected_workspace",
+    "workspace_summary": "/hexapod_workspace/workspace_summary",
     "reachability": "/hexapod_workspace/reachability",
     "check_poses": "/hexapod_workspace/check_poses",
     "compute_workspace": "/hexapod_workspace/compute_workspace",
@@ -85,8 +87,9 @@ TOPICS = {
 TYPES = {
     "workspace_request": "hexapod_workspace_msgs/msg/WorkspaceRequest",
     "commanded_pose": "hexapod_workspace_msgs/msg/CommandedPose",
-    "boundary": "sensor_msgs/msg/PointCloud2",
-    "summary": "hexapod_workspace_msgs/msg/WorkspaceSummary",
+    "orientation_workspace": "sensor_msgs/msg/PointCloud2",
+    "projected_workspace": "sensor_msgs/msg/PointCloud2",
+    "workspace_summary": "hexapod_workspace_msgs/msg/WorkspaceSummary",
     "reachability": "hexapod_workspace_msgs/msg/ReachabilityResult",
     "check_poses": "hexapod_workspace_msgs/srv/CheckPoses",
     "compute_workspace": "hexapod_workspace_msgs/srv/ComputeWorkspace",

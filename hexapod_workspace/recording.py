@@ -550,7 +550,7 @@ class LogWriter:
         Parameters
         ----------
         topic : str
-            Fully qualified topic name, e.g. ``"/hexapod_workspace/summary"``.
+            Fully qualified topic name, e.g. ``"/hexapod_workspace/workspace_summary"``.
         msgtype : str
             ROS type name, e.g. ``"hexapod_workspace_msgs/msg/WorkspaceSummary"``.
         qos : str

@@ -750,11 +750,20 @@ def record_results(
                     n_points=len(points),
                 )
                 writer.write_fields(
-                    topics["summary"], types["summary"], summary, stamp + 1_000, qos=RESULT_QOS
+                    topics["workspace_summary"],
+                    types["workspace_summary"],
+                    summary,
+                    stamp + 1_000,
+                    qos=RESULT_QOS,
+                )
+                cloud = (
+                    "orientation_workspace"
+                    if kind == messages.ORIENTATION
+                    else "projected_workspace"
                 )
                 writer.write_fields(
-                    topics["boundary"],
-                    types["boundary"],
+                    topics[cloud],
+                    types[cloud],
                     messages.pointcloud_fields(points, frame_id=frame_id, stamp_ns=stamp + 1_000),
                     stamp + 1_000,
                     qos=RESULT_QOS,

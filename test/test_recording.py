@@ -79,10 +79,10 @@ def sample_messages() -> list[tuple[str, str, str, dict]]:
             recording.REQUEST_QOS,
             messages.workspace_request_fields(1, [0, 0, 1], request_id="w1", n_rays=36),
         ),
-        (topics["summary"], types["summary"], recording.RESULT_QOS, summary),
+        (topics["workspace_summary"], types["workspace_summary"], recording.RESULT_QOS, summary),
         (
-            topics["boundary"],
-            types["boundary"],
+            topics["projected_workspace"],
+            types["projected_workspace"],
             recording.RESULT_QOS,
             messages.pointcloud_fields(points, frame_id="base", stamp_ns=10),
         ),
@@ -175,7 +175,9 @@ def test_rosbag2_form_schemas_channels_statistics_metadata(finished_log) -> None
         assert len(qos) == 1
         schema = summary.schemas[channel.schema_id]
         assert channel.metadata["topic_type_hash"] == recording.type_hash(schema.name)
-    result_channel = next(c for c in summary.channels.values() if c.topic.endswith("/summary"))
+    result_channel = next(
+        c for c in summary.channels.values() if c.topic.endswith("/workspace_summary")
+    )
     assert parse_qos(result_channel.metadata["offered_qos_profiles"])[0].durability.name == (
         "TRANSIENT_LOCAL"
     )

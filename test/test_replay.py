@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import io
 import json
@@ -58,8 +59,9 @@ def test_record_then_replay_check_and_stub_workspaces(tmp_path: Path, check_resu
         "/hexapod_workspace/check_poses/request": 1,
         "/hexapod_workspace/check_poses/response": 1,
         "/hexapod_workspace/workspace_request": 2,
-        "/hexapod_workspace/summary": 2,
-        "/hexapod_workspace/boundary": 2,
+        "/hexapod_workspace/workspace_summary": 2,
+        "/hexapod_workspace/projected_workspace": 1,
+        "/hexapod_workspace/orientation_workspace": 1,
     }
     (check,) = report["pose_checks"]
     assert check["n_poses"] == 3 and check["n_reachable"] == int(check_result.reachable.sum())
@@ -105,7 +107,7 @@ def test_summary_and_cloud_of_one_computation_are_paired(tmp_path: Path) -> None
     )
     with recording.LogWriter(path) as writer:
         writer.write_fields("/n/projected_workspace", "sensor_msgs/msg/PointCloud2", cloud, 1)
-        writer.write_fields("/n/workspace_summary", messages.TYPES["summary"], summary, 2)
+        writer.write_fields("/n/workspace_summary", messages.TYPES["workspace_summary"], summary, 2)
         writer.write_fields(
             "/n/compute_workspace/response",
             "hexapod_workspace_msgs/srv/ComputeWorkspace_Response",
@@ -227,7 +229,7 @@ def test_unknown_topics_are_skipped_with_a_note(tmp_path: Path) -> None:
     code, _, err = replay(path)
     assert code == 2 and "foo_msgs/msg/Bar is unknown" in err and "nothing usable" in err
     summary = messages.summary_fields(projected_stub(), stamp_ns=1, frame_id="base")
-    summary_type = messages.TYPES["summary"]
+    summary_type = messages.TYPES["workspace_summary"]
     write_foreign_log(path, [("/s", summary_type, recording.serialize(summary_type, summary))])
     code, out, err = replay(path)
     assert code == 0
@@ -240,9 +242,11 @@ def test_bag_directory_and_bad_rate(tmp_path: Path) -> None:
     fields = messages.summary_fields(orientation_stub(), stamp_ns=3, frame_id="base")
     with Rosbag2Writer(bag, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
         connection = writer.add_connection(
-            "/ws/summary", messages.TYPES["summary"], typestore=recording.get_typestore()
+            "/ws/summary", messages.TYPES["workspace_summary"], typestore=recording.get_typestore()
         )
-        writer.write(connection, 5, recording.serialize(messages.TYPES["summary"], fields))
+        writer.write(
+            connection, 5, recording.serialize(messages.TYPES["workspace_summary"], fields)
+        )
     code, out, _ = replay(bag)
     assert code == 0 and "orientation: psi -5.730..5.730 deg" in out
     assert replay(bag, rate=-1.0)[0] == 2
@@ -267,7 +271,7 @@ def test_rejected_requests_with_nan_replay_as_json(tmp_path: Path) -> None:
         )
         writer.write_fields(
             "/n/workspace_summary",
-            messages.TYPES["summary"],
+            messages.TYPES["workspace_summary"],
             messages.summary_fields(
                 None, stamp_ns=3, frame_id="base", kind=0, position=[nan, nan, nan], message="NaN"
             ),
@@ -285,7 +289,7 @@ def test_rejected_requests_with_nan_replay_as_json(tmp_path: Path) -> None:
 def test_empty_finished_log_is_fine(tmp_path: Path) -> None:
     path = tmp_path / "idle.mcap"
     with recording.LogWriter(path) as writer:
-        writer.add_channel("/hexapod_workspace/summary", messages.TYPES["summary"])
+        writer.add_channel("/hexapod_workspace/summary", messages.TYPES["workspace_summary"])
     code, out, err = replay(path)
     assert code == 0 and err == "" and "0 messages" in out
 
@@ -320,7 +324,7 @@ def test_publish_republishes_recorded_clouds(tmp_path: Path, monkeypatch) -> Non
     import threading
 
     import rclpy
-    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
     from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import PointCloud2
 
@@ -359,7 +363,13 @@ def test_publish_republishes_recorded_clouds(tmp_path: Path, monkeypatch) -> Non
         node.create_subscription(PointCloud2, "/replay_test/boundary", on_cloud, qos)
         executor = SingleThreadedExecutor(context=context)
         executor.add_node(node)
-        spinner = threading.Thread(target=executor.spin, daemon=True)
+
+        def spin() -> None:
+            # The context is shut down at the end of the test, which ends spin() this way.
+            with contextlib.suppress(ExternalShutdownException):
+                executor.spin()
+
+        spinner = threading.Thread(target=spin, daemon=True)
         spinner.start()
         code, _, err = replay(path, publish=True, rate=10.0, wait_for_subscribers=60.0)
         assert code == 0, err
