@@ -154,7 +154,9 @@ def segment_distance(
     c = np.einsum("...k,...k->...", d1, r)
     f = np.einsum("...k,...k->...", d2, r)
     rr = np.einsum("...k,...k->...", r, r)
-    return np.sqrt(_segment_distance_squared(a, b, c, e, f, rr)).reshape(np.shape(a))
+    shape = np.broadcast_shapes(a.shape, b.shape, c.shape, e.shape, f.shape, rr.shape)
+    dots = (np.atleast_1d(np.broadcast_to(v, shape)) for v in (a, b, c, e, f, rr))
+    return np.sqrt(_segment_distance_squared(*dots)).reshape(shape)
 
 
 def _unit_interval(values: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -181,9 +183,8 @@ def _segment_distance_squared(
     segments take a guarded path (only for the entries that need it). The squared distance is
     expanded as ``rr + s²a + t²e + 2sc − 2tf − 2stb``, so no 3-vector is formed.
     """
-    if not a.shape == b.shape == c.shape == e.shape == f.shape == rr.shape or a.ndim == 0:
-        a, b, c, e, f, rr = (np.atleast_1d(v) for v in np.broadcast_arrays(a, b, c, e, f, rr))
-    # np.clip's Python wrapper costs more than the arithmetic at the sizes used here.
+    # Inputs are arrays of at least one dimension that broadcast together; np.clip's Python
+    # wrapper costs more than the arithmetic at the sizes used here.
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         denom = a * e - b * b
         s = _unit_interval((b * f - c * e) / denom)
@@ -191,9 +192,8 @@ def _segment_distance_squared(
         s = _unit_interval((b * t - c) / a)
     special = ~(denom > 1e-14 * a * e)  # parallel, point-like, or NaN from 0/0
     if np.any(special):
-        s[special], t[special] = _degenerate_parameters(
-            a[special], b[special], c[special], e[special], f[special]
-        )
+        full = np.broadcast_arrays(a, b, c, e, f)
+        s[special], t[special] = _degenerate_parameters(*(v[special] for v in full))
     squared = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
     return np.maximum(squared, 0.0)
 
@@ -317,6 +317,9 @@ class _ChunkModel:
         r = manipulator.base_joints[PAIRS_I] - manipulator.base_joints[PAIRS_J]  # (15, 3)
         self.r = r
         self.rr = np.einsum("pk,pk->p", r, r)
+        self.alpha_equal = bool(np.all(self.alpha == self.alpha[0]))
+        self.beta_equal = bool(np.all(self.beta == self.beta[0]))
+        self.relative_scale = _relative_scale(manipulator)
 
     def evaluate(
         self,
@@ -345,13 +348,13 @@ class _ChunkModel:
 
         # Base joint: angle between jA_i (base frame) and n_i.
         cos_a = (self.ja_t[0] * lx + self.ja_t[1] * ly + self.ja_t[2] * lz) * inverse
-        self._angle_margin(cos_a, self.alpha, rows, margins_out[1], legs_out[1])
+        self._angle_margin(cos_a, self.alpha, self.alpha_equal, rows, margins_out[1], legs_out[1])
 
         # Platform joint: angle between R·jB_i and −n_i.
         cos_b = (
             rotated[:, 0, 6:] * lx + rotated[:, 1, 6:] * ly + rotated[:, 2, 6:] * lz
         ) * -inverse
-        self._angle_margin(cos_b, self.beta, rows, margins_out[2], legs_out[2])
+        self._angle_margin(cos_b, self.beta, self.beta_equal, rows, margins_out[2], legs_out[2])
 
         if not self.interference:
             margins_out[3] = np.inf
@@ -377,6 +380,7 @@ class _ChunkModel:
     def _angle_margin(
         cosine: NDArray[np.float64],
         limit: NDArray[np.float64],
+        equal: bool,
         rows: NDArray[np.int64],
         margin_out: NDArray[np.float64],
         leg_out: NDArray[np.int64],
@@ -384,7 +388,7 @@ class _ChunkModel:
         """min_i (limit_i − arccos(cos_i)) and its leg; one arccos per pose when limits are equal
         (the margin is then decreasing in the angle, so the smallest cosine is the limiting leg).
         """
-        if np.all(limit == limit[0]):
+        if equal:
             leg = cosine.argmin(axis=1)
             smallest = np.minimum(np.maximum(cosine[rows, leg], -1.0), 1.0)
             margin_out[:] = limit[0] - np.arccos(smallest)
@@ -460,7 +464,12 @@ def relative_margins(manipulator: Manipulator, margins: NDArray[np.float64]) -> 
         Leg length over half the mean stroke, joint angles over the mean maximum angle,
         interference over D (+inf when disabled). Dimensionless.
     """
-    scale = np.array(
+    return margins / _chunk_model(manipulator, True).relative_scale[:, None]
+
+
+def _relative_scale(manipulator: Manipulator) -> NDArray[np.float64]:
+    """Natural scale of each constraint's margin, shape (4,): see :func:`relative_margins`."""
+    return np.array(
         [
             float(np.mean(manipulator.leg_length_max - manipulator.leg_length_min)) / 2.0,
             float(np.mean(manipulator.base_joint_max_angle)),
@@ -468,7 +477,6 @@ def relative_margins(manipulator: Manipulator, margins: NDArray[np.float64]) -> 
             manipulator.leg_diameter if manipulator.leg_diameter > 0.0 else 1.0,
         ]
     )
-    return margins / scale[:, None]
 
 
 def check(
