@@ -325,6 +325,25 @@ def cmd_check(options: argparse.Namespace, out: TextIO) -> int:
 
 
 # ---------------------------------------------------------------------------- workspaces
+def _finish_workspace(
+    options: argparse.Namespace,
+    out: TextIO,
+    manipulator: Manipulator,
+    workspace: Any,
+    to_json: Callable[[Any], dict[str, Any]],
+    to_text: Callable[[Any, TextIO], None],
+) -> int:
+    """Record (``--record``) and print a computed workspace (JSON or text); exit code 0."""
+    _record(options, manipulator, [workspace])
+    if options.json:
+        out.write(json.dumps(to_json(workspace)) + "\n")
+    else:
+        to_text(workspace, out)
+        if options.plot:
+            out.write(f"  plot: {options.plot}\n")
+    return 0
+
+
 def projected_to_json(workspace: ProjectedWorkspace) -> dict[str, Any]:
     """The JSON document of a projected workspace (angles in degrees)."""
     document: dict[str, Any] = {
@@ -403,14 +422,9 @@ def cmd_projected(options: argparse.Namespace, out: TextIO) -> int:
             [workspace, overlay] if workspace.method == "torsion_zero" else [overlay, workspace]
         )
         plot_projected(ordered, options.plot)
-    _record(options, manipulator, [workspace])
-    if options.json:
-        out.write(json.dumps(projected_to_json(workspace)) + "\n")
-    else:
-        _projected_text(workspace, out)
-        if options.plot:
-            out.write(f"  plot: {options.plot}\n")
-    return 0
+    return _finish_workspace(
+        options, out, manipulator, workspace, projected_to_json, _projected_text
+    )
 
 
 def orientation_to_json(workspace: OrientationWorkspace) -> dict[str, Any]:
@@ -474,14 +488,9 @@ def cmd_orientation(options: argparse.Namespace, out: TextIO) -> int:
         from .plotting import plot_orientation
 
         plot_orientation(workspace, options.plot)
-    _record(options, manipulator, [workspace])
-    if options.json:
-        out.write(json.dumps(orientation_to_json(workspace)) + "\n")
-    else:
-        _orientation_text(workspace, out)
-        if options.plot:
-            out.write(f"  plot: {options.plot}\n")
-    return 0
+    return _finish_workspace(
+        options, out, manipulator, workspace, orientation_to_json, _orientation_text
+    )
 
 
 def cmd_torsion_range(options: argparse.Namespace, out: TextIO) -> int:

@@ -329,19 +329,27 @@ def _exact(
     low = grid[np.maximum(best - 1, 0)]
     high = grid[np.minimum(best + 1, grid.size - 1)]
     ratio = (math.sqrt(5.0) - 1.0) / 2.0
+
+    def keep_best(best: tuple, *trials: tuple) -> tuple:
+        """(theta, psi, limiting) improved by trial points (psi, theta, limiting) where higher."""
+        theta_best, psi_best, limit_best = best
+        for candidate, value, limit in trials:
+            better = value > theta_best
+            theta_best = np.where(better, value, theta_best)
+            psi_best = np.where(better, candidate, psi_best)
+            limit_best = np.where(better, limit, limit_best)
+        return theta_best, psi_best, limit_best
+
     left = high - ratio * (high - low)
     right = low + ratio * (high - low)
     theta_left, limit_left = boundary(left)
     theta_right, limit_right = boundary(right)
     for step in range(EXACT_GOLDEN_STEPS):
-        for candidate, value, limit in (
+        theta, psi, limiting = keep_best(
+            (theta, psi, limiting),
             (left, theta_left, limit_left),
             (right, theta_right, limit_right),
-        ):
-            better = value > theta
-            theta = np.where(better, value, theta)
-            psi = np.where(better, candidate, psi)
-            limiting = np.where(better, limit, limiting)
+        )
         go_right = theta_left < theta_right
         low = np.where(go_right, left, low)
         high = np.where(go_right, high, right)
@@ -359,14 +367,9 @@ def _exact(
         left, right = new_left, new_right
         if progress:
             progress(0.5 + 0.5 * (step + 1) / EXACT_GOLDEN_STEPS)
-    for candidate, value, limit in (
-        (left, theta_left, limit_left),
-        (right, theta_right, limit_right),
-    ):
-        better = value > theta
-        theta = np.where(better, value, theta)
-        psi = np.where(better, candidate, psi)
-        limiting = np.where(better, limit, limiting)
+    theta, psi, limiting = keep_best(
+        (theta, psi, limiting), (left, theta_left, limit_left), (right, theta_right, limit_right)
+    )
     # Full tolerance at the winning torsion (ψ = 0 keeps its torsion-zero result).
     refine = psi != 0.0
     if tolerance < coarse and np.any(refine):
