@@ -17,6 +17,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .rotations import approach_vector
+
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike, NDArray
 
@@ -349,10 +351,7 @@ def boundary_points(workspace: ProjectedWorkspace | OrientationWorkspace) -> NDA
     phi = np.asarray(workspace.phi, dtype=float)
     theta = np.asarray(workspace.theta, dtype=float)
     psi = np.broadcast_to(np.asarray(workspace.psi, dtype=float), phi.shape)
-    sin_theta = np.sin(theta)
-    return np.column_stack(
-        (np.cos(phi) * sin_theta, np.sin(phi) * sin_theta, np.cos(theta), phi, theta, psi)
-    )
+    return np.column_stack((approach_vector(phi, theta), phi, theta, psi))
 
 
 def summary_fields(

@@ -36,6 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 from .constraints import CONSTRAINT_NAMES
 from .errors import InputError, ResolutionError, UnreachableReferenceError
 from .manipulator import Manipulator
+from .rotations import approach_vector
 from .search import RaySearch
 
 __all__ = [
@@ -149,10 +150,7 @@ class ProjectedWorkspace:
 
     def approach_vectors(self) -> NDArray[np.float64]:
         """Unit approach vectors of the boundary directions, base frame; shape (n, 3)."""
-        sin_theta = np.sin(self.theta)
-        return np.column_stack(
-            [np.cos(self.phi) * sin_theta, np.sin(self.phi) * sin_theta, np.cos(self.theta)]
-        )
+        return approach_vector(self.phi, self.theta)
 
 
 def _solid_angle(theta: NDArray[np.float64]) -> float:
