@@ -19,13 +19,20 @@ import time
 for variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(variable, "1")
 
+import sys  # noqa: E402
+from pathlib import Path  # noqa: E402
+
 import numpy as np  # noqa: E402
+
+# The literal reference is a test oracle (test/reference.py), not part of the package.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "test"))
+
+from reference import pose_margins_literal  # noqa: E402
 
 from hexapod_workspace import Manipulator, check  # noqa: E402
 from hexapod_workspace._resources import example_config_path  # noqa: E402
-from hexapod_workspace.constraints import CHUNK, _chunk_model  # noqa: E402
-from hexapod_workspace.reference import pose_margins_literal  # noqa: E402
-from hexapod_workspace.rotations import tt_to_matrix  # noqa: E402
+from hexapod_workspace.core.constraints import CHUNK, _chunk_model  # noqa: E402
+from hexapod_workspace.core.rotations import tt_to_matrix  # noqa: E402
 
 
 def random_poses(count: int, seed: int = 1) -> np.ndarray:

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hexapod_workspace import messages, recording
+from hexapod_workspace.logs import messages, recording
 
 CLOUD = "sensor_msgs/msg/PointCloud2"
 
@@ -140,15 +140,15 @@ def service_impact(repeat: int, workdir: Path) -> None:
     node's one log per run, in background mode. Uses the projected workspace when the core has
     it, else a CheckPoses batch of 10^4 poses.
     """
-    from hexapod_workspace import constraints
     from hexapod_workspace._resources import example_config_path
-    from hexapod_workspace.manipulator import Manipulator
+    from hexapod_workspace.core import constraints
+    from hexapod_workspace.core.manipulator import Manipulator
 
     manipulator = Manipulator.from_params_file(example_config_path())
     store = recording.get_typestore()
     stamp = time.time_ns()
     try:
-        from hexapod_workspace.projected import projected_workspace
+        from hexapod_workspace.core.projected import projected_workspace
     except ImportError:
         projected_workspace = None
     rng = np.random.default_rng(5)

@@ -25,7 +25,15 @@ import time
 for variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(variable, "1")
 
+import sys  # noqa: E402
+from pathlib import Path  # noqa: E402
+
 import numpy as np  # noqa: E402
+
+# The literal reference is a test oracle (test/reference.py), not part of the package.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "test"))
+
+from reference import paper_projected_workspace  # noqa: E402
 
 from hexapod_workspace import (  # noqa: E402
     Manipulator,
@@ -34,7 +42,6 @@ from hexapod_workspace import (  # noqa: E402
     torsion_range,
 )
 from hexapod_workspace._resources import example_config_path  # noqa: E402
-from hexapod_workspace.reference import paper_projected_workspace  # noqa: E402
 
 
 def best_of(repeats: int, function):

@@ -4,10 +4,19 @@ The core (model, kinematics, constraints, workspace algorithms) depends on numpy
 standard library only; ROS 2 lives in :mod:`hexapod_workspace.ros`.
 
 Units are SI (m, rad). Orientations are Tilt-and-Torsion angles (φ, θ, ψ) with
-``R = Rz(φ) Ry(θ) Rz(−φ) Rz(ψ)``; see :mod:`hexapod_workspace.rotations`.
+``R = Rz(φ) Ry(θ) Rz(−φ) Rz(ψ)``; see :mod:`hexapod_workspace.core.rotations`.
 """
 
-from .constraints import CONSTRAINT_NAMES, CheckResult, check
+from .core.constraints import CONSTRAINT_NAMES, CheckResult, check
+from .core.manipulator import HomePoseWarning, Manipulator
+from .core.orientation import (
+    OrientationSlice,
+    OrientationWorkspace,
+    TorsionRange,
+    orientation_workspace,
+    torsion_range,
+)
+from .core.projected import ProjectedWorkspace, projected_workspace
 from .errors import (
     ConfigError,
     GeometryError,
@@ -18,15 +27,6 @@ from .errors import (
     ResolutionError,
     UnreachableReferenceError,
 )
-from .manipulator import HomePoseWarning, Manipulator
-from .orientation import (
-    OrientationSlice,
-    OrientationWorkspace,
-    TorsionRange,
-    orientation_workspace,
-    torsion_range,
-)
-from .projected import ProjectedWorkspace, projected_workspace
 
 __version__ = "0.1.0"
 

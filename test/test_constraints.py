@@ -6,11 +6,11 @@ import math
 
 import numpy as np
 import pytest
+from reference import pose_margins_literal, segment_distance_literal
 
 from hexapod_workspace import CONSTRAINT_NAMES, InputError, Manipulator, check
-from hexapod_workspace.constraints import inverse_kinematics, pose_margins, segment_distance
-from hexapod_workspace.reference import pose_margins_literal, segment_distance_literal
-from hexapod_workspace.rotations import tt_to_matrix
+from hexapod_workspace.core.constraints import inverse_kinematics, pose_margins, segment_distance
+from hexapod_workspace.core.rotations import tt_to_matrix
 
 
 def brute_segment_distance(p0, p1, q0, q1, samples: int = 4001) -> float:

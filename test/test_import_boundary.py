@@ -7,9 +7,9 @@ import sys
 
 CORE = [
     "hexapod_workspace",
-    "hexapod_workspace.manipulator",
-    "hexapod_workspace.rotations",
-    "hexapod_workspace.constraints",
+    "hexapod_workspace.core.manipulator",
+    "hexapod_workspace.core.rotations",
+    "hexapod_workspace.core.constraints",
 ]
 
 

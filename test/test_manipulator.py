@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from hexapod_workspace import ConfigError, GeometryError, HomePoseWarning, Manipulator
-from hexapod_workspace.params import load_params_file
+from hexapod_workspace.core.params import load_params_file
 
 
 def build(parameters: dict, **changes) -> Manipulator:

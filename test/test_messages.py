@@ -1,4 +1,4 @@
-"""Tests of hexapod_workspace.messages: results -> ROS field dicts -> CDR -> back (ROS-free)."""
+"""Tests of logs.messages: results -> ROS field dicts -> CDR -> back (ROS-free)."""
 
 from __future__ import annotations
 
@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 from recording_support import NAN, plain
 
-from hexapod_workspace import constraints, messages, recording
 from hexapod_workspace._resources import example_config_path
-from hexapod_workspace.manipulator import Manipulator
+from hexapod_workspace.core import constraints
+from hexapod_workspace.core.manipulator import Manipulator
+from hexapod_workspace.logs import messages, recording
 
 
 @pytest.fixture(scope="module")

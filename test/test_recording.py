@@ -1,4 +1,4 @@
-"""Tests of hexapod_workspace.recording: rosbag2-form MCAP writing, durability, tolerant reading.
+"""Tests of logs.recording: rosbag2-form MCAP writing, durability, tolerant reading.
 
 Every recorded message is decoded by two independent readers (rosbags' AnyReader with the log's
 own schemas, and mcap + mcap_ros2) and compared with what was written, after decoding.
@@ -23,10 +23,11 @@ from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Rosbag2Writer
 from rosbags.rosbag2.metadata import parse_qos
 
-from hexapod_workspace import constraints, messages, recording
 from hexapod_workspace._resources import data_dir, example_config_path
+from hexapod_workspace.core import constraints
+from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.errors import LogReadError, RecordingError
-from hexapod_workspace.manipulator import Manipulator
+from hexapod_workspace.logs import messages, recording
 
 SUMMARY = "hexapod_workspace_msgs/msg/WorkspaceSummary"
 CLOUD = "sensor_msgs/msg/PointCloud2"
@@ -232,7 +233,7 @@ def test_full_disk_at_creation_raises_recording_error() -> None:
 FULL_DISK_CHILD = textwrap.dedent(
     """
     import resource, signal, sys, threading
-    from hexapod_workspace import recording
+    from hexapod_workspace.logs import recording
     from hexapod_workspace.errors import RecordingError
     signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
     resource.setrlimit(resource.RLIMIT_FSIZE, (200_000, 200_000))
@@ -308,7 +309,7 @@ def test_run_log_path_is_named_by_start_time_and_unique(tmp_path: Path) -> None:
 CHILD = textwrap.dedent(
     """
     import sys, time
-    from hexapod_workspace import recording
+    from hexapod_workspace.logs import recording
     path, mode = sys.argv[1], sys.argv[2]
     kwargs = {"count": dict(flush_interval=0, flush_messages=5),
               "timer": dict(flush_interval=0.05, flush_messages=10_000)}[mode]

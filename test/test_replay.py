@@ -1,4 +1,4 @@
-"""Tests of hexapod_workspace.replay: --record then replay, bad logs, plots, republishing."""
+"""Tests of hexapod_workspace.cli.replay: --record then replay, bad logs, plots, republishing."""
 
 from __future__ import annotations
 
@@ -17,13 +17,9 @@ from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Rosbag2Writer
 from test_messages import orientation_stub, projected_stub
 
-from hexapod_workspace import constraints, messages, recording
-from hexapod_workspace.replay import record_results, run_replay, summarize_log
-
-HAVE_CORE_WORKSPACES = all(
-    importlib.util.find_spec(f"hexapod_workspace.{name}") is not None
-    for name in ("projected", "orientation", "plotting")
-)
+from hexapod_workspace.cli.replay import record_results, run_replay, summarize_log
+from hexapod_workspace.core import constraints
+from hexapod_workspace.logs import messages, recording
 
 
 def replay(*args: object, **kwargs: object) -> tuple[int, str, str]:
@@ -122,10 +118,9 @@ def test_summary_and_cloud_of_one_computation_are_paired(tmp_path: Path) -> None
     np.testing.assert_array_equal(record.points, messages.pointcloud_to_array(cloud))
 
 
-@pytest.mark.skipif(not HAVE_CORE_WORKSPACES, reason="core workspaces/plotting not there yet")
 def test_record_real_workspaces_replay_and_plot(tmp_path: Path, example) -> None:
-    from hexapod_workspace.orientation import orientation_workspace
-    from hexapod_workspace.projected import projected_workspace
+    from hexapod_workspace.core.orientation import orientation_workspace
+    from hexapod_workspace.core.projected import projected_workspace
 
     results = [
         projected_workspace(example, method="torsion_zero", n_phi=72),
@@ -145,7 +140,6 @@ def test_record_real_workspaces_replay_and_plot(tmp_path: Path, example) -> None
     assert plots == ["workspace_001_projected.png", "workspace_003_orientation.png"]
 
 
-@pytest.mark.skipif(not HAVE_CORE_WORKSPACES, reason="core workspaces/plotting not there yet")
 def test_cli_record_then_replay(tmp_path: Path) -> None:
     """The console script end to end: projected --record, then replay (text, JSON, plots)."""
     from cli_support import run_cli
@@ -172,7 +166,6 @@ def test_cli_record_then_replay(tmp_path: Path) -> None:
     assert "Traceback" not in broken.stderr and len(broken.stderr.splitlines()) == 1
 
 
-@pytest.mark.skipif(not HAVE_CORE_WORKSPACES, reason="core workspaces/plotting not there yet")
 def test_plot_redraws_overlaid_methods_and_degenerate_workspaces(tmp_path: Path) -> None:
     single_point = orientation_stub()
     single_point.boundary_points = lambda: np.array([[0.1, 0.0, 0.0, 0.0, 0.1, 0.0]])

@@ -5,8 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hexapod_workspace.errors import InputError
-from hexapod_workspace.rotations import (
+from hexapod_workspace.core.rotations import (
     approach_vector,
     matrix_to_quaternion,
     matrix_to_tt,
@@ -19,6 +18,7 @@ from hexapod_workspace.rotations import (
     zyz_to_matrix,
     zyz_to_tt,
 )
+from hexapod_workspace.errors import InputError
 
 
 def rz(angle: float) -> np.ndarray:

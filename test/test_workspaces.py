@@ -91,7 +91,7 @@ def test_torsion_zero_summary(tz_off):
 
 @pytest.mark.parametrize("position", [ON_AXIS, OFF_AXIS])
 def test_paper_procedure_agrees_within_its_step(example, position):
-    from hexapod_workspace.reference import paper_projected_workspace
+    from reference import paper_projected_workspace
 
     ours = projected_workspace(example, position, n_phi=24, tolerance=1e-7)
     paper = paper_projected_workspace(example, position, n_phi=24)
@@ -260,7 +260,7 @@ def test_volume_and_boundary_points(solid_off):
 
 
 def test_slice_centres_are_previous_centroids(example, solid_off):
-    from hexapod_workspace.orientation import _polygon_area_centroid
+    from hexapod_workspace.core.orientation import _polygon_area_centroid
 
     slices = solid_off.slices
     zero = int(np.argmin(np.abs([piece.psi for piece in slices])))
@@ -380,8 +380,8 @@ def test_leg_length_boundary_closed_form(example, tz_off):
     K0 + K1 cos(theta) + K2 sin(theta) (R is linear in cos and sin of theta). Where the search
     reports leg_length as the limiting constraint, its boundary must equal the first root of
     l_i(theta)^2 = l_min^2 or l_max^2 over the legs (from three samples, solved in closed form)."""
-    from hexapod_workspace.constraints import inverse_kinematics
-    from hexapod_workspace.rotations import tt_to_matrix
+    from hexapod_workspace.core.constraints import inverse_kinematics
+    from hexapod_workspace.core.rotations import tt_to_matrix
 
     checked = 0
     for k in np.flatnonzero(np.array(tz_off.limiting) == "leg_length"):

@@ -2,7 +2,7 @@
 
 :mod:`hexapod_workspace.ros.node` holds the node ``hexapod_workspace`` (executable
 ``workspace_node``); :mod:`hexapod_workspace.ros.conversions` fills rclpy messages from the
-ROS-free field dicts of :mod:`hexapod_workspace.messages`; :mod:`hexapod_workspace.ros.worker`
+ROS-free field dicts of :mod:`hexapod_workspace.logs.messages`; :mod:`hexapod_workspace.ros.worker`
 computes workspaces in a worker process (ROS-free). Nothing here is imported by the core.
 """
 

@@ -1,6 +1,6 @@
-"""rclpy messages from the ROS-free field dicts of :mod:`hexapod_workspace.messages`, and back.
+"""rclpy messages from the ROS-free field dicts of :mod:`hexapod_workspace.logs.messages`, and back.
 
-:mod:`hexapod_workspace.messages` is the single mapping from core results to message fields
+:mod:`hexapod_workspace.logs.messages` is the single mapping from core results to message fields
 (nested dicts keyed by ROS field names). This module only moves those dicts into generated rclpy
 message classes (:func:`to_message`) and reads request messages into numpy arrays. No per-point
 Python loop touches a point cloud: ``PointCloud2.data`` is assigned as one
@@ -76,7 +76,7 @@ def to_message(message_class: type, fields: Mapping[str, Any] | Any) -> Any:
         A generated message (or service request/response) class, e.g.
         ``hexapod_workspace_msgs.msg.PoseCheck``.
     fields : Mapping or message
-        Nested dict keyed by field names, as returned by :mod:`hexapod_workspace.messages`
+        Nested dict keyed by field names, as returned by :mod:`hexapod_workspace.logs.messages`
         (nested messages as dicts, message sequences as lists of dicts, ``uint8[]`` as
         ``bytes``). Missing fields keep their defaults. A message instance of the right class is
         returned unchanged.

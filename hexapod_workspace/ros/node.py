@@ -25,7 +25,7 @@ reentrant one, under a multi-threaded executor; the computation itself runs in a
 (:mod:`hexapod_workspace.ros.worker`), so a long 3-D computation neither blocks nor slows the
 pose checks (it does not hold this interpreter's lock).
 Every request and result is recorded to one MCAP log per run (rosbag2 form), see
-:mod:`hexapod_workspace.recording`; a failure to write turns recording off, the node keeps
+:mod:`hexapod_workspace.logs.recording`; a failure to write turns recording off, the node keeps
 serving. Units: SI (m, rad), positions in the base frame ``frame_id``.
 """
 
@@ -68,17 +68,17 @@ from rclpy.serialization import serialize_message
 from sensor_msgs.msg import PointCloud2
 from std_srvs.srv import Trigger
 
-from hexapod_workspace import messages
 from hexapod_workspace._resources import example_config_path
-from hexapod_workspace.constraints import check
+from hexapod_workspace.core.constraints import check
+from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.errors import (
     ConfigError,
     InputError,
     RecordingError,
     UnreachableReferenceError,
 )
-from hexapod_workspace.manipulator import Manipulator
-from hexapod_workspace.recording import (
+from hexapod_workspace.logs import messages
+from hexapod_workspace.logs.recording import (
     REQUEST_QOS,
     SERVICE_QOS,
     LogWriter,

@@ -4,7 +4,7 @@ A 3-D orientation workspace takes seconds of mostly-Python work. Run in a thread
 would share the interpreter lock with the pose checks and delay them; run here, in a spawned
 process, it leaves the node's interpreter to the checks. The node sends one
 :class:`WorkspaceJob` at a time and gets back the ROS-free field dicts of the summary and of the
-boundary cloud (:mod:`hexapod_workspace.messages`), ready to become rclpy messages.
+boundary cloud (:mod:`hexapod_workspace.logs.messages`), ready to become rclpy messages.
 """
 
 from __future__ import annotations
@@ -20,11 +20,11 @@ from typing import Any
 
 import numpy as np
 
-from hexapod_workspace import messages
+from hexapod_workspace.core.manipulator import Manipulator
+from hexapod_workspace.core.orientation import orientation_workspace
+from hexapod_workspace.core.projected import projected_workspace
 from hexapod_workspace.errors import HexapodWorkspaceError
-from hexapod_workspace.manipulator import Manipulator
-from hexapod_workspace.orientation import orientation_workspace
-from hexapod_workspace.projected import projected_workspace
+from hexapod_workspace.logs import messages
 
 __all__ = ["WORKER_NICENESS", "WorkerError", "WorkspaceJob", "WorkspaceWorker", "compute_fields"]
 

@@ -2,7 +2,7 @@
 
 What the node published, answered and was sent is compared with what its log holds, decoded by
 two independent readers (rosbags with the log's own schemas, mcap + mcap_ros2) and by
-hexapod_workspace.recording. SIGINT must leave a finished log; SIGKILL must keep every message
+hexapod_workspace.logs.recording. SIGINT must leave a finished log; SIGKILL must keep every message
 flushed before the kill; an unwritable recording directory must not stop the node serving.
 """
 
@@ -31,7 +31,7 @@ from hexapod_workspace_msgs.srv import CheckPoses, ComputeWorkspace  # noqa: E40
 from sensor_msgs.msg import PointCloud2  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 
-from hexapod_workspace import messages, recording  # noqa: E402
+from hexapod_workspace.logs import messages, recording  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # test/recording_support.py
 from recording_support import plain, read_with_mcap_ros2, read_with_rosbags  # noqa: E402

@@ -16,7 +16,8 @@ from hexapod_workspace_msgs.srv import CheckPoses  # noqa: E402
 from rclpy.serialization import deserialize_message, serialize_message  # noqa: E402
 from sensor_msgs.msg import PointCloud2  # noqa: E402
 
-from hexapod_workspace import check, messages  # noqa: E402
+from hexapod_workspace import check  # noqa: E402
+from hexapod_workspace.logs import messages  # noqa: E402
 from hexapod_workspace.ros.conversions import (  # noqa: E402
     angles_from_orientations,
     position_from_point,

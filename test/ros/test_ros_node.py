@@ -24,7 +24,8 @@ from rcl_interfaces.srv import (  # noqa: E402
     SetParametersAtomically,
 )
 
-from hexapod_workspace import CONSTRAINT_NAMES, Manipulator, check, recording  # noqa: E402
+from hexapod_workspace import CONSTRAINT_NAMES, Manipulator, check  # noqa: E402
+from hexapod_workspace.logs import recording  # noqa: E402
 
 NODE = "/hexapod_workspace"
 #: Small resolutions keep the workspace computations of the tests short.

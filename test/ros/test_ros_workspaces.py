@@ -27,9 +27,9 @@ from hexapod_workspace_msgs.srv import CheckPoses, ComputeWorkspace  # noqa: E40
 from sensor_msgs.msg import PointCloud2, PointField  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 
-from hexapod_workspace import messages  # noqa: E402
-from hexapod_workspace.orientation import orientation_workspace  # noqa: E402
-from hexapod_workspace.projected import projected_workspace  # noqa: E402
+from hexapod_workspace.core.orientation import orientation_workspace  # noqa: E402
+from hexapod_workspace.core.projected import projected_workspace  # noqa: E402
+from hexapod_workspace.logs import messages  # noqa: E402
 
 NODE = "/hexapod_workspace"
 N_PHI, N_RAYS, PSI_STEP, TOLERANCE = 72, 24, 0.05, 1e-4

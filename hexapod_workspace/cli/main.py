@@ -21,13 +21,13 @@ from typing import Any, TextIO
 import numpy as np
 from numpy.typing import NDArray
 
-from . import __version__
-from ._resources import example_config_path
-from .constraints import CONSTRAINT_NAMES, CheckResult, check
-from .errors import HexapodWorkspaceError, InputError, UnreachableReferenceError
-from .manipulator import Manipulator
-from .orientation import OrientationWorkspace, orientation_workspace, torsion_range
-from .projected import ProjectedWorkspace, projected_workspace
+from .. import __version__
+from .._resources import example_config_path
+from ..core.constraints import CONSTRAINT_NAMES, CheckResult, check
+from ..core.manipulator import Manipulator
+from ..core.orientation import OrientationWorkspace, orientation_workspace, torsion_range
+from ..core.projected import ProjectedWorkspace, projected_workspace
+from ..errors import HexapodWorkspaceError, InputError, UnreachableReferenceError
 
 __all__ = ["main", "read_poses_file"]
 
@@ -518,7 +518,7 @@ def cmd_torsion_range(options: argparse.Namespace, out: TextIO) -> int:
 
 
 def cmd_replay(options: argparse.Namespace, out: TextIO) -> int:
-    """``replay``: what a recorded log holds (see :func:`hexapod_workspace.replay.run_replay`)."""
+    """``replay``: what a recorded log holds (see :func:`.replay.run_replay`)."""
     from .replay import run_replay
 
     return run_replay(
@@ -532,7 +532,7 @@ def cmd_replay(options: argparse.Namespace, out: TextIO) -> int:
 
 
 def cmd_demo(options: argparse.Namespace, out: TextIO) -> int:
-    """``demo``: the example manipulator end to end (see :mod:`hexapod_workspace.demo`)."""
+    """``demo``: the example manipulator end to end (see :mod:`hexapod_workspace.cli.demo`)."""
     from .demo import run_demo
 
     manipulator = load_manipulator(options)

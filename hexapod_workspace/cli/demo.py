@@ -19,10 +19,10 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from .errors import UnreachableReferenceError
-from .manipulator import Manipulator
-from .orientation import orientation_workspace
-from .projected import projected_workspace
+from ..core.manipulator import Manipulator
+from ..core.orientation import orientation_workspace
+from ..core.projected import projected_workspace
+from ..errors import UnreachableReferenceError
 
 __all__ = ["DEMO_CASES", "run_demo"]
 
@@ -34,7 +34,7 @@ DEMO_CASES: tuple[tuple[str, tuple[float, float, float]], ...] = (
 
 
 def _progress(label: str):
-    from .cli import ProgressBar
+    from .main import ProgressBar
 
     return ProgressBar(label)
 

@@ -1,7 +1,7 @@
 """Literal, per-pose reference implementations (slow on purpose).
 
 They follow the definitions of DESIGN.md section 2 line by line, one pose at a time, with a
-segment distance computed by a different method than :mod:`hexapod_workspace.constraints`
+segment distance computed by a different method than :mod:`hexapod_workspace.core.constraints`
 (interior critical point plus the four edge cases). Tests use them as independent evidence
 for the batched code; the benchmarks use them as the "straightforward per-pose loop" and the
 paper's literal projected-workspace procedure.
@@ -14,7 +14,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .manipulator import Manipulator
+from hexapod_workspace.core.manipulator import Manipulator
 
 __all__ = [
     "paper_projected_workspace",

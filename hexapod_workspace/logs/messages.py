@@ -3,7 +3,7 @@
 Every function returns plain nested dicts keyed by the ROS field names of the message named in
 its docstring (nested messages are dicts, message arrays lists of dicts, ``uint8[]`` is
 ``bytes``, numeric arrays numpy arrays). The node fills rclpy messages from them; the CLI's
-``--record`` builds rosbags messages from them (:func:`hexapod_workspace.recording.serialize`);
+``--record`` builds rosbags messages from them (:func:`hexapod_workspace.logs.recording.serialize`);
 replay reads recorded messages back with the inverse helpers at the end of this module.
 
 Units are SI (m, rad) as everywhere in the package. Stamps are ns since the epoch.
@@ -17,14 +17,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .rotations import approach_vector
+from ..core.rotations import approach_vector
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike, NDArray
 
-    from hexapod_workspace.constraints import CheckResult
-    from hexapod_workspace.orientation import OrientationWorkspace
-    from hexapod_workspace.projected import ProjectedWorkspace
+    from hexapod_workspace.core.constraints import CheckResult
+    from hexapod_workspace.core.orientation import OrientationWorkspace
+    from hexapod_workspace.core.projected import ProjectedWorkspace
 
 __all__ = [
     "KIND_NAMES",

@@ -3,7 +3,7 @@
 Cylindrical picture (DESIGN.md section 1): x = θ cos φ, y = θ sin φ, z = ψ. The orientation
 workspace at a position is the set of reachable (x, y, ψ) connected to the reference
 orientation (0, 0, 0). It is computed as in Bonev & Ryu, with every boundary located to a
-tolerance by the certified search of :mod:`hexapod_workspace.search`:
+tolerance by the certified search of :mod:`hexapod_workspace.core.search`:
 
 1. The ψ = 0 slice: ``n_rays`` rays from the origin, then again from the area centroid of
    that first polygon.
@@ -31,8 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..errors import InputError, ResolutionError
 from .constraints import relative_margins
-from .errors import InputError, ResolutionError
 from .manipulator import Manipulator
 from .projected import (
     reference_torsion_interval,

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .errors import ConfigError, GeometryError
+from ..errors import ConfigError, GeometryError
 from .params import flatten, load_params_file
 
 __all__ = ["PARAMETER_DEFAULTS", "HomePoseWarning", "Manipulator"]

@@ -5,7 +5,7 @@ Two methods:
 ``torsion_zero``
     Bonev & Ryu's approximation. For n_phi azimuths φ_k = k·2π/n_phi, the first tilt θ along
     the ray from θ = 0 at torsion ψ = 0 where a constraint is violated. Located to the
-    tolerance with the Lipschitz-certified march + bisection of :mod:`hexapod_workspace.search`
+    tolerance with the Lipschitz-certified march + bisection of :mod:`hexapod_workspace.core.search`
     (no 0.1° walk; why no thin violated band is stepped over is explained there).
 ``exact``
     The true shadow of the orientation workspace, which the paper leaves open: for each φ the
@@ -33,8 +33,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..errors import InputError, ResolutionError, UnreachableReferenceError
 from .constraints import CONSTRAINT_NAMES
-from .errors import InputError, ResolutionError, UnreachableReferenceError
 from .manipulator import Manipulator
 from .rotations import approach_vector
 from .search import RaySearch

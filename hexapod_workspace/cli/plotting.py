@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .orientation import OrientationWorkspace
-from .projected import ProjectedWorkspace
+from ..core.orientation import OrientationWorkspace
+from ..core.projected import ProjectedWorkspace
 
 __all__ = ["plot_orientation", "plot_projected"]
 

@@ -19,9 +19,9 @@ from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
-from hexapod_workspace import messages
 from hexapod_workspace.errors import LogReadError
-from hexapod_workspace.recording import (
+from hexapod_workspace.logs import messages
+from hexapod_workspace.logs.recording import (
     RESULT_QOS,
     SERVICE_QOS,
     LogContents,
@@ -393,7 +393,7 @@ def _rebuild(record: WorkspaceRecord) -> Any:
     position = np.array([summary["position"][k] for k in "xyz"])
     kind = int(summary["kind"])
     if kind == messages.ORIENTATION:
-        from hexapod_workspace.orientation import (
+        from hexapod_workspace.core.orientation import (
             OrientationSlice,
             OrientationWorkspace,
         )
@@ -426,7 +426,7 @@ def _rebuild(record: WorkspaceRecord) -> Any:
             tolerance=summary["tolerance"],
             elapsed=summary["elapsed"],
         )
-    from hexapod_workspace.projected import ProjectedWorkspace
+    from hexapod_workspace.core.projected import ProjectedWorkspace
 
     return _make(
         ProjectedWorkspace,
@@ -452,7 +452,7 @@ def _make(cls: type, **values: Any) -> Any:
 
 def _plot(summary: LogSummary, plot_dir: Path, out: IO[str], err: IO[str]) -> list[Path]:
     """Redraw the recorded workspaces; one that cannot be redrawn is a note, not a failure."""
-    from hexapod_workspace import plotting
+    from hexapod_workspace.cli import plotting
 
     plot_dir.mkdir(parents=True, exist_ok=True)
     written: list[Path] = []
