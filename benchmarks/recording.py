@@ -21,7 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from hexapod_workspace.logs import messages, recording
+from hexapod_workspace import logs
+from hexapod_workspace.logs import messages
 
 CLOUD = "sensor_msgs/msg/PointCloud2"
 
@@ -37,7 +38,7 @@ def timed(function: Callable[[int], object], repeat: int) -> float:
     return statistics.median(times)
 
 
-def drain_ms(writer: recording.LogWriter) -> float:
+def drain_ms(writer: logs.LogWriter) -> float:
     """How long a background writer still needs to get what was queued onto the disk, ms."""
     start = time.perf_counter()
     writer.flush()
@@ -58,27 +59,27 @@ def main() -> None:
 
     def ours(index: int) -> None:
         fields = messages.pointcloud_fields(points, frame_id="base", stamp_ns=stamp)
-        data = recording.serialize(CLOUD, fields)
-        with recording.LogWriter(workdir / f"ours{index}.mcap", flush_interval=0) as writer:
-            writer.add_channel("/hexapod_workspace/boundary", CLOUD, recording.RESULT_QOS)
+        data = logs.serialize(CLOUD, fields)
+        with logs.LogWriter(workdir / f"ours{index}.mcap", flush_interval=0) as writer:
+            writer.add_channel("/hexapod_workspace/boundary", CLOUD, logs.RESULT_QOS)
             writer.write("/hexapod_workspace/boundary", data, stamp)
 
     def ours_write_only(
         index: int,
-        data: bytes = recording.serialize(
+        data: bytes = logs.serialize(
             CLOUD, messages.pointcloud_fields(points, frame_id="base", stamp_ns=stamp)
         ),
     ) -> None:
-        with recording.LogWriter(workdir / f"w{index}.mcap", flush_interval=0) as writer:
-            writer.add_channel("/hexapod_workspace/boundary", CLOUD, recording.RESULT_QOS)
+        with logs.LogWriter(workdir / f"w{index}.mcap", flush_interval=0) as writer:
+            writer.add_channel("/hexapod_workspace/boundary", CLOUD, logs.RESULT_QOS)
             writer.write("/hexapod_workspace/boundary", data, stamp)
 
     def rosbags_writer(index: int) -> None:
         from rosbags.rosbag2 import StoragePlugin, Writer
 
         fields = messages.pointcloud_fields(points, frame_id="base", stamp_ns=stamp)
-        data = recording.serialize(CLOUD, fields)
-        store = recording.get_typestore()
+        data = logs.serialize(CLOUD, fields)
+        store = logs.get_typestore()
         with Writer(
             workdir / f"rosbags{index}", version=9, storage_plugin=StoragePlugin.MCAP
         ) as writer:
@@ -93,7 +94,7 @@ def main() -> None:
         fields = messages.pointcloud_fields(points, frame_id="base", stamp_ns=stamp)
         with (workdir / f"mcap_ros2_{index}.mcap").open("wb") as stream:
             writer = Writer(stream)
-            schema = writer.register_msgdef(CLOUD, recording.message_definition(CLOUD))
+            schema = writer.register_msgdef(CLOUD, logs.message_definition(CLOUD))
             writer.write_message("/hexapod_workspace/boundary", schema, fields, stamp, stamp)
             writer.finish()
 
@@ -145,7 +146,7 @@ def service_impact(repeat: int, workdir: Path) -> None:
     from hexapod_workspace.core.manipulator import Manipulator
 
     manipulator = Manipulator.from_params_file(example_config_path())
-    store = recording.get_typestore()
+    store = logs.get_typestore()
     stamp = time.time_ns()
     try:
         from hexapod_workspace.core.projected import projected_workspace
@@ -185,15 +186,15 @@ def service_impact(repeat: int, workdir: Path) -> None:
             )
         ]
 
-    def serve(writer: recording.LogWriter | None, produce: Callable[[], list]) -> None:
+    def serve(writer: logs.LogWriter | None, produce: Callable[[], list]) -> None:
         built = [
-            (topic, msgtype, recording.build_message(msgtype, fields))
+            (topic, msgtype, logs.build_message(msgtype, fields))
             for topic, msgtype, fields in produce()
         ]
         if writer is not None:
             for topic, msgtype, message in built:
-                writer.add_channel(topic, msgtype, recording.RESULT_QOS)
-                writer.write(topic, store.serialize_cdr(message, recording.store_name(msgtype)))
+                writer.add_channel(topic, msgtype, logs.RESULT_QOS)
+                writer.write(topic, store.serialize_cdr(message, logs.store_name(msgtype)))
 
     name = (
         "projected torsion_zero, 360 rays"
@@ -202,7 +203,7 @@ def service_impact(repeat: int, workdir: Path) -> None:
     )
     for label, produce in ((name, outputs),):  # the 10^6-point cloud: node_path() below
         without = timed(lambda _, make=produce: serve(None, make), repeat)
-        with recording.LogWriter(workdir / "node_run.mcap", background=True) as writer:
+        with logs.LogWriter(workdir / "node_run.mcap", background=True) as writer:
             with_recording = timed(lambda _, make=produce: serve(writer, make), repeat)
             drain = drain_ms(writer)
         print(
@@ -235,8 +236,8 @@ def node_path(points: np.ndarray, repeat: int, workdir: Path) -> None:
         fields=[PointField(**f) for f in fields["fields"]],
     )
     cloud.data = array.array("B", fields["data"])
-    with recording.LogWriter(workdir / "node_path.mcap", background=True) as writer:
-        writer.add_channel("/hexapod_workspace/projected_workspace", CLOUD, recording.RESULT_QOS)
+    with logs.LogWriter(workdir / "node_path.mcap", background=True) as writer:
+        writer.add_channel("/hexapod_workspace/projected_workspace", CLOUD, logs.RESULT_QOS)
         serialize_ms = timed(lambda _: serialize_message(cloud), repeat)
         record_ms = timed(
             lambda _: writer.write(

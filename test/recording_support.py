@@ -88,7 +88,7 @@ def write_foreign_log(path: Path, ours: list[tuple[str, str, bytes]] = ()) -> No
     foo_msgs/msg/Bar), then ``ours``: (topic, type, CDR bytes) written with full schemas."""
     from mcap.writer import Writer
 
-    from hexapod_workspace.logs.recording import message_definition
+    from hexapod_workspace.logs import message_definition
 
     with Path(path).open("wb") as stream:
         writer = Writer(stream)

@@ -9,10 +9,12 @@ import numpy as np
 import pytest
 from recording_support import NAN, plain
 
+from hexapod_workspace import logs
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import constraints
 from hexapod_workspace.core.manipulator import Manipulator
-from hexapod_workspace.logs import messages, recording
+from hexapod_workspace.core.resolution import WorkspaceKind
+from hexapod_workspace.logs import messages
 
 
 @pytest.fixture(scope="module")
@@ -77,7 +79,7 @@ def orientation_stub() -> SimpleNamespace:
 
 
 def roundtrip(msgtype: str, fields: dict) -> dict:
-    return plain(recording.deserialize(msgtype, recording.serialize(msgtype, fields)))
+    return plain(logs.deserialize(msgtype, logs.serialize(msgtype, fields)))
 
 
 def test_pose_check_fields_match_the_result(check_result: constraints.CheckResult) -> None:
@@ -136,7 +138,7 @@ def test_reachability_result_success_and_invalid(check_result: constraints.Check
 def test_projected_summary_and_boundary(method: str) -> None:
     workspace = projected_stub(method)
     kind = messages.workspace_kind(workspace)
-    assert messages.KIND_NAMES[kind] == method
+    assert WorkspaceKind(kind).label == method
     points = messages.boundary_points(workspace)
     assert points.shape == (36, 6)
     np.testing.assert_allclose(np.linalg.norm(points[:, :3], axis=1), 1.0)
@@ -153,7 +155,7 @@ def test_projected_summary_and_boundary(method: str) -> None:
 def test_orientation_summary_and_failure() -> None:
     workspace = orientation_stub()
     summary = messages.summary_fields(workspace, stamp_ns=5, frame_id="base")
-    assert summary["kind"] == messages.ORIENTATION
+    assert summary["kind"] == WorkspaceKind.ORIENTATION
     assert (summary["psi_min"], summary["psi_max"], summary["n_points"]) == (-0.1, 0.1, 24)
     assert math.isnan(summary["tilt_min"])
     failed = messages.summary_fields(
@@ -183,8 +185,8 @@ def test_pointcloud_round_trip_float32_nan_and_empty() -> None:
     assert fields["point_step"] == 24 and fields["row_step"] == 24_000
     assert [f["name"] for f in fields["fields"]] == list(messages.POINT_FIELD_NAMES)
     assert fields["is_dense"] is False
-    decoded = recording.deserialize(
-        "sensor_msgs/msg/PointCloud2", recording.serialize("sensor_msgs/msg/PointCloud2", fields)
+    decoded = logs.deserialize(
+        "sensor_msgs/msg/PointCloud2", logs.serialize("sensor_msgs/msg/PointCloud2", fields)
     )
     back = messages.pointcloud_to_array(decoded)
     np.testing.assert_array_equal(back, points.astype(np.float32).astype(float))
@@ -225,7 +227,7 @@ def test_stamps_and_small_pieces() -> None:
     assert messages.tilt_torsion_fields([0.1, 0.2, 0.3]) == {"phi": 0.1, "theta": 0.2, "psi": 0.3}
     pose = messages.commanded_pose_fields([0.1, 0.2, 0.3], [0, 0, 1], request_id="c1")
     assert roundtrip("hexapod_workspace_msgs/msg/CommandedPose", pose) == plain(pose)
-    request = messages.workspace_request_fields(messages.PROJECTED_EXACT, [0, 0, 1], n_rays=90)
+    request = messages.workspace_request_fields(WorkspaceKind.PROJECTED_EXACT, [0, 0, 1], n_rays=90)
     assert roundtrip("hexapod_workspace_msgs/msg/WorkspaceRequest", request) == plain(request)
 
 
@@ -233,6 +235,6 @@ def test_every_topic_type_is_in_the_typestore() -> None:
     for name, msgtype in messages.TYPES.items():
         if "/srv/" in msgtype:
             for part in ("_Request", "_Response"):
-                assert recording.message_definition(msgtype + part) is not None, name
+                assert logs.message_definition(msgtype + part) is not None, name
         else:
-            assert recording.message_definition(msgtype), name
+            assert logs.message_definition(msgtype), name

@@ -23,11 +23,12 @@ from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Rosbag2Writer
 from rosbags.rosbag2.metadata import parse_qos
 
+from hexapod_workspace import logs
 from hexapod_workspace._resources import data_dir, example_config_path
 from hexapod_workspace.core import constraints
 from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.errors import LogReadError, RecordingError
-from hexapod_workspace.logs import messages, recording
+from hexapod_workspace.logs import messages
 
 SUMMARY = "hexapod_workspace_msgs/msg/WorkspaceSummary"
 CLOUD = "sensor_msgs/msg/PointCloud2"
@@ -50,20 +51,20 @@ def sample_messages() -> list[tuple[str, str, str, dict]]:
         message="reference orientation unreachable",
     )
     topics, types = messages.TOPICS, messages.TYPES
-    check_req, check_resp = recording.service_topics(topics["check_poses"])
-    trig_req, trig_resp = recording.service_topics(topics["compute_projected_workspace"])
-    cw_req, cw_resp = recording.service_topics(topics["compute_workspace"])
+    check_req, check_resp = logs.service_topics(topics["check_poses"])
+    trig_req, trig_resp = logs.service_topics(topics["compute_projected_workspace"])
+    cw_req, cw_resp = logs.service_topics(topics["compute_workspace"])
     return [
         (
             topics["commanded_pose"],
             types["commanded_pose"],
-            recording.REQUEST_QOS,
+            logs.REQUEST_QOS,
             messages.commanded_pose_fields(angles[1], result.position, request_id="c1"),
         ),
         (
             topics["reachability"],
             types["reachability"],
-            recording.RESULT_QOS,
+            logs.RESULT_QOS,
             messages.reachability_result_fields(
                 result,
                 position=result.position,
@@ -77,45 +78,45 @@ def sample_messages() -> list[tuple[str, str, str, dict]]:
         (
             topics["workspace_request"],
             types["workspace_request"],
-            recording.REQUEST_QOS,
+            logs.REQUEST_QOS,
             messages.workspace_request_fields(1, [0, 0, 1], request_id="w1", n_rays=36),
         ),
-        (topics["workspace_summary"], types["workspace_summary"], recording.RESULT_QOS, summary),
+        (topics["workspace_summary"], types["workspace_summary"], logs.RESULT_QOS, summary),
         (
             topics["projected_workspace"],
             types["projected_workspace"],
-            recording.RESULT_QOS,
+            logs.RESULT_QOS,
             messages.pointcloud_fields(points, frame_id="base", stamp_ns=10),
         ),
         (
             check_req,
             types["check_poses"] + "_Request",
-            recording.SERVICE_QOS,
+            logs.SERVICE_QOS,
             messages.check_poses_request_fields(result.position, angles),
         ),
         (
             check_resp,
             types["check_poses"] + "_Response",
-            recording.SERVICE_QOS,
+            logs.SERVICE_QOS,
             messages.check_poses_response_fields(result),
         ),
-        (trig_req, "std_srvs/srv/Trigger_Request", recording.SERVICE_QOS, {}),
+        (trig_req, "std_srvs/srv/Trigger_Request", logs.SERVICE_QOS, {}),
         (
             trig_resp,
             "std_srvs/srv/Trigger_Response",
-            recording.SERVICE_QOS,
+            logs.SERVICE_QOS,
             {"success": True, "message": "projected workspace: tilt 0..30 deg"},
         ),
         (
             cw_req,
             types["compute_workspace"] + "_Request",
-            recording.SERVICE_QOS,
+            logs.SERVICE_QOS,
             {"request": messages.workspace_request_fields(2, [0, 0, 1])},
         ),
         (
             cw_resp,
             types["compute_workspace"] + "_Response",
-            recording.SERVICE_QOS,
+            logs.SERVICE_QOS,
             messages.compute_workspace_response_fields(
                 None, stamp_ns=10, frame_id="base", summary=summary
             ),
@@ -127,7 +128,7 @@ def sample_messages() -> list[tuple[str, str, str, dict]]:
 def finished_log(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list]:
     path = tmp_path_factory.mktemp("log") / "session.mcap"
     written = []
-    with recording.LogWriter(path) as writer:
+    with logs.LogWriter(path) as writer:
         for i, (topic, msgtype, qos, fields) in enumerate(sample_messages()):
             writer.write_fields(topic, msgtype, fields, 1_000_000_000 + i, qos=qos)
             written.append((topic, msgtype, plain(fields)))
@@ -136,16 +137,16 @@ def finished_log(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list]:
 
 def test_typestore_has_every_interface_with_full_definitions() -> None:
     for path in data_dir("msg").glob("*.msg"):
-        text = recording.message_definition(f"hexapod_workspace_msgs/msg/{path.stem}")
+        text = logs.message_definition(f"hexapod_workspace_msgs/msg/{path.stem}")
         assert text.strip() or path.stem == "Empty"
-    text = recording.message_definition("hexapod_workspace_msgs/srv/CheckPoses_Request")
+    text = logs.message_definition("hexapod_workspace_msgs/srv/CheckPoses_Request")
     assert "=" * 80 + "\nMSG: hexapod_workspace_msgs/TiltTorsion\n" in text
     assert "MSG: geometry_msgs/Point" in text
-    summary = recording.message_definition(SUMMARY)
+    summary = logs.message_definition(SUMMARY)
     assert "MSG: builtin_interfaces/Time" in summary  # ROS 2 form, not ROS 1 "time"
-    assert recording.type_hash(SUMMARY).startswith("RIHS01_")
+    assert logs.type_hash(SUMMARY).startswith("RIHS01_")
     with pytest.raises(KeyError, match="unknown ROS type"):
-        recording.message_definition("nope_msgs/msg/Nope")
+        logs.message_definition("nope_msgs/msg/Nope")
 
 
 def test_every_message_decodes_with_rosbags_and_mcap_ros2(finished_log) -> None:
@@ -153,7 +154,7 @@ def test_every_message_decodes_with_rosbags_and_mcap_ros2(finished_log) -> None:
     expected = [(topic, msgtype, fields) for topic, msgtype, fields in written]
     by_rosbags = [(t, m, plain(msg)) for t, m, msg in read_with_rosbags(path)]
     by_mcap_ros2 = [(t, m, plain(msg)) for t, m, msg in read_with_mcap_ros2(path)]
-    ours = [(m.topic, m.msgtype, plain(m.message)) for m in recording.read_log(path).messages]
+    ours = [(m.topic, m.msgtype, plain(m.message)) for m in logs.read_log(path).messages]
     assert by_rosbags == expected
     assert by_mcap_ros2 == expected
     assert ours == expected
@@ -175,7 +176,7 @@ def test_rosbag2_form_schemas_channels_statistics_metadata(finished_log) -> None
         qos = parse_qos(channel.metadata["offered_qos_profiles"])
         assert len(qos) == 1
         schema = summary.schemas[channel.schema_id]
-        assert channel.metadata["topic_type_hash"] == recording.type_hash(schema.name)
+        assert channel.metadata["topic_type_hash"] == logs.type_hash(schema.name)
     result_channel = next(
         c for c in summary.channels.values() if c.topic.endswith("/workspace_summary")
     )
@@ -190,22 +191,22 @@ def test_rosbag2_form_schemas_channels_statistics_metadata(finished_log) -> None
 def test_bag_directory_written_by_rosbags_is_read(tmp_path: Path) -> None:
     """The other rosbag2 form (directory + metadata.yaml), written by an independent writer."""
     bag = tmp_path / "bag"
-    store = recording.get_typestore()
+    store = logs.get_typestore()
     fields = messages.summary_fields(
         None, stamp_ns=3, frame_id="base", kind=0, position=[0, 0, 1], message="bad"
     )
     with Rosbag2Writer(bag, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
         connection = writer.add_connection("/hexapod_workspace/summary", SUMMARY, typestore=store)
-        writer.write(connection, 5, recording.serialize(SUMMARY, fields))
-    contents = recording.read_log(bag)
+        writer.write(connection, 5, logs.serialize(SUMMARY, fields))
+    contents = logs.read_log(bag)
     assert [plain(m.message) for m in contents.messages] == [plain(fields)]
     assert contents.finished and not contents.problems
     (bag / "metadata.yaml").unlink()  # a killed `ros2 bag record` leaves no metadata.yaml
-    assert len(recording.read_log(bag).messages) == 1
+    assert len(logs.read_log(bag).messages) == 1
 
 
 def test_close_is_idempotent_and_write_after_close_fails(tmp_path: Path) -> None:
-    writer = recording.LogWriter(tmp_path / "a.mcap")
+    writer = logs.LogWriter(tmp_path / "a.mcap")
     writer.write_fields("/t", SUMMARY, {"request_id": "x"})
     writer.close()
     writer.finish()
@@ -213,27 +214,27 @@ def test_close_is_idempotent_and_write_after_close_fails(tmp_path: Path) -> None
     with pytest.raises(RecordingError, match="closed"):
         writer.write_fields("/t", SUMMARY, {})
     with pytest.raises(KeyError):
-        recording.LogWriter(tmp_path / "b.mcap").write("/never-added", b"")
+        logs.LogWriter(tmp_path / "b.mcap").write("/never-added", b"")
 
 
 def test_unwritable_directory_raises_recording_error(tmp_path: Path) -> None:
     blocker = tmp_path / "a_file"
     blocker.write_text("not a directory")
     with pytest.raises(RecordingError, match="cannot create MCAP log"):
-        recording.LogWriter(blocker / "logs" / "x.mcap")
+        logs.LogWriter(blocker / "logs" / "x.mcap")
 
 
 @pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full (Linux)")
 def test_full_disk_at_creation_raises_recording_error() -> None:
     with pytest.raises(RecordingError, match="No space left on device"):
-        recording.LogWriter("/dev/full")
+        logs.LogWriter("/dev/full")
 
 
 # A file-size limit makes the disk "full" in the middle of a log, in a child process only.
 FULL_DISK_CHILD = textwrap.dedent(
     """
     import resource, signal, sys, threading
-    from hexapod_workspace.logs import recording
+    from hexapod_workspace import logs
     from hexapod_workspace.errors import RecordingError
     signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
     resource.setrlimit(resource.RLIMIT_FSIZE, (200_000, 200_000))
@@ -242,11 +243,11 @@ FULL_DISK_CHILD = textwrap.dedent(
     def on_error(error):
         print("on_error", error.__cause__.errno, flush=True)
         reported.set()
-    writer = recording.LogWriter(path, flush_interval=0.01 if mode == "timer" else 0,
+    writer = logs.LogWriter(path, flush_interval=0.01 if mode == "timer" else 0,
                                  flush_messages=1 if mode == "background" else 64,
                                  background=mode == "background", on_error=on_error)
     writer.add_channel("/t", "sensor_msgs/msg/PointCloud2")
-    data = recording.serialize("sensor_msgs/msg/PointCloud2", {"data": bytes(300_000)})
+    data = logs.serialize("sensor_msgs/msg/PointCloud2", {"data": bytes(300_000)})
     writer.write("/t", data)
     if mode in ("timer", "background"):
         print("reported", reported.wait(60), writer.closed, flush=True)
@@ -283,25 +284,25 @@ def test_disk_full_mid_log_is_reported_not_raised_elsewhere(tmp_path: Path, mode
         assert lines[0].startswith("raised writing MCAP log") and "File too large" in lines[0]
         assert lines[1:] == ["closed True", "refused", "done"]
     assert "Traceback" not in child.stderr
-    recording.read_log(tmp_path / "full.mcap")  # what reached the disk is still readable
+    logs.read_log(tmp_path / "full.mcap")  # what reached the disk is still readable
 
 
 def test_background_writer_keeps_order_and_drains_on_close(tmp_path: Path) -> None:
     path = tmp_path / "background.mcap"
-    with recording.LogWriter(path, background=True, flush_messages=7) as writer:
+    with logs.LogWriter(path, background=True, flush_messages=7) as writer:
         for i in range(100):
             writer.write_fields("/s", SUMMARY, {"n_points": i}, 1_000 + i)
         writer.flush()
         assert sum(writer.message_counts.values()) == 100
-    assert [m.message.n_points for m in recording.read_log(path).messages] == list(range(100))
+    assert [m.message.n_points for m in logs.read_log(path).messages] == list(range(100))
 
 
 def test_run_log_path_is_named_by_start_time_and_unique(tmp_path: Path) -> None:
     start = 1_763_758_800_123_000_000  # 2025-11-21T21:00:00.123Z
-    first = recording.run_log_path(tmp_path, start_ns=start)
+    first = logs.run_log_path(tmp_path, start_ns=start)
     assert first.name == "hexapod_workspace_20251121T210000.123Z.mcap"
     first.touch()
-    assert recording.run_log_path(tmp_path, start_ns=start) != first
+    assert logs.run_log_path(tmp_path, start_ns=start) != first
 
 
 # --------------------------------------------------------------------------- durability
@@ -309,11 +310,11 @@ def test_run_log_path_is_named_by_start_time_and_unique(tmp_path: Path) -> None:
 CHILD = textwrap.dedent(
     """
     import sys, time
-    from hexapod_workspace.logs import recording
+    from hexapod_workspace import logs
     path, mode = sys.argv[1], sys.argv[2]
     kwargs = {"count": dict(flush_interval=0, flush_messages=5),
               "timer": dict(flush_interval=0.05, flush_messages=10_000)}[mode]
-    with recording.LogWriter(path, **kwargs) as writer:
+    with logs.LogWriter(path, **kwargs) as writer:
         total = 12 if mode == "count" else 3
         for i in range(total):
             writer.write_fields("/hexapod_workspace/summary",
@@ -340,18 +341,18 @@ def test_sigkill_keeps_every_flushed_message(tmp_path: Path) -> None:
     child = start_child(path, "count")
     child.send_signal(signal.SIGKILL)
     child.wait()
-    contents = recording.read_log(path)
+    contents = logs.read_log(path)
     assert [m.message.request_id for m in contents.messages] == [f"r{i}" for i in range(10)]
     assert not contents.finished and contents.problems
     by_mcap_ros2 = read_with_mcap_ros2(path)
     assert [m.request_id for _, _, m in by_mcap_ros2] == [f"r{i}" for i in range(10)]
-    store_decoded = [recording.deserialize(m.msgtype, m.data) for m in contents.messages]
+    store_decoded = [logs.deserialize(m.msgtype, m.data) for m in contents.messages]
     assert [plain(m) for m in store_decoded] == [plain(m.message) for m in contents.messages]
-    recovered = recording.recover_log(path, tmp_path / "recovered.mcap")
+    recovered = logs.recover_log(path, tmp_path / "recovered.mcap")
     assert recovered.problems == contents.problems
     by_rosbags = read_with_rosbags(tmp_path / "recovered.mcap")  # needs a finished file
     assert [plain(m) for _, _, m in by_rosbags] == [plain(m.message) for m in contents.messages]
-    again = recording.read_log(tmp_path / "recovered.mcap")
+    again = logs.read_log(tmp_path / "recovered.mcap")
     assert again.finished and not again.problems
     assert [m.log_time_ns for m in again.messages] == [m.log_time_ns for m in contents.messages]
 
@@ -363,13 +364,13 @@ def test_sigkill_after_the_flush_interval_keeps_messages(tmp_path: Path) -> None
     try:
         # Wait (no timed assertion) until the flusher has written the 3 messages out.
         for _ in range(1200):
-            if len(recording.read_log(path).messages) == 3:
+            if len(logs.read_log(path).messages) == 3:
                 break
             threading.Event().wait(0.05)
     finally:
         child.send_signal(signal.SIGKILL)
         child.wait()
-    assert [m.message.n_points for m in recording.read_log(path).messages] == [0, 1, 2]
+    assert [m.message.n_points for m in logs.read_log(path).messages] == [0, 1, 2]
 
 
 def test_sigint_finishes_a_playable_log(tmp_path: Path) -> None:
@@ -377,7 +378,7 @@ def test_sigint_finishes_a_playable_log(tmp_path: Path) -> None:
     child = start_child(path, "count")
     child.send_signal(signal.SIGINT)
     child.wait()
-    contents = recording.read_log(path)
+    contents = logs.read_log(path)
     assert contents.finished and not contents.problems
     assert len(contents.messages) == 12
     assert [m.request_id for _, _, m in read_with_rosbags(path)] == [f"r{i}" for i in range(12)]
@@ -388,7 +389,7 @@ def test_sigint_finishes_a_playable_log(tmp_path: Path) -> None:
 
 def test_truncation_anywhere_reads_an_intact_prefix(tmp_path: Path) -> None:
     source = tmp_path / "full.mcap"
-    with recording.LogWriter(source, flush_messages=1) as writer:
+    with logs.LogWriter(source, flush_messages=1) as writer:
         for i in range(6):
             writer.write_fields("/s", SUMMARY, {"request_id": f"r{i}"}, 100 + i)
     data = source.read_bytes()
@@ -397,7 +398,7 @@ def test_truncation_anywhere_reads_an_intact_prefix(tmp_path: Path) -> None:
         damaged = tmp_path / "cut.mcap"
         damaged.write_bytes(data[:cut])
         try:
-            contents = recording.read_log(damaged)
+            contents = logs.read_log(damaged)
         except LogReadError:
             assert cut < 8  # not even the magic is there
             continue
@@ -410,22 +411,22 @@ def test_truncation_anywhere_reads_an_intact_prefix(tmp_path: Path) -> None:
 
 def test_corrupt_chunk_is_skipped_and_reported(tmp_path: Path) -> None:
     path = tmp_path / "corrupt.mcap"
-    with recording.LogWriter(path, flush_messages=1) as writer:
+    with logs.LogWriter(path, flush_messages=1) as writer:
         for i in range(3):
             writer.write_fields("/s", SUMMARY, {"request_id": f"request-{i}"}, 100 + i)
     data = bytearray(path.read_bytes())
     where = data.find(b"request-1")
     data[where] ^= 0xFF
     path.write_bytes(bytes(data))
-    contents = recording.read_log(path)
+    contents = logs.read_log(path)
     assert [m.message.request_id for m in contents.messages] == ["request-0", "request-2"]
     assert any("corrupt" in p for p in contents.problems)
 
 
 def test_unknown_types_are_skipped_with_a_note(tmp_path: Path) -> None:
     path = tmp_path / "foreign.mcap"
-    write_foreign_log(path, [("/s", SUMMARY, recording.serialize(SUMMARY, {"request_id": "k"}))])
-    contents = recording.read_log(path)
+    write_foreign_log(path, [("/s", SUMMARY, logs.serialize(SUMMARY, {"request_id": "k"}))])
+    contents = logs.read_log(path)
     assert [m.topic for m in contents.messages] == ["/s"]
     assert contents.topics["/foo"].count == 1 and contents.topics["/foo"].decoded == 0
     assert contents.problems == [
@@ -435,12 +436,12 @@ def test_unknown_types_are_skipped_with_a_note(tmp_path: Path) -> None:
 
 def test_not_a_log(tmp_path: Path) -> None:
     with pytest.raises(LogReadError, match="no such file"):
-        recording.read_log(tmp_path / "missing.mcap")
+        logs.read_log(tmp_path / "missing.mcap")
     junk = tmp_path / "junk.mcap"
     junk.write_bytes(b"this is not an mcap file")
     with pytest.raises(LogReadError, match="not an MCAP file"):
-        recording.read_log(junk)
+        logs.read_log(junk)
     empty_dir = tmp_path / "empty"
     empty_dir.mkdir()
     with pytest.raises(LogReadError, match="without metadata.yaml"):
-        recording.read_log(empty_dir)
+        logs.read_log(empty_dir)

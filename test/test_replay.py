@@ -17,9 +17,12 @@ from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Rosbag2Writer
 from test_messages import orientation_stub, projected_stub
 
-from hexapod_workspace.cli.replay import record_results, run_replay, summarize_log
+from hexapod_workspace import logs
+from hexapod_workspace.cli.replay import run_replay
 from hexapod_workspace.core import constraints
-from hexapod_workspace.logs import messages, recording
+from hexapod_workspace.logs import messages
+from hexapod_workspace.logs.record import record_results
+from hexapod_workspace.logs.summary import summarize_log
 
 
 def replay(*args: object, **kwargs: object) -> tuple[int, str, str]:
@@ -101,7 +104,7 @@ def test_summary_and_cloud_of_one_computation_are_paired(tmp_path: Path) -> None
     cloud = messages.pointcloud_fields(
         messages.boundary_points(workspace), frame_id="base", stamp_ns=9
     )
-    with recording.LogWriter(path) as writer:
+    with logs.LogWriter(path) as writer:
         writer.write_fields("/n/projected_workspace", "sensor_msgs/msg/PointCloud2", cloud, 1)
         writer.write_fields("/n/workspace_summary", messages.TYPES["workspace_summary"], summary, 2)
         writer.write_fields(
@@ -223,7 +226,7 @@ def test_unknown_topics_are_skipped_with_a_note(tmp_path: Path) -> None:
     assert code == 2 and "foo_msgs/msg/Bar is unknown" in err and "nothing usable" in err
     summary = messages.summary_fields(projected_stub(), stamp_ns=1, frame_id="base")
     summary_type = messages.TYPES["workspace_summary"]
-    write_foreign_log(path, [("/s", summary_type, recording.serialize(summary_type, summary))])
+    write_foreign_log(path, [("/s", summary_type, logs.serialize(summary_type, summary))])
     code, out, err = replay(path)
     assert code == 0
     assert err == "note: /foo: type foo_msgs/msg/Bar is unknown here; 1 message(s) skipped\n"
@@ -235,11 +238,9 @@ def test_bag_directory_and_bad_rate(tmp_path: Path) -> None:
     fields = messages.summary_fields(orientation_stub(), stamp_ns=3, frame_id="base")
     with Rosbag2Writer(bag, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
         connection = writer.add_connection(
-            "/ws/summary", messages.TYPES["workspace_summary"], typestore=recording.get_typestore()
+            "/ws/summary", messages.TYPES["workspace_summary"], typestore=logs.get_typestore()
         )
-        writer.write(
-            connection, 5, recording.serialize(messages.TYPES["workspace_summary"], fields)
-        )
+        writer.write(connection, 5, logs.serialize(messages.TYPES["workspace_summary"], fields))
     code, out, _ = replay(bag)
     assert code == 0 and "orientation: psi -5.730..5.730 deg" in out
     assert replay(bag, rate=-1.0)[0] == 2
@@ -249,7 +250,7 @@ def test_rejected_requests_with_nan_replay_as_json(tmp_path: Path) -> None:
     """A node records bad requests too (NaN position): JSON output stays valid (null)."""
     path = tmp_path / "bad.mcap"
     nan = float("nan")
-    with recording.LogWriter(path) as writer:
+    with logs.LogWriter(path) as writer:
         writer.write_fields(
             "/n/check_poses/request",
             messages.TYPES["check_poses"] + "_Request",
@@ -281,7 +282,7 @@ def test_rejected_requests_with_nan_replay_as_json(tmp_path: Path) -> None:
 
 def test_empty_finished_log_is_fine(tmp_path: Path) -> None:
     path = tmp_path / "idle.mcap"
-    with recording.LogWriter(path) as writer:
+    with logs.LogWriter(path) as writer:
         writer.add_channel("/hexapod_workspace/summary", messages.TYPES["workspace_summary"])
     code, out, err = replay(path)
     assert code == 0 and err == "" and "0 messages" in out
@@ -329,14 +330,14 @@ def test_publish_republishes_recorded_clouds(tmp_path: Path, monkeypatch) -> Non
         messages.pointcloud_fields(rng.normal(size=(100 * (i + 1), 6)), frame_id="base", stamp_ns=i)
         for i in range(3)
     ]
-    with recording.LogWriter(path) as writer:
+    with logs.LogWriter(path) as writer:
         for i, cloud in enumerate(clouds):
             writer.write_fields(
                 "/replay_test/boundary",
                 "sensor_msgs/msg/PointCloud2",
                 cloud,
                 1_000_000 * i,
-                qos=recording.REQUEST_QOS,
+                qos=logs.REQUEST_QOS,
             )
     context = rclpy.Context()
     rclpy.init(context=context)

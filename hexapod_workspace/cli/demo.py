@@ -34,7 +34,7 @@ DEMO_CASES: tuple[tuple[str, tuple[float, float, float]], ...] = (
 
 
 def _progress(label: str):
-    from .main import ProgressBar
+    from .progress import ProgressBar
 
     return ProgressBar(label)
 
@@ -56,8 +56,8 @@ def run_demo(manipulator: Manipulator, out_dir: Path, *, out: TextIO, as_json: b
     int
         0, or 1 when a case's reference orientation is unreachable (reported in the table).
     """
+    from ..logs.record import record_results
     from .plotting import plot_orientation, plot_projected
-    from .replay import record_results
 
     out_dir.mkdir(parents=True, exist_ok=True)
     rows: list[dict[str, Any]] = []

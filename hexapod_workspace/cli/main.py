@@ -23,11 +23,13 @@ from numpy.typing import NDArray
 
 from .. import __version__
 from .._resources import example_config_path
+from ..core import resolution
 from ..core.constraints import CONSTRAINT_NAMES, CheckResult, check
 from ..core.manipulator import Manipulator
 from ..core.orientation import OrientationWorkspace, orientation_workspace, torsion_range
 from ..core.projected import ProjectedWorkspace, projected_workspace
 from ..errors import HexapodWorkspaceError, InputError, UnreachableReferenceError
+from .progress import ProgressBar
 
 __all__ = ["main", "read_poses_file"]
 
@@ -54,45 +56,22 @@ def _finite(values: Sequence[float], what: str) -> NDArray[np.float64]:
     return array
 
 
-class ProgressBar:
-    """A one-line progress bar on stderr, drawn only when stderr is a terminal."""
-
-    def __init__(self, label: str, *, stream: TextIO | None = None) -> None:
-        self.stream = sys.stderr if stream is None else stream
-        self.enabled = bool(getattr(self.stream, "isatty", lambda: False)())
-        self.label = label
-        self.shown = -1
-
-    def __call__(self, fraction: float) -> None:
-        if not self.enabled:
-            return
-        percent = int(100 * min(max(fraction, 0.0), 1.0))
-        if percent == self.shown:
-            return
-        self.shown = percent
-        filled = percent * 30 // 100
-        self.stream.write(f"\r{self.label} [{'#' * filled}{'.' * (30 - filled)}] {percent:3d}%")
-        if percent >= 100:
-            self.stream.write("\n")
-        self.stream.flush()
-
-
 def _degrees(values: Any) -> Any:
     """Radians to degrees as plain Python floats (lists for arrays)."""
     converted = np.degrees(values)
     return converted.tolist() if isinstance(converted, np.ndarray) else float(converted)
 
 
-def _tolerance(options: argparse.Namespace, default_rad: float) -> float:
+def _tolerance(options: argparse.Namespace) -> float:
     if options.tol_deg is None:
-        return default_rad
+        return resolution.DEFAULT_TOLERANCE
     return math.radians(_finite([options.tol_deg], "--tol-deg")[0])
 
 
 def _record(options: argparse.Namespace, manipulator: Manipulator, results: list) -> None:
     """Write ``--record FILE`` (rosbag2-form MCAP) when asked."""
     if getattr(options, "record", None):
-        from .replay import record_results
+        from ..logs.record import record_results
 
         path = record_results(options.record, results, frame_id=manipulator.frame_id)
         print(f"{PROG}: recorded {len(results)} result(s) to {path}", file=sys.stderr)
@@ -396,7 +375,7 @@ def _projected_text(workspace: ProjectedWorkspace, out: TextIO) -> None:
 def cmd_projected(options: argparse.Namespace, out: TextIO) -> int:
     """``projected``: the projected orientation workspace (attainable tool directions)."""
     manipulator = load_manipulator(options)
-    tolerance = _tolerance(options, 1e-6)
+    tolerance = _tolerance(options)
     try:
         workspace = projected_workspace(
             manipulator,
@@ -408,7 +387,7 @@ def cmd_projected(options: argparse.Namespace, out: TextIO) -> int:
     except UnreachableReferenceError as error:
         return _unreachable(error, manipulator.position, options, out)
     if options.plot:
-        other = "exact" if options.method == "torsion_zero" else "torsion_zero"
+        other = next(m.value for m in resolution.Method if m.value != options.method)
         overlay = projected_workspace(
             manipulator,
             method=other,
@@ -479,7 +458,7 @@ def cmd_orientation(options: argparse.Namespace, out: TextIO) -> int:
             manipulator,
             n_rays=options.n_rays,
             psi_step=step,
-            tolerance=_tolerance(options, 1e-5),
+            tolerance=_tolerance(options),
             progress=ProgressBar("orientation"),
         )
     except UnreachableReferenceError as error:
@@ -498,7 +477,7 @@ def cmd_torsion_range(options: argparse.Namespace, out: TextIO) -> int:
     manipulator = load_manipulator(options)
     phi, theta = _finite(options.direction, "--direction")
     found = torsion_range(
-        manipulator, math.radians(phi), math.radians(theta), tolerance=_tolerance(options, 1e-6)
+        manipulator, math.radians(phi), math.radians(theta), tolerance=_tolerance(options)
     )
     intervals = np.degrees(found.intervals).tolist()
     if options.json:
@@ -617,8 +596,14 @@ def build_parser() -> argparse.ArgumentParser:
         "reach. torsion_zero follows the paper (psi = 0); exact maximises over the torsion.",
     )
     _add_global_options(sub, top=False)
-    sub.add_argument("--method", choices=("torsion_zero", "exact"), default="torsion_zero")
-    sub.add_argument("--n-phi", type=int, default=360, metavar="N", help="azimuths (3-7200)")
+    sub.add_argument(
+        "--method",
+        choices=[method.value for method in resolution.Method],
+        default=resolution.Method.TORSION_ZERO.value,
+    )
+    sub.add_argument(
+        "--n-phi", type=int, default=resolution.DEFAULT_N_PHI, metavar="N", help="azimuths (3-7200)"
+    )
     _add_workspace_options(sub, "polar plot, both methods overlaid")
     sub.set_defaults(handler=cmd_projected)
 
@@ -629,8 +614,12 @@ def build_parser() -> argparse.ArgumentParser:
         "previous slice; psi_min and psi_max located to the tolerance.",
     )
     _add_global_options(sub, top=False)
-    sub.add_argument("--n-rays", type=int, default=180, metavar="N", help="rays per slice")
-    sub.add_argument("--psi-step-deg", type=float, default=1.0, metavar="S")
+    sub.add_argument(
+        "--n-rays", type=int, default=resolution.DEFAULT_N_RAYS, metavar="N", help="rays per slice"
+    )
+    sub.add_argument(
+        "--psi-step-deg", type=float, default=math.degrees(resolution.DEFAULT_PSI_STEP), metavar="S"
+    )
     _add_workspace_options(sub, "surface + top view (paper's Fig. 4/5)")
     sub.set_defaults(handler=cmd_orientation)
 

@@ -1,8 +1,7 @@
-"""Replay recorded MCAP logs: list what they hold, redraw the workspaces, republish on ROS.
+"""``hexapod-workspace replay LOG``: list what a log holds, redraw its workspaces, republish it.
 
-:func:`run_replay` is what ``hexapod-workspace replay LOG`` calls; :func:`record_results` is
-what ``check``/``projected``/``orientation --record FILE`` call. Neither needs ROS; only
-``--publish`` imports rclpy, lazily.
+The log is read by :mod:`hexapod_workspace.logs.summary`; ``--publish`` hands it to
+:mod:`hexapod_workspace.ros.republish` (rclpy, imported only then).
 """
 
 from __future__ import annotations
@@ -10,211 +9,26 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-import os
 import sys
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
+from hexapod_workspace.core.resolution import WorkspaceKind
 from hexapod_workspace.errors import LogReadError
-from hexapod_workspace.logs import messages
-from hexapod_workspace.logs.recording import (
-    RESULT_QOS,
-    SERVICE_QOS,
-    LogContents,
-    LogMessage,
-    LogWriter,
-    iter_log,
-    message_to_fields,
-    service_topics,
-)
 
 if TYPE_CHECKING:
-    from collections.abc import Iterable, Sequence
-
-__all__ = [
-    "LogSummary",
-    "PoseCheckCall",
-    "WorkspaceRecord",
-    "record_results",
-    "run_replay",
-    "summarize_log",
-]
-
-_SUMMARY = "hexapod_workspace_msgs/msg/WorkspaceSummary"
-_CLOUD = "sensor_msgs/msg/PointCloud2"
-_REACHABILITY = "hexapod_workspace_msgs/msg/ReachabilityResult"
-_WORKSPACE_RESPONSE = "hexapod_workspace_msgs/srv/ComputeWorkspace_Response"
-_CHECK_REQUEST = "hexapod_workspace_msgs/srv/CheckPoses_Request"
-_CHECK_RESPONSE = "hexapod_workspace_msgs/srv/CheckPoses_Response"
-_TRIGGER_RESPONSE = "std_srvs/srv/Trigger_Response"
-_DISCOVERY = "ROS_AUTOMATIC_DISCOVERY_RANGE"
-
-
-# --------------------------------------------------------------------------- what a log holds
-
-
-@dataclass
-class WorkspaceRecord:
-    """One recorded workspace result: its summary fields and, when recorded, its boundary.
-
-    Attributes
-    ----------
-    log_time_ns : int
-        When the summary was recorded.
-    sources : list of str
-        Topics it was found on (a topic summary and a service response of the same computation
-        are one record).
-    summary : dict
-        WorkspaceSummary fields (SI units).
-    points : ndarray, shape (M, 6) or None
-        Boundary points x, y, z, φ, θ, ψ.
-    """
-
-    log_time_ns: int
-    sources: list[str]
-    summary: dict[str, Any]
-    points: np.ndarray | None = None
-
-    @property
-    def key(self) -> tuple[Any, ...]:
-        """Identity of a computation: header stamp, request id, kind."""
-        header = self.summary["header"]
-        return (
-            messages.stamp_to_ns(header["stamp"]),
-            self.summary["request_id"],
-            int(self.summary["kind"]),
-        )
-
-
-@dataclass
-class PoseCheckCall:
-    """One recorded CheckPoses call (request and its response, paired in order)."""
-
-    log_time_ns: int
-    topic: str
-    position: list[float] | None = None
-    angles: np.ndarray | None = None
-    response: dict[str, Any] | None = None
-
-
-@dataclass
-class LogSummary:
-    """Everything :func:`run_replay` reports about a log."""
-
-    contents: LogContents
-    workspaces: list[WorkspaceRecord] = field(default_factory=list)
-    checks: list[PoseCheckCall] = field(default_factory=list)
-    reachability: list[dict[str, Any]] = field(default_factory=list)
-    triggers: list[dict[str, Any]] = field(default_factory=list)
-    decoded: int = 0
-
-
-def summarize_log(
-    log: str | Path, *, keep_messages: bool = False
-) -> tuple[LogSummary, list[LogMessage]]:
-    """Read a log and gather its workspace results, pose checks and reachability results.
-
-    Parameters
-    ----------
-    log : str or Path
-        Bare ``.mcap`` file or rosbag2 bag directory.
-    keep_messages : bool
-        Also return every message read (for republishing).
-
-    Raises
-    ------
-    LogReadError
-        The log cannot be opened at all.
-    """
-    contents = LogContents(Path(log))
-    summary = LogSummary(contents)
-    kept: list[LogMessage] = []
-    by_key: dict[tuple[Any, ...], WorkspaceRecord] = {}
-    clouds: dict[int, np.ndarray] = {}  # boundary clouds whose summary is still to come
-    awaiting: dict[int, WorkspaceRecord] = {}  # summaries whose boundary is still to come
-    pending_requests: dict[str, list[PoseCheckCall]] = {}
-    for item in iter_log(log, contents):
-        if keep_messages:
-            kept.append(item)
-        if item.message is None:
-            continue
-        summary.decoded += 1
-        msgtype = item.msgtype
-        if msgtype in (_SUMMARY, _WORKSPACE_RESPONSE):
-            fields = message_to_fields(item.message)
-            points = None
-            if msgtype == _WORKSPACE_RESPONSE:
-                points = _cloud_points(fields["boundary"], contents, item.topic)
-                fields = fields["summary"]
-            record = WorkspaceRecord(item.log_time_ns, [item.topic], fields, points)
-            known = by_key.get(record.key)
-            if known is None:
-                by_key[record.key] = record
-                summary.workspaces.append(record)
-                known = record
-            elif item.topic not in known.sources:
-                known.sources.append(item.topic)
-            if known.points is None:
-                known.points = points if points is not None else clouds.pop(record.key[0], None)
-            if known.points is None:
-                awaiting[record.key[0]] = known
-        elif msgtype == _CLOUD:
-            fields = message_to_fields(item.message)
-            points = _cloud_points(fields, contents, item.topic)
-            stamp = messages.stamp_to_ns(fields["header"]["stamp"])
-            waiting = awaiting.pop(stamp, None)
-            if waiting is not None:
-                waiting.points = points
-            elif points is not None:
-                clouds[stamp] = points
-        elif msgtype == _CHECK_REQUEST:
-            fields = message_to_fields(item.message)
-            position = fields["position"]
-            call = PoseCheckCall(
-                item.log_time_ns,
-                item.topic,
-                [position["x"], position["y"], position["z"]],
-                np.array(
-                    [[o["phi"], o["theta"], o["psi"]] for o in fields["orientations"]], dtype=float
-                ).reshape(-1, 3),
-            )
-            summary.checks.append(call)
-            pending_requests.setdefault(_service_of(item.topic), []).append(call)
-        elif msgtype == _CHECK_RESPONSE:
-            queue = pending_requests.get(_service_of(item.topic), [])
-            call = queue.pop(0) if queue else None
-            if call is None:  # response without its request (log cut before it)
-                call = PoseCheckCall(item.log_time_ns, item.topic)
-                summary.checks.append(call)
-            call.response = message_to_fields(item.message)
-        elif msgtype == _REACHABILITY:
-            fields = message_to_fields(item.message)
-            fields["log_time_ns"] = item.log_time_ns
-            summary.reachability.append(fields)
-        elif msgtype == _TRIGGER_RESPONSE:
-            fields = message_to_fields(item.message)
-            fields.update(topic=item.topic, log_time_ns=item.log_time_ns)
-            summary.triggers.append(fields)
-    return summary, kept
-
-
-def _service_of(topic: str) -> str:
-    return topic.rsplit("/", 1)[0]
-
-
-def _cloud_points(fields: dict[str, Any], contents: LogContents, topic: str) -> np.ndarray | None:
-    try:
-        return messages.pointcloud_to_array(fields)
-    except ValueError as err:
-        contents.problems.append(f"{topic}: a PointCloud2 could not be read ({err})")
-        return None
-
+    pass
+from hexapod_workspace.logs.summary import LogSummary, PoseCheckCall, WorkspaceRecord, summarize_log
 
 # --------------------------------------------------------------------------- reporting
+
+
+def _kind_label(kind: int) -> str:
+    known = WorkspaceKind.of(kind)
+    return known.label if known is not None else str(kind)
 
 
 def _iso(ns: int | None) -> str:
@@ -240,7 +54,7 @@ def _workspace_json(index: int, record: WorkspaceRecord, start_ns: int) -> dict[
         "time_s": (record.log_time_ns - start_ns) / 1e9,
         "sources": record.sources,
         "request_id": summary["request_id"],
-        "kind": messages.KIND_NAMES.get(int(summary["kind"]), str(summary["kind"])),
+        "kind": _kind_label(int(summary["kind"])),
         "success": bool(summary["success"]),
         "message": summary["message"],
         "position": [position["x"], position["y"], position["z"]],
@@ -392,7 +206,7 @@ def _rebuild(record: WorkspaceRecord) -> Any:
     summary, points = record.summary, record.points
     position = np.array([summary["position"][k] for k in "xyz"])
     kind = int(summary["kind"])
-    if kind == messages.ORIENTATION:
+    if kind == WorkspaceKind.ORIENTATION:
         from hexapod_workspace.core.orientation import (
             OrientationSlice,
             OrientationWorkspace,
@@ -430,7 +244,7 @@ def _rebuild(record: WorkspaceRecord) -> Any:
 
     return _make(
         ProjectedWorkspace,
-        method=messages.KIND_NAMES[kind],
+        method=WorkspaceKind(kind).label,
         position=position,
         phi=points[:, 3],
         theta=points[:, 4],
@@ -472,7 +286,7 @@ def _plot(summary: LogSummary, plot_dir: Path, out: IO[str], err: IO[str]) -> li
         except (ValueError, IndexError, TypeError, KeyError) as error:
             err.write(f"note: workspace {index} could not be rebuilt from the log ({error})\n")
             continue
-        if int(record.summary["kind"]) == messages.ORIENTATION:
+        if int(record.summary["kind"]) == WorkspaceKind.ORIENTATION:
             path = plot_dir / f"workspace_{index:03d}_orientation.png"
             draw(index, plotting.plot_orientation, workspace, path)
         else:  # methods computed at one position are overlaid, like the live command
@@ -484,107 +298,6 @@ def _plot(summary: LogSummary, plot_dir: Path, out: IO[str], err: IO[str]) -> li
     for path in written:
         out.write(f"plot: {path}\n")
     return written
-
-
-# --------------------------------------------------------------------------- republish
-
-
-def _message_class(msgtype: str) -> Any:
-    """The rclpy message class of ``pkg/msg/Type`` or ``pkg/srv/Name_Request``."""
-    import importlib
-
-    package, kind, name = msgtype.split("/")
-    module = importlib.import_module(f"{package}.{kind}")
-    if kind == "srv":
-        service, _, part = name.rpartition("_")
-        return getattr(getattr(module, service), part)
-    return getattr(module, name)
-
-
-def _qos(text: str) -> Any:
-    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-
-    transient = "transient_local" in text
-    return QoSProfile(
-        depth=1 if transient else 10,
-        reliability=ReliabilityPolicy.BEST_EFFORT
-        if "best_effort" in text
-        else ReliabilityPolicy.RELIABLE,
-        durability=DurabilityPolicy.TRANSIENT_LOCAL if transient else DurabilityPolicy.VOLATILE,
-    )
-
-
-def _publish(
-    summary: LogSummary,
-    kept: Sequence[LogMessage],
-    rate: float,
-    err: IO[str],
-    *,
-    allow_network: bool,
-    wait_for_subscribers: float,
-) -> int:
-    """Republish the recorded bytes on their topics at ``rate`` × the recorded pace."""
-    value = os.environ.get(_DISCOVERY)
-    if value is None:
-        os.environ[_DISCOVERY] = "LOCALHOST"
-    elif value != "LOCALHOST" and not allow_network:
-        err.write(
-            f"replay --publish: refusing to publish with {_DISCOVERY}={value}; "
-            "set it to LOCALHOST (or unset it)\n"
-        )
-        return 2
-    try:
-        import rclpy
-        from rclpy.duration import Duration
-        from rclpy.node import Node
-    except ImportError as error:
-        err.write(f"replay --publish needs rclpy (a ROS 2 environment): {error}\n")
-        return 2
-    usable = [m for m in kept if m.message is not None]
-    classes: dict[str, Any] = {}
-    for info in summary.contents.topics.values():
-        try:
-            classes[info.topic] = _message_class(info.msgtype)
-        except (ImportError, AttributeError, ValueError):
-            err.write(
-                f"note: {info.topic}: type {info.msgtype} not available in this ROS "
-                "environment; not republished\n"
-            )
-    context = rclpy.Context()
-    rclpy.init(context=context)
-    try:
-        node = Node("hexapod_workspace_replay", context=context)
-        publishers = {
-            topic: node.create_publisher(cls, topic, _qos(summary.contents.topics[topic].qos))
-            for topic, cls in classes.items()
-        }
-        deadline = time.monotonic() + wait_for_subscribers
-        while any(p.get_subscription_count() == 0 for p in publishers.values()):
-            if time.monotonic() >= deadline:
-                break
-            time.sleep(0.01)
-        start_wall = time.monotonic()
-        start_log = usable[0].log_time_ns if usable else 0
-        for item in usable:
-            publisher = publishers.get(item.topic)
-            if publisher is None:
-                continue
-            if rate > 0:
-                due = start_wall + (item.log_time_ns - start_log) / 1e9 / rate
-                delay = due - time.monotonic()
-                if delay > 0:
-                    time.sleep(delay)
-            publisher.publish(item.data)  # serialized bytes go out unchanged
-        for publisher in publishers.values():  # let reliable subscribers receive everything
-            publisher.wait_for_all_acked(Duration(seconds=5))
-        node.destroy_node()
-    finally:
-        rclpy.try_shutdown(context=context)
-    err.write(f"republished {len(usable)} messages on {len(classes)} topics\n")
-    return 0
-
-
-# --------------------------------------------------------------------------- entry points
 
 
 def run_replay(
@@ -661,7 +374,12 @@ def run_replay(
             err.write(f"replay: cannot write plots to {plot_dir}: {error.strerror or error}\n")
             return 2
     if publish:
-        return _publish(
+        try:
+            from hexapod_workspace.ros.republish import publish_log
+        except ImportError as error:
+            err.write(f"replay --publish needs rclpy (a ROS 2 environment): {error}\n")
+            return 2
+        return publish_log(
             summary,
             kept,
             rate,
@@ -670,103 +388,3 @@ def run_replay(
             wait_for_subscribers=wait_for_subscribers,
         )
     return 0
-
-
-def record_results(
-    path: str | Path,
-    results: Iterable[Any],
-    *,
-    frame_id: str = "base",
-    request_id: str = "",
-    stamp_ns: int | None = None,
-) -> Path:
-    """Record CLI results in the node's log format (what ``--record FILE`` writes).
-
-    Each ``CheckResult`` is recorded as a CheckPoses call (request and response on
-    ``/hexapod_workspace/check_poses/{request,response}``); each projected or orientation
-    workspace as the WorkspaceRequest that asks for it, then its WorkspaceSummary and its
-    boundary PointCloud2 (same header stamp) on the node's topics.
-
-    Parameters
-    ----------
-    path : str or Path
-        The ``.mcap`` file to write (replaced if it exists).
-    results : iterable
-        ``CheckResult``, ``ProjectedWorkspace`` and/or ``OrientationWorkspace`` objects.
-    frame_id : str
-        The manipulator's base frame.
-    request_id : str
-        Copied into requests and summaries.
-    stamp_ns : int, optional
-        Time of the first record (ns since the epoch); default now. Later records follow 1 µs
-        apart so that every message keeps its order.
-
-    Returns
-    -------
-    Path
-        The finished log.
-
-    Raises
-    ------
-    RecordingError
-        The file cannot be written.
-    """
-    topics, types = messages.TOPICS, messages.TYPES
-    stamp = time.time_ns() if stamp_ns is None else int(stamp_ns)
-    # One chunk per message: a damaged file keeps every message before the damage.
-    with LogWriter(path, flush_interval=0, flush_messages=1) as writer:
-        for result in results:
-            if hasattr(result, "margins"):  # a CheckResult
-                request, response = service_topics(topics["check_poses"])
-                writer.write_fields(
-                    request,
-                    f"{types['check_poses']}_Request",
-                    messages.check_poses_request_fields(result.position, result.angles),
-                    stamp,
-                    qos=SERVICE_QOS,
-                )
-                writer.write_fields(
-                    response,
-                    f"{types['check_poses']}_Response",
-                    messages.check_poses_response_fields(result),
-                    stamp + 1_000,
-                    qos=SERVICE_QOS,
-                )
-            else:
-                kind = messages.workspace_kind(result)
-                request_fields = messages.compute_workspace_request_fields(
-                    result, request_id=request_id, stamp_ns=stamp, frame_id=frame_id
-                )["request"]
-                writer.write_fields(
-                    topics["workspace_request"], types["workspace_request"], request_fields, stamp
-                )
-                points = messages.boundary_points(result)
-                summary = messages.summary_fields(
-                    result,
-                    stamp_ns=stamp + 1_000,
-                    frame_id=frame_id,
-                    request_id=request_id,
-                    kind=kind,
-                    n_points=len(points),
-                )
-                writer.write_fields(
-                    topics["workspace_summary"],
-                    types["workspace_summary"],
-                    summary,
-                    stamp + 1_000,
-                    qos=RESULT_QOS,
-                )
-                cloud = (
-                    "orientation_workspace"
-                    if kind == messages.ORIENTATION
-                    else "projected_workspace"
-                )
-                writer.write_fields(
-                    topics[cloud],
-                    types[cloud],
-                    messages.pointcloud_fields(points, frame_id=frame_id, stamp_ns=stamp + 1_000),
-                    stamp + 1_000,
-                    qos=RESULT_QOS,
-                )
-            stamp += 2_000
-    return Path(path)

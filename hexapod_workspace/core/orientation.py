@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,17 +33,21 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import InputError, ResolutionError
 from .constraints import relative_margins
 from .manipulator import Manipulator
-from .projected import (
-    reference_torsion_interval,
-    require_reachable_reference,
+from .projected import reference_torsion_interval, require_reachable_reference
+from .resolution import (
+    DEFAULT_N_RAYS,
+    DEFAULT_PSI_STEP,
+    DEFAULT_TOLERANCE,
+    MAX_POINTS,
+    Progress,
     validate_position,
+    validate_psi_step,
     validate_rays,
     validate_tolerance,
 )
 from .search import RaySearch
 
 __all__ = [
-    "MAX_SLICES",
     "OrientationSlice",
     "OrientationWorkspace",
     "TorsionRange",
@@ -52,16 +55,8 @@ __all__ = [
     "torsion_range",
 ]
 
-#: Bounds on the slice step Δψ, rad.
-MIN_PSI_STEP, MAX_PSI_STEP = 1e-4, 0.5
-#: Largest number of slices one computation may produce (both directions together).
-MAX_SLICES = 20_000
-#: Largest number of boundary points (slices × rays) one computation may produce.
-MAX_POINTS = 5_000_000
 #: Pattern-search rounds when refining ψmax / ψmin.
 PSI_LIMIT_ROUNDS = 24
-
-Progress = Callable[[float], None]
 
 
 @dataclass(frozen=True)
@@ -291,9 +286,9 @@ def orientation_workspace(
     manipulator: Manipulator,
     position: ArrayLike | None = None,
     *,
-    n_rays: int = 180,
-    psi_step: float = math.radians(1.0),
-    tolerance: float = 1e-5,
+    n_rays: int = DEFAULT_N_RAYS,
+    psi_step: float = DEFAULT_PSI_STEP,
+    tolerance: float = DEFAULT_TOLERANCE,
     progress: Progress | None = None,
 ) -> OrientationWorkspace:
     """Compute the 3-D orientation workspace at a position (see the module documentation).
@@ -326,10 +321,7 @@ def orientation_workspace(
     started = time.perf_counter()
     n_rays = validate_rays(n_rays, "n_rays")
     tolerance = validate_tolerance(tolerance)
-    step = float(psi_step)
-    if not (math.isfinite(step) and MIN_PSI_STEP <= step <= MAX_PSI_STEP):
-        msg = f"psi_step: expected {MIN_PSI_STEP:g} to {MAX_PSI_STEP:g} rad, got {psi_step!r}"
-        raise ResolutionError(msg)
+    step = validate_psi_step(psi_step)
     max_slices = int(2.0 * math.pi / step) + 1
     if max_slices * n_rays > MAX_POINTS:
         msg = (
@@ -418,7 +410,7 @@ def torsion_range(
     theta: float,
     position: ArrayLike | None = None,
     *,
-    tolerance: float = 1e-6,
+    tolerance: float = DEFAULT_TOLERANCE,
 ) -> TorsionRange:
     """Feasible torsion intervals for one tool direction (what a 5-axis controller needs).
 

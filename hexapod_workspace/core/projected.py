@@ -27,73 +27,34 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import InputError, ResolutionError, UnreachableReferenceError
+from ..errors import InputError, UnreachableReferenceError
 from .constraints import CONSTRAINT_NAMES
 from .manipulator import Manipulator
+from .resolution import (
+    DEFAULT_N_PHI,
+    DEFAULT_TOLERANCE,
+    Method,
+    Progress,
+    validate_position,
+    validate_rays,
+    validate_tolerance,
+)
 from .rotations import approach_vector
 from .search import RaySearch
 
-__all__ = [
-    "MAX_RAYS",
-    "METHODS",
-    "ProjectedWorkspace",
-    "projected_workspace",
-    "reference_torsion_interval",
-    "require_reachable_reference",
-    "validate_position",
-    "validate_rays",
-    "validate_tolerance",
-]
+__all__ = ["ProjectedWorkspace", "projected_workspace"]
 
-METHODS = ("torsion_zero", "exact")
-#: Bounds on resolutions accepted by every workspace function.
-MIN_RAYS, MAX_RAYS = 3, 7200
-MIN_TOLERANCE, MAX_TOLERANCE = 1e-12, 0.1
 #: ψ samples per azimuth for the ``exact`` method before golden-section refinement.
 EXACT_PSI_SAMPLES = 13
 #: Golden-section iterations on ψ for the ``exact`` method.
 EXACT_GOLDEN_STEPS = 18
 #: Boundary tolerance while ranking ψ values in the ``exact`` method, rad.
 COARSE_TOLERANCE = 1e-5
-
-Progress = Callable[[float], None]
-
-
-def validate_rays(count: int, name: str) -> int:
-    """Check a ray count (``n_phi``, ``n_rays``) against [3, 7200]."""
-    if isinstance(count, bool) or not isinstance(count, (int, np.integer)):
-        msg = f"{name}: expected an integer, got {count!r}"
-        raise ResolutionError(msg)
-    if not MIN_RAYS <= count <= MAX_RAYS:
-        msg = f"{name}: expected {MIN_RAYS} to {MAX_RAYS} rays, got {count}"
-        raise ResolutionError(msg)
-    return int(count)
-
-
-def validate_tolerance(tolerance: float, name: str = "tolerance") -> float:
-    """Check a boundary tolerance (rad) against [1e-12, 0.1]."""
-    value = float(tolerance)
-    if not (math.isfinite(value) and MIN_TOLERANCE <= value <= MAX_TOLERANCE):
-        msg = f"{name}: expected {MIN_TOLERANCE:g} to {MAX_TOLERANCE:g} rad, got {tolerance!r}"
-        raise ResolutionError(msg)
-    return value
-
-
-def validate_position(manipulator: Manipulator, position: ArrayLike | None) -> NDArray:
-    """The position to use (default ``manipulator.position``), checked: shape (3,), finite."""
-    if position is None:
-        return np.array(manipulator.position)
-    array = np.asarray(position, dtype=np.float64)
-    if array.shape != (3,) or not np.all(np.isfinite(array)):
-        msg = f"position: expected 3 finite values (x, y, z) in m, got {np.ravel(array).tolist()}"
-        raise InputError(msg)
-    return array
 
 
 @dataclass(frozen=True)
@@ -194,9 +155,9 @@ def projected_workspace(
     manipulator: Manipulator,
     position: ArrayLike | None = None,
     *,
-    method: str = "torsion_zero",
-    n_phi: int = 360,
-    tolerance: float = 1e-6,
+    method: Method | str = Method.TORSION_ZERO,
+    n_phi: int = DEFAULT_N_PHI,
+    tolerance: float = DEFAULT_TOLERANCE,
     progress: Progress | None = None,
 ) -> ProjectedWorkspace:
     """Compute the projected orientation workspace at a position.
@@ -229,9 +190,12 @@ def projected_workspace(
         Unknown method, bad position.
     """
     started = time.perf_counter()
-    if method not in METHODS:
-        msg = f"method: expected one of {', '.join(METHODS)}, got {method!r}"
-        raise InputError(msg)
+    try:
+        method = Method(method)
+    except ValueError:
+        names = ", ".join(m.value for m in Method)
+        msg = f"method: expected one of {names}, got {method!r}"
+        raise InputError(msg) from None
     n_phi = validate_rays(n_phi, "n_phi")
     tolerance = validate_tolerance(tolerance)
     position = validate_position(manipulator, position)
@@ -249,7 +213,7 @@ def projected_workspace(
     base = search.first_violation(tilt_rays(zero), n_phi, math.pi, tolerance)
     theta, psi, limiting = base.feasible, zero.copy(), base.limiting
     gap = None
-    if method == "exact":
+    if method is Method.EXACT:
         if progress:
             progress(0.1)
         torsion = reference_torsion_interval(search, tolerance)
@@ -260,7 +224,7 @@ def projected_workspace(
     if progress:
         progress(1.0)
     return ProjectedWorkspace(
-        method=method,
+        method=method.value,
         position=position,
         phi=phi,
         theta=theta,

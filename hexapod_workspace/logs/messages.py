@@ -3,7 +3,7 @@
 Every function returns plain nested dicts keyed by the ROS field names of the message named in
 its docstring (nested messages are dicts, message arrays lists of dicts, ``uint8[]`` is
 ``bytes``, numeric arrays numpy arrays). The node fills rclpy messages from them; the CLI's
-``--record`` builds rosbags messages from them (:func:`hexapod_workspace.logs.recording.serialize`);
+``--record`` builds rosbags messages from them (:func:`hexapod_workspace.logs.fields.serialize`);
 replay reads recorded messages back with the inverse helpers at the end of this module.
 
 Units are SI (m, rad) as everywhere in the package. Stamps are ns since the epoch.
@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..core.resolution import WorkspaceKind
 from ..core.rotations import approach_vector
 
 if TYPE_CHECKING:
@@ -27,11 +28,7 @@ if TYPE_CHECKING:
     from hexapod_workspace.core.projected import ProjectedWorkspace
 
 __all__ = [
-    "KIND_NAMES",
-    "ORIENTATION",
     "POINT_FIELD_NAMES",
-    "PROJECTED_EXACT",
-    "PROJECTED_TORSION_ZERO",
     "TOPICS",
     "TYPES",
     "boundary_points",
@@ -56,16 +53,6 @@ __all__ = [
     "workspace_request_fields",
 ]
 
-#: WorkspaceRequest.kind constants (msg_defs/msg/WorkspaceRequest.msg).
-ORIENTATION = 0
-PROJECTED_TORSION_ZERO = 1
-PROJECTED_EXACT = 2
-#: kind -> name used by the CLI and the core (``method`` of a projected workspace).
-KIND_NAMES = {
-    ORIENTATION: "orientation",
-    PROJECTED_TORSION_ZERO: "torsion_zero",
-    PROJECTED_EXACT: "exact",
-}
 #: PointCloud2 fields of a boundary cloud, all float32, in this order (point_step 24 bytes).
 POINT_FIELD_NAMES = ("x", "y", "z", "phi", "theta", "psi")
 _FLOAT32 = 7  # sensor_msgs/PointField.FLOAT32
@@ -267,11 +254,11 @@ def reachability_result_fields(
 
 
 def workspace_kind(workspace: ProjectedWorkspace | OrientationWorkspace) -> int:
-    """WorkspaceRequest kind of a result: ORIENTATION, PROJECTED_TORSION_ZERO or _EXACT."""
+    """The WorkspaceKind of a result (orientation, projected torsion_zero or exact)."""
     method = getattr(workspace, "method", None)
     if method is None:
-        return ORIENTATION
-    return PROJECTED_EXACT if method == "exact" else PROJECTED_TORSION_ZERO
+        return WorkspaceKind.ORIENTATION
+    return WorkspaceKind.projected(method)
 
 
 def workspace_request_fields(
@@ -305,7 +292,7 @@ def _request_for(
     frame_id: str,
 ) -> dict[str, Any]:
     kind = workspace_kind(workspace)
-    if kind == ORIENTATION:
+    if kind == WorkspaceKind.ORIENTATION:
         n_rays, psi_step = int(workspace.n_rays), float(workspace.psi_step)
     else:
         n_rays, psi_step = int(np.asarray(workspace.phi).shape[0]), 0.0
@@ -346,7 +333,7 @@ def boundary_points(workspace: ProjectedWorkspace | OrientationWorkspace) -> NDA
         Orientation workspace: x, y, z = θ cos φ, θ sin φ, ψ (the cylindrical picture).
         Projected workspace: x, y, z = the unit approach vector of each boundary direction.
     """
-    if workspace_kind(workspace) == ORIENTATION:
+    if workspace_kind(workspace) == WorkspaceKind.ORIENTATION:
         return np.asarray(workspace.boundary_points(), dtype=float).reshape(-1, 6)
     phi = np.asarray(workspace.phi, dtype=float)
     theta = np.asarray(workspace.theta, dtype=float)
@@ -396,7 +383,7 @@ def summary_fields(
     }
     if workspace is None or not success:
         fields.update(
-            kind=int(kind if kind is not None else ORIENTATION),
+            kind=int(kind if kind is not None else WorkspaceKind.ORIENTATION),
             success=False,
             message=message or "workspace computation failed",
             position=point_fields(position if position is not None else np.zeros(3)),
@@ -408,7 +395,7 @@ def summary_fields(
         )
         return fields
     kind = workspace_kind(workspace) if kind is None else int(kind)
-    if kind == ORIENTATION:
+    if kind == WorkspaceKind.ORIENTATION:
         fields.update(
             psi_min=float(workspace.psi_min),
             psi_max=float(workspace.psi_max),
@@ -550,10 +537,11 @@ def pointcloud_to_array(cloud: Any) -> NDArray[np.float64]:
 def summary_line(summary: Any) -> str:
     """One-line human summary of a WorkspaceSummary (dict or message), degrees."""
     kind = int(_get(summary, "kind"))
-    name = KIND_NAMES.get(kind, f"kind {kind}")
+    known = WorkspaceKind.of(kind)
+    name = known.label if known is not None else f"kind {kind}"
     if not bool(_get(summary, "success")):
         return f"{name}: failed: {_get(summary, 'message')}"
-    if kind == ORIENTATION:
+    if kind == WorkspaceKind.ORIENTATION:
         return (
             f"{name}: psi {math.degrees(_get(summary, 'psi_min')):.3f}..."
             f"{math.degrees(_get(summary, 'psi_max')):.3f} deg, "

@@ -24,8 +24,10 @@ from rosidl_parser.definition import AbstractSequence, Array, BasicType, Namespa
 
 __all__ = [
     "angles_from_orientations",
+    "message_class",
     "position_from_point",
     "to_message",
+    "type_name",
 ]
 
 
@@ -45,6 +47,24 @@ def _slots(message_class: type) -> dict[str, Any]:
 
 def _namespaced_class(definition: NamespacedType) -> type:
     return _message_class((*definition.namespaces, definition.name))
+
+
+def message_class(msgtype: str) -> type:
+    """The generated rclpy class of ``pkg/msg/Type``, ``pkg/srv/Name`` or ``pkg/srv/Name_Request``.
+
+    Raises ImportError or AttributeError when the type is not available in this ROS environment.
+    """
+    package, kind, name = msgtype.split("/")
+    if kind == "srv" and name.endswith(("_Request", "_Response")):
+        service, _, part = name.rpartition("_")
+        return getattr(_message_class((package, kind, service)), part)
+    return _message_class((package, kind, name))
+
+
+def type_name(message_class: type) -> str:
+    """``pkg/msg/Type`` of a generated message class (inverse of :func:`message_class`)."""
+    package, kind = message_class.__module__.split(".")[:2]
+    return f"{package}/{kind}/{message_class.__name__}"
 
 
 def _value(definition: Any, value: Any) -> Any:

@@ -25,7 +25,7 @@ reentrant one, under a multi-threaded executor; the computation itself runs in a
 (:mod:`hexapod_workspace.ros.worker`), so a long 3-D computation neither blocks nor slows the
 pose checks (it does not hold this interpreter's lock).
 Every request and result is recorded to one MCAP log per run (rosbag2 form), see
-:mod:`hexapod_workspace.logs.recording`; a failure to write turns recording off, the node keeps
+:mod:`hexapod_workspace.logs`; a failure to write turns recording off, the node keeps
 serving. Units: SI (m, rad), positions in the base frame ``frame_id``.
 """
 
@@ -69,35 +69,37 @@ from sensor_msgs.msg import PointCloud2
 from std_srvs.srv import Trigger
 
 from hexapod_workspace._resources import example_config_path
+from hexapod_workspace.core import resolution
 from hexapod_workspace.core.constraints import check
 from hexapod_workspace.core.manipulator import Manipulator
+from hexapod_workspace.core.resolution import WorkspaceKind
 from hexapod_workspace.errors import (
     ConfigError,
     InputError,
     RecordingError,
     UnreachableReferenceError,
 )
-from hexapod_workspace.logs import messages
-from hexapod_workspace.logs.recording import (
+from hexapod_workspace.logs import (
     REQUEST_QOS,
     SERVICE_QOS,
     LogWriter,
+    messages,
     qos_profile_text,
     run_log_path,
     service_topics,
 )
 
-from .conversions import angles_from_orientations, position_from_point, to_message
+from .conversions import angles_from_orientations, position_from_point, to_message, type_name
 from .worker import WorkspaceJob, WorkspaceWorker
 
 __all__ = ["NODE_NAME", "WorkspaceNode", "main"]
 
 NODE_NAME = "hexapod_workspace"
-#: Resolution bounds, as enforced by the core (projected.py, orientation.py).
-RAYS_RANGE = (3, 7200)
-PSI_STEP_RANGE = (1e-4, 0.5)
-TOLERANCE_RANGE = (1e-12, 0.1)
-PROJECTED_METHODS = ("torsion_zero", "exact")
+#: Parameter ranges: the core's resolution bounds (one definition, core/resolution.py).
+RAYS_RANGE = (resolution.MIN_RAYS, resolution.MAX_RAYS)
+PSI_STEP_RANGE = (resolution.MIN_PSI_STEP, resolution.MAX_PSI_STEP)
+TOLERANCE_RANGE = (resolution.MIN_TOLERANCE, resolution.MAX_TOLERANCE)
+PROJECTED_METHODS = tuple(method.value for method in resolution.Method)
 #: GIL switch interval of the node process, s: a pose check waits at most this long for the
 #: interpreter while a workspace computation runs in another thread (Python's default is 5 ms).
 SWITCH_INTERVAL = 2e-4
@@ -197,31 +199,31 @@ def _parameter_specs() -> list[_Spec]:
     specs += [
         _Spec(
             "resolution.n_phi",
-            360,
+            resolution.DEFAULT_N_PHI,
             "Projected workspace: number of equally spaced azimuths phi (rays).",
             int_range=RAYS_RANGE,
         ),
         _Spec(
             "resolution.n_rays",
-            180,
+            resolution.DEFAULT_N_RAYS,
             "Orientation workspace: rays per psi slice.",
             int_range=RAYS_RANGE,
         ),
         _Spec(
             "resolution.psi_step",
-            math.radians(1.0),
+            resolution.DEFAULT_PSI_STEP,
             "Orientation workspace: torsion step between slices, rad.",
             float_range=PSI_STEP_RANGE,
         ),
         _Spec(
             "resolution.tolerance",
-            1e-5,
+            resolution.DEFAULT_TOLERANCE,
             "Boundary tolerance of every workspace computation, rad.",
             float_range=TOLERANCE_RANGE,
         ),
         _Spec(
             "resolution.projected_method",
-            "torsion_zero",
+            resolution.Method.TORSION_ZERO.value,
             "Method of ~/compute_projected_workspace: torsion_zero (psi = 0, the paper's) or "
             "exact (true shadow over all psi).",
             constraints="one of: torsion_zero, exact",
@@ -411,12 +413,6 @@ class _Recorder:
         self.close()
 
 
-def _type_name(message_class: type) -> str:
-    """ROS type name of a generated class, e.g. ``std_srvs/srv/Trigger_Request``."""
-    package, kind = message_class.__module__.split(".")[:2]
-    return f"{package}/{kind}/{message_class.__name__}"
-
-
 def _result_qos(depth: int = 1) -> QoSProfile:
     return QoSProfile(
         history=HistoryPolicy.KEEP_LAST,
@@ -457,11 +453,13 @@ class WorkspaceNode(Node):
         check_group = ReentrantCallbackGroup()
 
         self._cloud_publishers = {
-            messages.ORIENTATION: self._publisher(PointCloud2, "~/orientation_workspace"),
-            messages.PROJECTED_TORSION_ZERO: self._publisher(PointCloud2, "~/projected_workspace"),
+            WorkspaceKind.ORIENTATION: self._publisher(PointCloud2, "~/orientation_workspace"),
+            WorkspaceKind.PROJECTED_TORSION_ZERO: self._publisher(
+                PointCloud2, "~/projected_workspace"
+            ),
         }
-        self._cloud_publishers[messages.PROJECTED_EXACT] = self._cloud_publishers[
-            messages.PROJECTED_TORSION_ZERO
+        self._cloud_publishers[WorkspaceKind.PROJECTED_EXACT] = self._cloud_publishers[
+            WorkspaceKind.PROJECTED_TORSION_ZERO
         ]
         self._summary_publisher = self._publisher(WorkspaceSummary, "~/workspace_summary")
         self._reachability_publisher = self._publisher(
@@ -501,7 +499,7 @@ class WorkspaceNode(Node):
     def _publisher(self, message_class: type, topic: str, depth: int = 1) -> Any:
         publisher = self.create_publisher(message_class, topic, _result_qos(depth))
         qos = qos_profile_text(durability="transient_local", depth=depth)
-        self._recorder.add_channel(publisher.topic_name, _type_name(message_class), qos)
+        self._recorder.add_channel(publisher.topic_name, type_name(message_class), qos)
         return publisher
 
     def _service(self, service_class: type, name: str, callback: Any, group: Any) -> Any:
@@ -509,15 +507,15 @@ class WorkspaceNode(Node):
         # recorded as <resolved service name>/request and /response
         request_topic, response_topic = service_topics(self.resolve_service_name(name))
         self._service_topics[service] = (request_topic, response_topic)
-        self._recorder.add_channel(request_topic, _type_name(service_class.Request), SERVICE_QOS)
-        self._recorder.add_channel(response_topic, _type_name(service_class.Response), SERVICE_QOS)
+        self._recorder.add_channel(request_topic, type_name(service_class.Request), SERVICE_QOS)
+        self._recorder.add_channel(response_topic, type_name(service_class.Response), SERVICE_QOS)
         return service
 
     def _subscription(self, message_class: type, topic: str, callback: Any, group: Any) -> Any:
         subscription = self.create_subscription(
             message_class, topic, callback, 10, callback_group=group
         )
-        self._recorder.add_channel(subscription.topic_name, _type_name(message_class), REQUEST_QOS)
+        self._recorder.add_channel(subscription.topic_name, type_name(message_class), REQUEST_QOS)
         return subscription
 
     def _publish(self, publisher: Any, message: Any) -> None:
@@ -662,7 +660,7 @@ class WorkspaceNode(Node):
             "kind": kind,
             "position": np.nan_to_num(position),
         }
-        if kind not in messages.KIND_NAMES:
+        if WorkspaceKind.of(kind) is None:
             reason = f"kind: expected 0 (orientation), 1 (torsion_zero) or 2 (exact), got {kind}"
             return self._publish_failure(reason, failure)
         if not np.all(np.isfinite(position)):
@@ -672,7 +670,9 @@ class WorkspaceNode(Node):
             if not math.isfinite(value) or value < 0.0:
                 reason = f"{name}: expected a finite value >= 0 (0 = node parameter), got {value}"
                 return self._publish_failure(reason, failure)
-        rays = int(n_rays) or (settings.n_rays if kind == messages.ORIENTATION else settings.n_phi)
+        rays = int(n_rays) or (
+            settings.n_rays if kind == WorkspaceKind.ORIENTATION else settings.n_phi
+        )
         tolerance = float(tolerance) or settings.tolerance
         psi_step = float(psi_step) or settings.psi_step
         if not RAYS_RANGE[0] <= rays <= RAYS_RANGE[1]:
@@ -748,7 +748,7 @@ class WorkspaceNode(Node):
                 "stamp_ns": self._now_ns(),
                 "frame_id": self._state.manipulator.frame_id,
                 "request_id": options.get("request_id", ""),
-                "kind": kind if kind in messages.KIND_NAMES else messages.ORIENTATION,
+                "kind": kind if WorkspaceKind.of(kind) is not None else WorkspaceKind.ORIENTATION,
                 "position": np.nan_to_num(position),
             }
             return self._publish_failure(self._internal_error(error), failure)
@@ -792,13 +792,13 @@ class WorkspaceNode(Node):
     def _on_compute_orientation(
         self, request: Trigger.Request, response: Trigger.Response
     ) -> Trigger.Response:
-        return self._on_trigger(self._orientation_service, messages.ORIENTATION, response)
+        return self._on_trigger(self._orientation_service, WorkspaceKind.ORIENTATION, response)
 
     def _on_compute_projected(
         self, request: Trigger.Request, response: Trigger.Response
     ) -> Trigger.Response:
         method = self._state.settings.projected_method
-        kind = messages.PROJECTED_EXACT if method == "exact" else messages.PROJECTED_TORSION_ZERO
+        kind = WorkspaceKind.projected(method)
         return self._on_trigger(self._projected_service, kind, response)
 
     # ------------------------------------------------------------------ lifecycle

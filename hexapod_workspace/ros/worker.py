@@ -23,6 +23,7 @@ import numpy as np
 from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.core.orientation import orientation_workspace
 from hexapod_workspace.core.projected import projected_workspace
+from hexapod_workspace.core.resolution import WorkspaceKind
 from hexapod_workspace.errors import HexapodWorkspaceError
 from hexapod_workspace.logs import messages
 
@@ -45,8 +46,8 @@ class WorkspaceJob:
     ----------
     manipulator : Manipulator
     kind : int
-        :data:`messages.ORIENTATION`, :data:`messages.PROJECTED_TORSION_ZERO` or
-        :data:`messages.PROJECTED_EXACT`.
+        :data:`WorkspaceKind.ORIENTATION`, :data:`WorkspaceKind.PROJECTED_TORSION_ZERO` or
+        :data:`WorkspaceKind.PROJECTED_EXACT`.
     position : ndarray, shape (3,)
         Tool-tip position OC, base frame, m.
     n_rays : int
@@ -79,7 +80,7 @@ def compute_fields(job: WorkspaceJob) -> tuple[dict[str, Any], dict[str, Any]]:
         ``InputError``/``ResolutionError`` for a bad request, ``UnreachableReferenceError``
         when the reference orientation is unreachable at the position.
     """
-    if job.kind == messages.ORIENTATION:
+    if job.kind == WorkspaceKind.ORIENTATION:
         workspace = orientation_workspace(
             job.manipulator,
             job.position,
@@ -91,7 +92,7 @@ def compute_fields(job: WorkspaceJob) -> tuple[dict[str, Any], dict[str, Any]]:
         workspace = projected_workspace(
             job.manipulator,
             job.position,
-            method=messages.KIND_NAMES[job.kind],
+            method=WorkspaceKind(job.kind).label,
             n_phi=job.n_rays,
             tolerance=job.tolerance,
         )

@@ -2,7 +2,7 @@
 
 What the node published, answered and was sent is compared with what its log holds, decoded by
 two independent readers (rosbags with the log's own schemas, mcap + mcap_ros2) and by
-hexapod_workspace.logs.recording. SIGINT must leave a finished log; SIGKILL must keep every message
+hexapod_workspace.logs. SIGINT must leave a finished log; SIGKILL must keep every message
 flushed before the kill; an unwritable recording directory must not stop the node serving.
 """
 
@@ -31,7 +31,8 @@ from hexapod_workspace_msgs.srv import CheckPoses, ComputeWorkspace  # noqa: E40
 from sensor_msgs.msg import PointCloud2  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 
-from hexapod_workspace.logs import messages, recording  # noqa: E402
+from hexapod_workspace import logs  # noqa: E402
+from hexapod_workspace.core.resolution import WorkspaceKind  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # test/recording_support.py
 from recording_support import plain, read_with_mcap_ros2, read_with_rosbags  # noqa: E402
@@ -53,10 +54,10 @@ NODE_PARAMS = {
 
 
 def the_log(directory: Path) -> Path:
-    logs = sorted(directory.glob("*.mcap"))
-    assert len(logs) == 1, f"expected one log per node run in {directory}, found {logs}"
-    assert logs[0].name.startswith("hexapod_workspace_2")  # named by the start time
-    return logs[0]
+    found = sorted(directory.glob("*.mcap"))
+    assert len(found) == 1, f"expected one log per node run in {directory}, found {found}"
+    assert found[0].name.startswith("hexapod_workspace_2")  # named by the start time
+    return found[0]
 
 
 def check_request(angles_deg: list[list[float]]) -> CheckPoses.Request:
@@ -122,7 +123,7 @@ def test_sigint_log_holds_exactly_what_the_node_did(ros_domain, ros_client, tmp_
         check_response = ros_client.call(CheckPoses, f"{node_name}/check_poses", check)
         compute = ComputeWorkspace.Request()
         compute.request.request_id = "recording-test"
-        compute.request.kind = messages.PROJECTED_TORSION_ZERO
+        compute.request.kind = WorkspaceKind.PROJECTED_TORSION_ZERO
         compute.request.position.z = -1.3
         compute_response = ros_client.call(
             ComputeWorkspace, f"{node_name}/compute_workspace", compute
@@ -142,7 +143,7 @@ def test_sigint_log_holds_exactly_what_the_node_did(ros_domain, ros_client, tmp_
         assert stop(node) == 0, node.output()
     path = the_log(tmp_path / "logs")
 
-    ours = recording.read_log(path)
+    ours = logs.read_log(path)
     assert ours.finished and ours.problems == [], ours.problems
     entries = [(m.topic, m.msgtype, m.message) for m in ours.messages]
     for reader_entries in (read_with_rosbags(path), read_with_mcap_ros2(path)):
@@ -170,10 +171,10 @@ def test_sigkill_keeps_what_was_flushed(ros_domain, ros_client, tmp_path) -> Non
         log_dir = tmp_path / "logs"
 
         def flushed() -> bool:  # the flush interval bounds how long this takes
-            logs = list(log_dir.glob("*.mcap"))
-            if len(logs) != 1:
+            found = list(log_dir.glob("*.mcap"))
+            if len(found) != 1:
                 return False
-            topics = [m.topic for m in recording.read_log(logs[0]).messages]
+            topics = [m.topic for m in logs.read_log(found[0]).messages]
             return f"{node_name}/check_poses/response" in topics
 
         ros_client.spin_until(
@@ -181,7 +182,7 @@ def test_sigkill_keeps_what_was_flushed(ros_domain, ros_client, tmp_path) -> Non
         )
         node.stop(signal.SIGKILL)
     path = the_log(tmp_path / "logs")
-    contents = recording.read_log(path)
+    contents = logs.read_log(path)
     assert not contents.finished
     recorded = by_topic([(m.topic, m.msgtype, m.message) for m in contents.messages])
     assert recorded[f"{node_name}/check_poses/request"] == [plain(request)]
@@ -230,4 +231,4 @@ def test_recorded_type_hashes_are_the_ones_rclpy_announces(ros_client) -> None:
         topic = f"/type_hash_check/t{index}"
         ros_client.node.create_publisher(message_class, topic, 1)
         (info,) = ros_client.node.get_publishers_info_by_topic(topic)
-        assert recording.type_hash(msgtype) == str(info.topic_type_hash), msgtype
+        assert logs.type_hash(msgtype) == str(info.topic_type_hash), msgtype

@@ -17,6 +17,7 @@ from rclpy.serialization import deserialize_message, serialize_message  # noqa: 
 from sensor_msgs.msg import PointCloud2  # noqa: E402
 
 from hexapod_workspace import check  # noqa: E402
+from hexapod_workspace.core.resolution import WorkspaceKind  # noqa: E402
 from hexapod_workspace.logs import messages  # noqa: E402
 from hexapod_workspace.ros.conversions import (  # noqa: E402
     angles_from_orientations,
@@ -64,7 +65,7 @@ def test_failed_summary_keeps_nan_fields():
         None,
         stamp_ns=5,
         frame_id="base",
-        kind=messages.ORIENTATION,
+        kind=WorkspaceKind.ORIENTATION,
         position=np.zeros(3),
         message="bad",
     )

@@ -24,8 +24,12 @@ from rcl_interfaces.srv import (  # noqa: E402
     SetParametersAtomically,
 )
 
-from hexapod_workspace import CONSTRAINT_NAMES, Manipulator, check  # noqa: E402
-from hexapod_workspace.logs import recording  # noqa: E402
+from hexapod_workspace import (  # noqa: E402
+    CONSTRAINT_NAMES,
+    Manipulator,
+    check,
+    logs,
+)
 
 NODE = "/hexapod_workspace"
 #: Small resolutions keep the workspace computations of the tests short.
@@ -280,11 +284,11 @@ def test_recording_switched_off_finishes_the_log_and_on_starts_a_new_one(client,
     (first,) = sorted(workspace_node.record_dir.glob("*.mcap"))
     (result,) = set_parameters(client, boolean("recording.enabled", False))
     assert result.successful, result.reason
-    contents = recording.read_log(first)
+    contents = logs.read_log(first)
     assert contents.finished, contents.problems
     assert contents.topics[f"{NODE}/check_poses/request"].count > 0
     assert contents.topics[f"{NODE}/check_poses/response"].count > 0
     (result,) = set_parameters(client, boolean("recording.enabled", True))
     assert result.successful, result.reason
-    logs = sorted(workspace_node.record_dir.glob("*.mcap"))
-    assert len(logs) == 2 and first in logs
+    log_files = sorted(workspace_node.record_dir.glob("*.mcap"))
+    assert len(log_files) == 2 and first in log_files

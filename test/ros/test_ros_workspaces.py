@@ -29,6 +29,7 @@ from std_srvs.srv import Trigger  # noqa: E402
 
 from hexapod_workspace.core.orientation import orientation_workspace  # noqa: E402
 from hexapod_workspace.core.projected import projected_workspace  # noqa: E402
+from hexapod_workspace.core.resolution import WorkspaceKind  # noqa: E402
 from hexapod_workspace.logs import messages  # noqa: E402
 
 NODE = "/hexapod_workspace"
@@ -41,16 +42,16 @@ NODE_PARAMS = {
 }
 HOME = (0.0, 0.0, -1.3)
 CLOUD_TOPIC = {
-    messages.ORIENTATION: f"{NODE}/orientation_workspace",
-    messages.PROJECTED_TORSION_ZERO: f"{NODE}/projected_workspace",
-    messages.PROJECTED_EXACT: f"{NODE}/projected_workspace",
+    WorkspaceKind.ORIENTATION: f"{NODE}/orientation_workspace",
+    WorkspaceKind.PROJECTED_TORSION_ZERO: f"{NODE}/projected_workspace",
+    WorkspaceKind.PROJECTED_EXACT: f"{NODE}/projected_workspace",
 }
 
 
 def core_workspace(model, kind, position=HOME, n_rays=0, psi_step=0.0, tolerance=0.0):
     """The core's result for a request with the node's resolution defaults."""
     tolerance = tolerance or TOLERANCE
-    if kind == messages.ORIENTATION:
+    if kind == WorkspaceKind.ORIENTATION:
         return orientation_workspace(
             model,
             position,
@@ -61,7 +62,7 @@ def core_workspace(model, kind, position=HOME, n_rays=0, psi_step=0.0, tolerance
     return projected_workspace(
         model,
         position,
-        method=messages.KIND_NAMES[kind],
+        method=WorkspaceKind(kind).label,
         n_phi=n_rays or N_PHI,
         tolerance=tolerance,
     )
@@ -103,7 +104,7 @@ def assert_summary_matches(summary: WorkspaceSummary, workspace, kind: int) -> N
         [summary.position.x, summary.position.y, summary.position.z], workspace.position
     )
     assert summary.tolerance == pytest.approx(workspace.tolerance)
-    if kind == messages.ORIENTATION:
+    if kind == WorkspaceKind.ORIENTATION:
         assert summary.psi_min == pytest.approx(workspace.psi_min, abs=1e-12)
         assert summary.psi_max == pytest.approx(workspace.psi_max, abs=1e-12)
         assert summary.volume == pytest.approx(workspace.volume, rel=1e-9)
@@ -121,7 +122,11 @@ def assert_summary_matches(summary: WorkspaceSummary, workspace, kind: int) -> N
 
 @pytest.mark.parametrize(
     "kind",
-    [messages.PROJECTED_TORSION_ZERO, messages.PROJECTED_EXACT, messages.ORIENTATION],
+    [
+        WorkspaceKind.PROJECTED_TORSION_ZERO,
+        WorkspaceKind.PROJECTED_EXACT,
+        WorkspaceKind.ORIENTATION,
+    ],
     ids=["torsion_zero", "exact", "orientation"],
 )
 def test_compute_workspace_matches_core(client, model, kind):
@@ -139,14 +144,14 @@ def test_compute_workspace_matches_core(client, model, kind):
 def test_compute_workspace_at_another_position_with_own_resolution(client, model):
     position = (0.05, -0.05, -1.25)
     expected = core_workspace(
-        model, messages.PROJECTED_TORSION_ZERO, position, n_rays=40, tolerance=1e-6
+        model, WorkspaceKind.PROJECTED_TORSION_ZERO, position, n_rays=40, tolerance=1e-6
     )
     request = workspace_request(
-        messages.PROJECTED_TORSION_ZERO, position, n_rays=40, tolerance=1e-6
+        WorkspaceKind.PROJECTED_TORSION_ZERO, position, n_rays=40, tolerance=1e-6
     )
     response = compute(client, request)
     assert response.summary.n_rays == 40
-    assert_summary_matches(response.summary, expected, messages.PROJECTED_TORSION_ZERO)
+    assert_summary_matches(response.summary, expected, WorkspaceKind.PROJECTED_TORSION_ZERO)
     assert_cloud_matches(response.boundary, expected, model.frame_id)
 
 
@@ -158,13 +163,13 @@ def test_compute_workspace_at_another_position_with_own_resolution(client, model
         ({"n_rays": 100_000}, "n_rays"),
         ({"tolerance": math.nan}, "tolerance"),
         ({"tolerance": 0.5}, "tolerance"),
-        ({"psi_step": math.inf, "kind": messages.ORIENTATION}, "psi_step"),
+        ({"psi_step": math.inf, "kind": WorkspaceKind.ORIENTATION}, "psi_step"),
         ({"kind": 9}, "kind"),
     ],
     ids=["nan-pos", "inf-pos", "too-many-rays", "nan-tol", "coarse-tol", "inf-step", "kind"],
 )
 def test_compute_workspace_refuses_bad_requests(client, request_fields, reason):
-    fields = {"kind": messages.PROJECTED_TORSION_ZERO, **request_fields}
+    fields = {"kind": WorkspaceKind.PROJECTED_TORSION_ZERO, **request_fields}
     response = compute(client, workspace_request(**fields))
     assert not response.success
     assert reason in response.message
@@ -174,13 +179,13 @@ def test_compute_workspace_refuses_bad_requests(client, request_fields, reason):
 
 def test_unreachable_reference_is_an_empty_workspace_not_a_crash(client):
     # platform in the base plane: every leg far below its minimum length
-    response = compute(client, workspace_request(messages.PROJECTED_TORSION_ZERO, (0, 0, 0)))
+    response = compute(client, workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO, (0, 0, 0)))
     assert not response.success
     assert not response.summary.reference_reachable
     assert response.boundary.width == 0
     assert response.message
     # and the node still serves
-    assert compute(client, workspace_request(messages.PROJECTED_TORSION_ZERO)).success
+    assert compute(client, workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO)).success
 
 
 # ---------------------------------------------------------------------------- Trigger services
@@ -189,8 +194,8 @@ def test_unreachable_reference_is_an_empty_workspace_not_a_crash(client):
 @pytest.mark.parametrize(
     ("service", "kind"),
     [
-        ("compute_projected_workspace", messages.PROJECTED_TORSION_ZERO),
-        ("compute_orientation_workspace", messages.ORIENTATION),
+        ("compute_projected_workspace", WorkspaceKind.PROJECTED_TORSION_ZERO),
+        ("compute_orientation_workspace", WorkspaceKind.ORIENTATION),
     ],
 )
 def test_trigger_publishes_cloud_and_summary(client, model, service, kind):
@@ -217,7 +222,7 @@ def test_trigger_publishes_cloud_and_summary(client, model, service, kind):
 
 def test_late_subscriber_gets_the_last_result(client, model):
     """Transient-local results: a subscriber created after the computation still gets it."""
-    response = compute(client, workspace_request(messages.PROJECTED_EXACT, request_id="late"))
+    response = compute(client, workspace_request(WorkspaceKind.PROJECTED_EXACT, request_id="late"))
     assert response.success, response.message
     summaries = client.collect(WorkspaceSummary, f"{NODE}/workspace_summary", transient_local=True)
     clouds = client.collect(PointCloud2, f"{NODE}/projected_workspace", transient_local=True)
@@ -231,19 +236,19 @@ def test_late_subscriber_gets_the_last_result(client, model):
 
 
 def test_workspace_request_topic_publishes_results(client, model):
-    expected = core_workspace(model, messages.PROJECTED_TORSION_ZERO)
+    expected = core_workspace(model, WorkspaceKind.PROJECTED_TORSION_ZERO)
     summaries = client.collect(WorkspaceSummary, f"{NODE}/workspace_summary")
     clouds = client.collect(PointCloud2, f"{NODE}/projected_workspace")
     publisher = client.publisher(WorkspaceRequest, f"{NODE}/workspace_request")
-    publisher.publish(workspace_request(messages.PROJECTED_TORSION_ZERO, request_id="topic-1"))
-    bad = workspace_request(messages.PROJECTED_TORSION_ZERO, (math.nan, 0, 0), "topic-bad")
+    publisher.publish(workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO, request_id="topic-1"))
+    bad = workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO, (math.nan, 0, 0), "topic-bad")
     publisher.publish(bad)
     client.spin_until(
         lambda: {"topic-1", "topic-bad"} <= {s.request_id for s in summaries},
         what="summaries of both requests",
     )
     by_id = {s.request_id: s for s in summaries}
-    assert_summary_matches(by_id["topic-1"], expected, messages.PROJECTED_TORSION_ZERO)
+    assert_summary_matches(by_id["topic-1"], expected, WorkspaceKind.PROJECTED_TORSION_ZERO)
     assert not by_id["topic-bad"].success
     assert "finite" in by_id["topic-bad"].message
     client.spin_until(
@@ -259,7 +264,9 @@ def test_pose_checks_are_answered_during_a_long_computation(client, model):
     """A 3-D workspace computation (workspace callback group, worker process) does not hold up
     check_poses (check group, multi-threaded executor): checks are answered before it ends."""
     request = ComputeWorkspace.Request(
-        request=workspace_request(messages.ORIENTATION, n_rays=180, psi_step=0.01, tolerance=1e-6)
+        request=workspace_request(
+            WorkspaceKind.ORIENTATION, n_rays=180, psi_step=0.01, tolerance=1e-6
+        )
     )
     long_call = client.client(ComputeWorkspace, f"{NODE}/compute_workspace").call_async(request)
     # let the request reach the node (not an assertion: a slow delivery only weakens the test)
@@ -296,12 +303,14 @@ def worker_pids(node_pid: int) -> list[int]:
 def test_a_killed_worker_process_is_replaced(client, workspace_node):
     """The computation process dies (OOM killer, a bug): the node keeps serving and starts a
     new one for the next request."""
-    assert compute(client, workspace_request(messages.PROJECTED_TORSION_ZERO)).success
+    assert compute(client, workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO)).success
     pids = worker_pids(workspace_node.process.pid)
     assert pids, "the node has no worker process"
     for pid in pids:
         os.kill(pid, signal.SIGKILL)
-    response = compute(client, workspace_request(messages.PROJECTED_TORSION_ZERO, request_id="w"))
+    response = compute(
+        client, workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO, request_id="w")
+    )
     assert response.success, response.message
     assert response.summary.request_id == "w"
     assert set(worker_pids(workspace_node.process.pid)).isdisjoint(pids)

@@ -1,0 +1,153 @@
+"""One definition of every resolution fact: methods, kinds, bounds, defaults, and their checks.
+
+The core functions, the CLI, the ROS node (parameter ranges, request checks) and the logs (the
+``kind`` constant of a recorded request) all read these names, so the same request gets the same
+answer and the same refusal wherever it comes in.
+
+Units: rad for angles and tolerances; counts are plain integers.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import InputError, ResolutionError
+
+if TYPE_CHECKING:
+    from .manipulator import Manipulator
+
+__all__ = [
+    "DEFAULT_N_PHI",
+    "DEFAULT_N_RAYS",
+    "DEFAULT_PSI_STEP",
+    "DEFAULT_TOLERANCE",
+    "MAX_POINTS",
+    "MAX_PSI_STEP",
+    "MAX_RAYS",
+    "MAX_SLICES",
+    "MAX_TOLERANCE",
+    "MIN_PSI_STEP",
+    "MIN_RAYS",
+    "MIN_TOLERANCE",
+    "Method",
+    "Progress",
+    "WorkspaceKind",
+    "validate_position",
+    "validate_psi_step",
+    "validate_rays",
+    "validate_tolerance",
+]
+
+
+class Method(str, enum.Enum):
+    """How the projected orientation workspace is computed."""
+
+    #: The paper's approximation: the boundary along each azimuth at ψ = 0.
+    TORSION_ZERO = "torsion_zero"
+    #: The true shadow: for each azimuth the largest tilt attainable with some torsion.
+    EXACT = "exact"
+
+    def __str__(self) -> str:
+        return self.value
+
+
+class WorkspaceKind(enum.IntEnum):
+    """What a workspace request asks for (the ``kind`` constants of ``WorkspaceRequest.msg``)."""
+
+    ORIENTATION = 0
+    PROJECTED_TORSION_ZERO = 1
+    PROJECTED_EXACT = 2
+
+    @property
+    def label(self) -> str:
+        """``orientation``, ``torsion_zero`` or ``exact``: the name used in reports and logs."""
+        return _KIND_LABELS[self]
+
+    @classmethod
+    def of(cls, value: int) -> WorkspaceKind | None:
+        """The kind whose constant is ``value``, or None when no kind has it."""
+        try:
+            return cls(int(value))
+        except (ValueError, TypeError):
+            return None
+
+    @classmethod
+    def projected(cls, method: Method | str) -> WorkspaceKind:
+        """The kind of a projected workspace computed with ``method``."""
+        return cls.PROJECTED_EXACT if Method(method) is Method.EXACT else cls.PROJECTED_TORSION_ZERO
+
+
+_KIND_LABELS = {
+    WorkspaceKind.ORIENTATION: "orientation",
+    WorkspaceKind.PROJECTED_TORSION_ZERO: Method.TORSION_ZERO.value,
+    WorkspaceKind.PROJECTED_EXACT: Method.EXACT.value,
+}
+
+#: Bounds on ray counts (``n_phi``, ``n_rays``).
+MIN_RAYS, MAX_RAYS = 3, 7200
+#: Bounds on boundary tolerances, rad.
+MIN_TOLERANCE, MAX_TOLERANCE = 1e-12, 0.1
+#: Bounds on the slice step Δψ of the orientation workspace, rad.
+MIN_PSI_STEP, MAX_PSI_STEP = 1e-4, 0.5
+#: Largest number of slices one orientation workspace may produce (both directions together).
+MAX_SLICES = 20_000
+#: Largest number of boundary points (slices × rays) one orientation workspace may produce.
+MAX_POINTS = 5_000_000
+
+#: Default azimuths of the projected workspace.
+DEFAULT_N_PHI = 360
+#: Default rays per slice of the orientation workspace.
+DEFAULT_N_RAYS = 180
+#: Default slice step of the orientation workspace, rad (1°).
+DEFAULT_PSI_STEP = math.radians(1.0)
+#: Default boundary tolerance of every computation (API, CLI and node alike), rad.
+DEFAULT_TOLERANCE = 1e-6
+
+#: A progress callback: receives the fraction done, 0..1, non-decreasing.
+Progress = Callable[[float], None]
+
+
+def validate_rays(count: int, name: str) -> int:
+    """Check a ray count (``n_phi``, ``n_rays``) against [:data:`MIN_RAYS`, :data:`MAX_RAYS`]."""
+    if isinstance(count, bool) or not isinstance(count, (int, np.integer)):
+        msg = f"{name}: expected an integer, got {count!r}"
+        raise ResolutionError(msg)
+    if not MIN_RAYS <= count <= MAX_RAYS:
+        msg = f"{name}: expected {MIN_RAYS} to {MAX_RAYS} rays, got {count}"
+        raise ResolutionError(msg)
+    return int(count)
+
+
+def validate_tolerance(tolerance: float, name: str = "tolerance") -> float:
+    """Check a boundary tolerance (rad) against [:data:`MIN_TOLERANCE`, :data:`MAX_TOLERANCE`]."""
+    value = float(tolerance)
+    if not (math.isfinite(value) and MIN_TOLERANCE <= value <= MAX_TOLERANCE):
+        msg = f"{name}: expected {MIN_TOLERANCE:g} to {MAX_TOLERANCE:g} rad, got {tolerance!r}"
+        raise ResolutionError(msg)
+    return value
+
+
+def validate_psi_step(psi_step: float, name: str = "psi_step") -> float:
+    """Check a slice step Δψ (rad) against [:data:`MIN_PSI_STEP`, :data:`MAX_PSI_STEP`]."""
+    value = float(psi_step)
+    if not (math.isfinite(value) and MIN_PSI_STEP <= value <= MAX_PSI_STEP):
+        msg = f"{name}: expected {MIN_PSI_STEP:g} to {MAX_PSI_STEP:g} rad, got {psi_step!r}"
+        raise ResolutionError(msg)
+    return value
+
+
+def validate_position(manipulator: Manipulator, position: ArrayLike | None) -> NDArray[np.float64]:
+    """The position to use (default ``manipulator.position``), checked: shape (3,), finite, m."""
+    if position is None:
+        return np.array(manipulator.position)
+    array = np.asarray(position, dtype=np.float64)
+    if array.shape != (3,) or not np.all(np.isfinite(array)):
+        msg = f"position: expected 3 finite values (x, y, z) in m, got {np.ravel(array).tolist()}"
+        raise InputError(msg)
+    return array
