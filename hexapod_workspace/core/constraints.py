@@ -21,13 +21,16 @@ and processed in cache-sized chunks; there is no Python loop per pose.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
-from .manipulator import Manipulator
 from .rotations import tt_to_matrix
+
+if TYPE_CHECKING:
+    from .manipulator import Manipulator
 
 __all__ = [
     "CONSTRAINT_NAMES",

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import ConfigError, GeometryError
+from .constraints import check
 from .params import flatten, load_params_file
 
 __all__ = ["PARAMETER_DEFAULTS", "HomePoseWarning", "Manipulator"]
@@ -347,8 +348,6 @@ class Manipulator:
 
     def home_pose_violations(self) -> list[str]:
         """Names of the constraints violated at the home pose (home position, identity)."""
-        from .constraints import check
-
         result = check(self, np.zeros((1, 3)), self.home_position)
         return result.violated[0]
 

@@ -124,22 +124,23 @@ def validate_rays(count: int, name: str) -> int:
     return int(count)
 
 
+def _bounded(value: float, low: float, high: float, name: str) -> float:
+    """``value`` as a float when finite and within [low, high] rad, else ResolutionError."""
+    number = float(value)
+    if not (math.isfinite(number) and low <= number <= high):
+        msg = f"{name}: expected {low:g} to {high:g} rad, got {value!r}"
+        raise ResolutionError(msg)
+    return number
+
+
 def validate_tolerance(tolerance: float, name: str = "tolerance") -> float:
     """Check a boundary tolerance (rad) against [:data:`MIN_TOLERANCE`, :data:`MAX_TOLERANCE`]."""
-    value = float(tolerance)
-    if not (math.isfinite(value) and MIN_TOLERANCE <= value <= MAX_TOLERANCE):
-        msg = f"{name}: expected {MIN_TOLERANCE:g} to {MAX_TOLERANCE:g} rad, got {tolerance!r}"
-        raise ResolutionError(msg)
-    return value
+    return _bounded(tolerance, MIN_TOLERANCE, MAX_TOLERANCE, name)
 
 
 def validate_psi_step(psi_step: float, name: str = "psi_step") -> float:
     """Check a slice step Δψ (rad) against [:data:`MIN_PSI_STEP`, :data:`MAX_PSI_STEP`]."""
-    value = float(psi_step)
-    if not (math.isfinite(value) and MIN_PSI_STEP <= value <= MAX_PSI_STEP):
-        msg = f"{name}: expected {MIN_PSI_STEP:g} to {MAX_PSI_STEP:g} rad, got {psi_step!r}"
-        raise ResolutionError(msg)
-    return value
+    return _bounded(psi_step, MIN_PSI_STEP, MAX_PSI_STEP, name)
 
 
 def validate_position(manipulator: Manipulator, position: ArrayLike | None) -> NDArray[np.float64]:
