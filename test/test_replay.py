@@ -20,6 +20,7 @@ from test_messages import orientation_stub, projected_stub
 from hexapod_workspace import logs
 from hexapod_workspace.cli.replay import run_replay
 from hexapod_workspace.core import constraints
+from hexapod_workspace.core.orientation import OrientationSlice
 from hexapod_workspace.logs import messages
 from hexapod_workspace.logs.record import record_results
 from hexapod_workspace.logs.summary import summarize_log
@@ -170,8 +171,9 @@ def test_cli_record_then_replay(tmp_path: Path) -> None:
 
 
 def test_plot_redraws_overlaid_methods_and_degenerate_workspaces(tmp_path: Path) -> None:
-    single_point = orientation_stub()
-    single_point.boundary_points = lambda: np.array([[0.1, 0.0, 0.0, 0.0, 0.1, 0.0]])
+    single_point = orientation_stub(
+        [OrientationSlice(psi=0.0, center=np.zeros(2), phi=np.zeros(1), theta=np.full(1, 0.1))]
+    )
     path = record_results(
         tmp_path / "stubs.mcap",
         [projected_stub("exact"), projected_stub(), orientation_stub(), single_point],
