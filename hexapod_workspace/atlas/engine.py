@@ -220,7 +220,7 @@ def run_atlas(
         Complete an existing store of the same run (manipulator, grid, options, chunks,
         software version): only chunks without a completion marker are computed.
     chunk : tuple of int, optional
-        Positions per chunk along each dim (default 4×4×4, or 64 explicit positions).
+        Positions per chunk along each dim (default: see :meth:`ChunkLayout.for_grid`).
     progress : callable, optional
         ``progress(positions_done, positions_total)`` after each chunk (and once at the start).
     connect_timeout : float

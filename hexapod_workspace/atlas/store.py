@@ -46,6 +46,8 @@ __all__ = [
 ]
 
 MARKER = "chunk_done"
+#: Default chunk shapes shrink until the grid has at least this many chunks.
+MIN_CHUNKS = 32
 _COORD_ATTRS = {
     "x": {"units": "m", "long_name": "tool-tip position x, base frame"},
     "y": {"units": "m", "long_name": "tool-tip position y, base frame"},
@@ -70,10 +72,19 @@ class ChunkLayout:
 
     @classmethod
     def for_grid(cls, grid: AtlasGrid, chunk: tuple[int, ...] | None = None) -> ChunkLayout:
-        """Default chunks: 4×4×4 positions for a box, 64 for explicit positions."""
+        """The given chunk shape, or a default: the largest of 4×4×4, 3×3×3, 2×2×2 (64 to 8
+        explicit positions) that still cuts the grid into :data:`MIN_CHUNKS` chunks (so that
+        the workers stay busy to the end), else one position per chunk."""
         shape = grid.shape
         if chunk is None:
-            chunk = (4, 4, 4) if grid.is_box else (64,)
+            chunk = (1,) * len(shape)
+            for edge in (4, 3, 2):
+                trial = (edge,) * 3 if grid.is_box else (edge**3,)
+                if np.prod([math.ceil(s / c) for s, c in zip(shape, trial, strict=True)]) >= (
+                    MIN_CHUNKS
+                ):
+                    chunk = trial
+                    break
         chunk = tuple(int(c) for c in chunk)
         if len(chunk) != len(shape) or any(c < 1 for c in chunk):
             msg = f"chunk: expected {len(shape)} positive integers, got {list(chunk)}"

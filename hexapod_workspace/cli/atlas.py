@@ -90,7 +90,8 @@ def add_atlas_parser(commands: Any) -> None:
         type=int,
         nargs=3,
         metavar=("CX", "CY", "CZ"),
-        help="positions per task and Zarr chunk along x, y, z (default 4 4 4)",
+        help="positions per task and Zarr chunk along x, y, z "
+        "(default: 4 4 4, smaller for small grids)",
     )
     sub.add_argument(
         "--volume", action="store_true", help="also the 3-D orientation workspace volume (slow)"
