@@ -7,13 +7,17 @@ tolerance 1e-4 rad):
 
 * **scaling**: the same box computed in this process (``workers=0``, no Dask) and on a local
   cluster with one single-threaded worker process per core (bound to 127.0.0.1, no dashboard);
-  the cluster's start-up is timed apart. Ratio = cluster rate / one-process rate.
+  the cluster's start-up is timed apart. Ratio = cluster rate / one-process rate. Other jobs on
+  a shared machine cap that ratio, so the CPU seconds per position are measured too (this
+  process, and every worker through ``Client.run``): their ratio gives the scaling on idle
+  cores.
 * **warm start**: along a line of neighbouring positions, the ``exact`` tilt capability
   computed cold (the ψ grid of :func:`projected_workspace`) against a warm start that searches
   ψ only around the neighbour's best torsion per azimuth. Reports the speed ratio and how far
   the warm answer strays from the cold one.
-* **paper estimate**: hours for 100 × 100 × 50 = 500,000 positions on 1, 8 and 64 machines like
-  this one, from the measured per-position cost and the measured cluster efficiency.
+* **paper estimate**: hours for 100 × 100 × 50 = 500,000 positions on 1, 8 and 64 idle
+  machines with as many cores as this one, from the measured CPU seconds per position and the
+  workers' measured CPU efficiency.
 
 Usage: python benchmarks/atlas.py [--step S] [--workers N]
 """
@@ -99,13 +103,26 @@ def warm_exact(
     return np.where(better, refined, theta), np.where(better, best_psi, 0.0)
 
 
+def _worker_cpu() -> float:
+    """CPU seconds (user + system) of this process (run on each worker)."""
+    import psutil
+
+    times = psutil.Process().cpu_times()
+    return times.user + times.system
+
+
 def scaling(manipulator: Manipulator, grid: AtlasGrid, options: AtlasOptions, workers: int):
-    from distributed import LocalCluster
+    """Both runs, the cluster start-up, whether the stores are equal, and CPU seconds per
+    position in one process and on the workers (load-independent: what the ratio would be on
+    an idle machine follows from it)."""
+    from distributed import Client, LocalCluster
 
     with tempfile.TemporaryDirectory() as folder:
+        cpu = time.process_time()
         single = workspace_atlas(
             manipulator, grid, store=Path(folder) / "one.zarr", options=options, workers=0
         )
+        cpu_one = (time.process_time() - cpu) / grid.size
         started = time.perf_counter()
         with LocalCluster(
             host="127.0.0.1",
@@ -115,15 +132,19 @@ def scaling(manipulator: Manipulator, grid: AtlasGrid, options: AtlasOptions, wo
             dashboard_address=None,
         ) as cluster:
             startup = time.perf_counter() - started
-            spread = workspace_atlas(
-                manipulator,
-                grid,
-                store=Path(folder) / "cluster.zarr",
-                options=options,
-                scheduler=cluster.scheduler_address,
-            )
+            with Client(cluster) as observer:
+                before = observer.run(_worker_cpu)
+                spread = workspace_atlas(
+                    manipulator,
+                    grid,
+                    store=Path(folder) / "cluster.zarr",
+                    options=options,
+                    scheduler=cluster.scheduler_address,
+                )
+                after = observer.run(_worker_cpu)
+        cpu_workers = sum(after[k] - before[k] for k in after) / grid.size
         same = single.dataset.drop_vars("chunk_done").equals(spread.dataset.drop_vars("chunk_done"))
-    return single, spread, startup, same
+    return single, spread, startup, same, cpu_one, cpu_workers
 
 
 def warm_against_cold(manipulator: Manipulator, options: AtlasOptions, count: int):
@@ -173,7 +194,9 @@ def main() -> None:
         f"  load average at start: {load:.2f} on {os.cpu_count()} cores "
         "(other work on the machine caps the scaling ratio)"
     )
-    single, spread, startup, same = scaling(manipulator, grid, options, options_cli.workers)
+    single, spread, startup, same, cpu_one, cpu_workers = scaling(
+        manipulator, grid, options, options_cli.workers
+    )
     rate_one = grid.size / single.elapsed
     rate_cluster = grid.size / spread.elapsed
     print(f"  one process (no Dask):      {rate_one:7.2f} positions/s ({single.elapsed:.1f} s)")
@@ -185,6 +208,11 @@ def main() -> None:
         f"  scaling ratio cluster / one process: {rate_cluster / rate_one:.2f} "
         f"(ideal {spread.workers}); stores equal: {same}"
     )
+    print(
+        f"  CPU per position: one process {cpu_one * 1e3:.0f} ms, on the workers "
+        f"{cpu_workers * 1e3:.0f} ms: on idle cores the ratio would be about "
+        f"{spread.workers * cpu_one / cpu_workers:.2f}"
+    )
 
     cold_time, warm_time, cold, warm = warm_against_cold(manipulator, options, options_cli.line)
     stray = np.degrees(np.abs(warm - cold))
@@ -195,14 +223,22 @@ def main() -> None:
         f"(warm lower at {int((warm < cold - 1e-9).sum())} of {cold.size} positions)"
     )
 
-    cost = 1.0 / rate_one  # s per position on one core
-    efficiency = rate_cluster / rate_one / spread.workers
+    wall = 1.0 / rate_one  # s per position on one (shared) core
+    saved = (cold_time - warm_time) / cold.size  # s per position saved by the warm start
+    print(
+        f"  warm start per whole position (exact + torsion range + check, {wall:.3f} s cold): "
+        f"{wall / max(wall - saved, 1e-9):.2f}x"
+    )
+    # On paper: CPU seconds per position (independent of other load on this machine) and the
+    # CPU efficiency of the workers (scheduling and transfer overhead), on idle cores.
+    cost = cpu_one
+    efficiency = cpu_one / cpu_workers
     cores = options_cli.workers
     positions = 100 * 100 * 50
     print(
-        f"  paper estimate, 100 x 100 x 50 = {positions} positions at {cost:.3f} s each "
-        f"(every position costed as reachable: an upper bound), machines of {cores} cores at "
-        f"the measured efficiency {efficiency:.2f}:"
+        f"  paper estimate, 100 x 100 x 50 = {positions} positions at {cost:.3f} CPU-s each "
+        f"(every position costed as reachable: an upper bound), idle machines of {cores} cores, "
+        f"worker CPU efficiency {efficiency:.2f}:"
     )
     for machines in (1, 8, 64):
         hours = positions * cost / (machines * cores * efficiency) / 3600.0
