@@ -176,7 +176,17 @@ class _OnDask:
             futures[future] = chunk_id
         try:
             for future in as_completed(futures):
-                finished(futures[future], future.result())
+                try:
+                    values = future.result()
+                except Exception as error:  # a task that failed for good on the cluster
+                    reason = " ".join(str(error).split()) or type(error).__name__
+                    msg = (
+                        f"chunk {futures[future]} failed on the Dask cluster "
+                        f"({type(error).__name__}: {reason}); the finished chunks are kept, "
+                        "--resume completes the store"
+                    )
+                    raise AtlasError(msg) from error
+                finished(futures[future], values)
         finally:
             self.client.cancel(list(futures))
 
