@@ -241,11 +241,12 @@ def test_cli_json_plots_and_dexterous_volume(reference, tmp_path):
 
 
 def test_cli_interrupted_by_sigint_then_resumed(reference, tmp_path):
-    """A real interruption: SIGINT to the CLI once a chunk marker is on disk, then --resume."""
+    """A real interruption: SIGINT to the CLI (on its local cluster) once a chunk marker is on
+    disk, then --resume (in process)."""
     store = tmp_path / "sigint.zarr"
     env = dict(os.environ, MPLBACKEND="Agg")
     process = subprocess.Popen(
-        [*cli_command(), *CLI_JOB, "--out", str(store), "--workers", "0"],
+        [*cli_command(), *CLI_JOB, "--out", str(store), "--workers", "2"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -264,6 +265,7 @@ def test_cli_interrupted_by_sigint_then_resumed(reference, tmp_path):
             process.kill()
             process.wait(timeout=10)
     assert process.returncode == 130, stderr
+    assert stderr.strip() == "hexapod-workspace: interrupted"
     markers = int(open_atlas(store)[MARKER].values.sum())
     assert 1 <= markers < 6
     done = run_cli("--json", *CLI_JOB, "--out", str(store), "--workers", "0", "--resume")

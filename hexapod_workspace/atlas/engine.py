@@ -16,6 +16,7 @@ with a marker and ``resume=True`` computes only the others.
 
 from __future__ import annotations
 
+import logging
 import os
 import shutil
 import time
@@ -154,6 +155,7 @@ class _OnDask:
                 processes=True,
                 host="127.0.0.1",
                 dashboard_address=None,
+                silence_logs=logging.ERROR,  # no worker chatter on the CLI's stderr
             )
             self.client = Client(self.cluster)
         try:
