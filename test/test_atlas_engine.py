@@ -323,3 +323,27 @@ def test_cli_existing_store_without_resume_exits_2_and_keeps_it(tmp_path):
     assert again.returncode == 2 and again.stderr.count("\n") == 1
     assert "already exists" in again.stderr
     assert open_atlas(store).attrs["complete"] is True
+
+
+def test_explicit_positions_with_the_optional_volume(example, tmp_path):
+    positions = [[0.0, 0.0, -1.3], [0.2, 0.2, -0.95], [0.0, 0.0, -0.7]]  # the last: unreachable
+    options = AtlasOptions(n_phi=24, tolerance=1e-3, volume=True, n_rays=24)
+    run = workspace_atlas(
+        example,
+        AtlasGrid.from_positions(positions),
+        store=tmp_path / "points.zarr",
+        options=options,
+        workers=0,
+        chunk=(2,),
+    )
+    dataset = run.dataset
+    assert dict(dataset["tilt_capability"].sizes) == {"position": 3}
+    np.testing.assert_allclose(dataset["z"].values, [-1.3, -0.95, -0.7])
+    assert dataset["orientation_volume"].attrs["units"] == "rad^3"
+    assert dataset["reference_reachable"].values.tolist() == [True, True, False]
+    assert np.isnan(dataset["orientation_volume"].values[2])
+    for row, position in enumerate(positions[:2]):
+        expected = position_capability(example, position, options)
+        for name, value in expected.items():
+            np.testing.assert_equal(float(dataset[name].values[row]), value, err_msg=name)
+    assert run.chunks_total == 2 and run.dexterous_volume(0.1) is None  # points sample no volume
