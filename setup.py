@@ -57,6 +57,10 @@ setup(
         "mcap>=1.6",
         "rosbags>=0.11",
     ],
+    extras_require={
+        # The workspace atlas engine (hexapod_workspace.atlas): pip install .[atlas]
+        "atlas": ["dask[distributed]>=2024.12", "xarray>=2025.1", "zarr>=3.0"],
+    },
     zip_safe=False,
     entry_points={
         "console_scripts": [

@@ -3,6 +3,7 @@
 #
 #   tools/venv.sh base   runtime requirements + the package (editable): enough for the CLI, demo
 #   tools/venv.sh full   base + dev tools (pytest, ruff) + ROS 2 Jazzy wheels and build tools
+#                        + the atlas extra (Dask, xarray, Zarr)
 #
 # Idempotent: each level records a hash of its requirement files and packaging metadata in the
 # venv and is skipped when nothing changed. Needs only python3 (and the package index).
@@ -13,7 +14,7 @@ level="${1:-full}"
 case "$level" in
   base) reqs=("$ROOT/requirements/base.txt") ;;
   full) reqs=("$ROOT/requirements/base.txt" "$ROOT/requirements/dev.txt"
-              "$ROOT/requirements/ros.txt") ;;
+              "$ROOT/requirements/ros.txt" "$ROOT/requirements/atlas.txt") ;;
   *) log "usage: tools/venv.sh [base|full]"; exit 2 ;;
 esac
 

@@ -670,6 +670,10 @@ def build_parser() -> argparse.ArgumentParser:
     _add_global_options(sub, top=False)
     sub.add_argument("--out", default="demo_out", metavar="DIR", help="output folder")
     sub.set_defaults(handler=cmd_demo)
+
+    from .atlas import add_atlas_parser  # its own module (imports this one)
+
+    add_atlas_parser(commands)
     return parser
 
 
