@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from .manipulator import Manipulator
+from .resolution import validate_position
 from .rotations import tt_to_matrix
 
 __all__ = [
@@ -515,13 +516,7 @@ def check(
         bad = int(np.flatnonzero(~np.all(np.isfinite(angles), axis=1))[0])
         msg = f"angles: expected finite values, pose {bad} is {angles[bad].tolist()}"
         raise InputError(msg)
-    position = manipulator.position if position is None else np.asarray(position, dtype=float)
-    if position.shape != (3,):
-        msg = f"position: expected 3 values (x, y, z), got shape {position.shape}"
-        raise InputError(msg)
-    if not np.all(np.isfinite(position)):
-        msg = f"position: expected finite values, got {position.tolist()}"
-        raise InputError(msg)
+    position = validate_position(manipulator, position)  # shape, finite, |p| bounded
 
     count = angles.shape[0]
     margins = np.empty((4, count))
