@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import importlib.util
 import io
 import json
@@ -20,6 +21,7 @@ from test_messages import orientation_stub, projected_stub
 from hexapod_workspace import logs
 from hexapod_workspace.cli.replay import run_replay
 from hexapod_workspace.core import constraints
+from hexapod_workspace.core.orientation import OrientationSlice
 from hexapod_workspace.logs import messages
 from hexapod_workspace.logs.record import record_results
 from hexapod_workspace.logs.summary import summarize_log
@@ -80,16 +82,17 @@ def test_recorded_cli_messages_equal_what_was_built(tmp_path: Path, check_result
     """The --record log decodes with rosbags and mcap_ros2 to the dicts messages.py built."""
     path = tmp_path / "cli.mcap"
     workspace = projected_stub()
-    record_results(path, [check_result, workspace], frame_id="base", stamp_ns=5_000)
+    record_results(path, [check_result, workspace], frame_id="base", stamps_ns=[5_000, 7_000])
     points = messages.boundary_points(workspace)
+    answered = 7_000 + round(workspace.elapsed * 1e9)  # the response, elapsed after the request
     expected = [
         messages.check_poses_request_fields(check_result.position, check_result.angles),
         messages.check_poses_response_fields(check_result),
         messages.compute_workspace_request_fields(workspace, stamp_ns=7_000, frame_id="base")[
             "request"
         ],
-        messages.summary_fields(workspace, stamp_ns=8_000, frame_id="base", n_points=36),
-        messages.pointcloud_fields(points, frame_id="base", stamp_ns=8_000),
+        messages.summary_fields(workspace, stamp_ns=answered, frame_id="base", n_points=36),
+        messages.pointcloud_fields(points, frame_id="base", stamp_ns=answered),
     ]
     for reader in (read_with_rosbags, read_with_mcap_ros2):
         assert [plain(message) for _, _, message in reader(path)] == plain(expected)
@@ -170,8 +173,8 @@ def test_cli_record_then_replay(tmp_path: Path) -> None:
 
 
 def test_plot_redraws_overlaid_methods_and_degenerate_workspaces(tmp_path: Path) -> None:
-    single_point = orientation_stub()
-    single_point.boundary_points = lambda: np.array([[0.1, 0.0, 0.0, 0.0, 0.1, 0.0]])
+    one = OrientationSlice(psi=0.0, center=np.zeros(2), phi=np.zeros(1), theta=np.full(1, 0.1))
+    single_point = dataclasses.replace(orientation_stub(), slices=[one])
     path = record_results(
         tmp_path / "stubs.mcap",
         [projected_stub("exact"), projected_stub(), orientation_stub(), single_point],
@@ -213,9 +216,13 @@ def test_truncated_logs(tmp_path: Path, check_result) -> None:
     half = tmp_path / "half.mcap"
     half.write_bytes(data[: len(data) // 2])
     code, out, err = replay(half, as_json=True)
-    assert code == 0 and err.startswith("note: half.mcap: unreadable from about byte")
+    # Item 15: a damaged log is reported as damaged, exit 1, after everything intact.
+    assert code == 1 and err.startswith("note: half.mcap: unreadable from about byte")
+    assert err.splitlines()[-1].endswith(
+        "is damaged; everything intact was read (see the notes above)"
+    )
     report = json.loads(out)
-    assert not report["finished"] and report["problems"]
+    assert not report["finished"] and report["damaged"] and report["problems"]
     assert report["message_count"] >= 2
 
 

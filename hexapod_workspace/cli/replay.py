@@ -6,7 +6,6 @@ The log is read by :mod:`hexapod_workspace.logs.summary`; ``--publish`` hands it
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 import sys
@@ -43,8 +42,7 @@ def _rebuild(record: WorkspaceRecord) -> Any:
             rows = points[psi == level]
             # The ray origin is not recorded; the centroid of the slice's boundary stands in.
             slices.append(
-                _make(
-                    OrientationSlice,
+                OrientationSlice(
                     psi=float(rows[0, 5]),
                     center=rows[:, :2].mean(axis=0),
                     phi=rows[:, 3],
@@ -52,8 +50,7 @@ def _rebuild(record: WorkspaceRecord) -> Any:
                 )
             )
         step = float(np.median(np.diff(levels))) if levels.size > 1 else 0.0
-        return _make(
-            OrientationWorkspace,
+        return OrientationWorkspace(
             position=position,
             slices=slices,
             psi_min=summary["psi_min"],
@@ -66,8 +63,7 @@ def _rebuild(record: WorkspaceRecord) -> Any:
         )
     from hexapod_workspace.core.projected import ProjectedWorkspace
 
-    return _make(
-        ProjectedWorkspace,
+    return ProjectedWorkspace(
         method=WorkspaceKind(kind).label,
         position=position,
         phi=points[:, 3],
@@ -80,12 +76,6 @@ def _rebuild(record: WorkspaceRecord) -> Any:
         elapsed=summary["elapsed"],
         limiting=[""] * len(points),
     )
-
-
-def _make(cls: type, **values: Any) -> Any:
-    """Build a result dataclass from the values a log can give; other fields keep defaults."""
-    names = {f.name for f in dataclasses.fields(cls)}
-    return cls(**{k: v for k, v in values.items() if k in names})
 
 
 def _plot(summary: LogSummary, plot_dir: Path, out: IO[str], err: IO[str]) -> list[Path]:
