@@ -412,3 +412,43 @@ def test_publish_counts_only_what_went_out(tmp_path: Path, monkeypatch) -> None:
     assert err.splitlines()[-1] == (
         "republished 3 of 5 messages on 1 topics (2 not republished, see the notes above)"
     )
+
+
+def test_plotting_leaves_matplotlib_global_state_alone(tmp_path: Path) -> None:
+    """Finding 8: no backend switch and no pyplot on import or use; axis beyond the curves."""
+    import subprocess
+    import sys
+
+    script = f"""
+import sys
+import matplotlib
+matplotlib.use("svg")
+sys.path.insert(0, {str(Path(__file__).parent)!r})
+from test_messages import orientation_stub, projected_stub
+from hexapod_workspace.cli import plotting
+plotting.plot_projected([projected_stub(), projected_stub("exact")], {str(tmp_path / "p.png")!r})
+plotting.plot_orientation(orientation_stub(), {str(tmp_path / "o.png")!r})
+print(matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules)
+"""
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=120, check=False
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["svg", "False"]
+    assert (tmp_path / "p.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_projected_plot_radial_axis_clears_the_largest_tilt(tmp_path: Path) -> None:
+    """Item 17: the curves never lie on the frame, and no radial label sits on a curve."""
+    from hexapod_workspace.cli import plotting
+
+    workspaces = [projected_stub(), projected_stub("exact")]
+    largest = max(np.degrees(w.theta).max() for w in workspaces)
+    step = plotting._nice_step(largest, 5)
+    top = step * math.ceil(largest * 1.1 / step)
+    assert top >= 1.1 * largest
+    ticks = np.arange(step, top - step / 2, step)
+    curves = [(np.mod(np.degrees(w.phi), 360.0), np.degrees(w.theta)) for w in workspaces]
+    angle = plotting._label_angle(curves, ticks)
+    assert angle % 45.0 == 22.5
+    assert plotting.plot_projected(workspaces, tmp_path / "p.png").stat().st_size > 10_000
