@@ -130,8 +130,8 @@ def test_orientation_text_says_what_the_zero_slice_numbers_are():
     theta = 0 as in `projected`; the text says so and gives the centre."""
     code, out, _ = run_main("--position", "0.2", "0.2", "-0.95", "orientation", "--n-rays", "36")
     assert code == 0
-    assert "boundary points (rays from the slice centre (" in out
-    assert "`projected` samples the same psi = 0 boundary along azimuths from theta = 0" in out
+    assert "boundary points\n    (rays from the slice centre (" in out
+    assert "`projected` samples the same boundary along\n    azimuths from theta = 0" in out
 
 
 def test_torsion_range_json_is_exact_shape():

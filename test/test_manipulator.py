@@ -24,7 +24,7 @@ def test_example_loads_with_defaults_from_the_home_pose(example):
     assert example.base_joints.shape == (6, 3)
     assert example.platform_joints.shape == (6, 3)
     np.testing.assert_allclose(np.linalg.norm(example.base_joint_axes, axis=1), 1.0)
-    # Default axes: the leg directions at the home pose (DESIGN.md section 2).
+    # Default axes: the leg directions at the home pose (README, Conventions).
     legs = example.home_position + example.platform_joints - example.base_joints
     directions = legs / np.linalg.norm(legs, axis=1, keepdims=True)
     np.testing.assert_allclose(example.base_joint_axes, directions)
@@ -298,3 +298,29 @@ def test_lengths_beyond_a_million_metres_are_refused(example_parameters, name):
     parameters[name] = (value * 1e300).tolist()
     with pytest.raises(GeometryError, match=re.escape(f"{name}: expected values within")):
         Manipulator.from_mapping(parameters)
+
+
+def test_example_from_any_working_directory(tmp_path, monkeypatch, example):
+    """Item 20: the README's API snippet uses the packaged example, not a relative path."""
+    monkeypatch.chdir(tmp_path)
+    assert Manipulator.example() == example
+
+
+def test_a_clone_named_like_the_package_does_not_shadow_it(tmp_path):
+    """Item 20: Python started in the folder above a clone named hexapod_workspace imports the
+    package (editable install in compat mode), not the clone as an empty namespace package."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    (tmp_path / "hexapod_workspace").symlink_to(root, target_is_directory=True)
+    done = subprocess.run(
+        [sys.executable, "-c", "from hexapod_workspace import Manipulator; print(Manipulator)"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr

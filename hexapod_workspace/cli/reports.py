@@ -120,14 +120,14 @@ def check_table(result: CheckResult, out: IO[str], degrees: NDArray[np.float64])
     """
     x, y, z = result.position
     out.write(f"position: ({x:.4f}, {y:.4f}, {z:.4f}) m\n")
-    out.write(
-        f"{'':>9} {'':>9} {'':>9}  {'':<9}  {'margin to each limit (>= 0 holds, < 0 violated)':<48}"
-        f"  {'':>8}\n"
+    header = (
+        f"{'':>9} {'':>9} {'':>9}  {'':<9}  {'margin to each limit (>= 0 holds, < 0 violated)'}",
         f"{'phi':>9} {'theta':>9} {'psi':>9}  {'reachable':<9}  {'leg_length':>11} "
-        f"{'base_joint':>11} {'platform_j':>11} {'interfer.':>11}  {'limiting':>8}  violated\n"
+        f"{'base_joint':>11} {'platform_j':>11} {'interfer.':>11}  {'limiting':>8}  violated",
         f"{'[deg]':>9} {'[deg]':>9} {'[deg]':>9}  {'':<9}  {'[mm]':>11} {'[deg]':>11} "
-        f"{'[deg]':>11} {'[mm]':>11}  {'leg':>8}\n"
+        f"{'[deg]':>11} {'[mm]':>11}  {'leg':>8}",
     )
+    out.write("".join(line.rstrip() + "\n" for line in header))
     degrees = np.asarray(degrees)
     wide = bool(np.any(np.abs(degrees) >= 1e5))
     angle_columns = (
@@ -267,12 +267,12 @@ def orientation_text(workspace: OrientationWorkspace, out: IO[str]) -> None:
         f"  torsion range: {math.degrees(workspace.psi_min):.4f} .. "
         f"{math.degrees(workspace.psi_max):.4f} deg\n"
         f"  volume (cylindrical coordinates): {workspace.volume:.5f} rad^3\n"
-        f"  psi = {math.degrees(zero.psi):g} slice: area {areas[middle]:.5f} rad^2; its "
-        f"{zero.phi.size} boundary points (rays from the slice centre ({cx:.3f}, {cy:.3f}) deg "
-        f"in the theta cos phi, theta sin phi plane) have tilts "
-        f"{math.degrees(zero.theta.min()):.3f} .. {math.degrees(zero.theta.max()):.3f} deg\n"
-        "  (`projected` samples the same psi = 0 boundary along azimuths from theta = 0, so its "
-        "tilt range differs by the sampling)\n"
+        f"  psi = {math.degrees(zero.psi):g} slice: area {areas[middle]:.5f} rad^2, tilt "
+        f"{math.degrees(zero.theta.min()):.3f} .. {math.degrees(zero.theta.max()):.3f} deg over "
+        f"its {zero.phi.size} boundary points\n"
+        f"    (rays from the slice centre ({cx:.3f}, {cy:.3f}) deg; `projected` samples the same "
+        "boundary along\n"
+        "    azimuths from theta = 0, so its tilt range differs by the sampling)\n"
     )
 
 

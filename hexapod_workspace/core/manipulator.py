@@ -315,7 +315,7 @@ class Manipulator:
         Parameters
         ----------
         path : str or pathlib.Path
-            YAML parameters file, as in the README's "Configuration" section.
+            YAML parameters file, as in the README's section *ROS 2 node*, *Parameters*.
         warn : bool
             See :meth:`from_mapping`.
 
@@ -336,6 +336,18 @@ class Manipulator:
             msg = f"parameters file {path}: {unknown}"
             raise ConfigError(msg)
         return cls.from_mapping(parameters, warn=warn)
+
+    @classmethod
+    def example(cls, *, warn: bool = True) -> Manipulator:
+        """The packaged example GPM (``config/example_gpm.yaml``), from any working directory.
+
+        Returns
+        -------
+        Manipulator
+        """
+        from .._resources import example_config_path
+
+        return cls.from_params_file(example_config_path(), warn=warn)
 
     # ------------------------------------------------------------------ views
     def to_parameters(self) -> dict[str, Any]:
