@@ -41,7 +41,15 @@ const channels = new Map();
 const result = {};
 const problems = [];
 const decoder = new TextDecoder();
-for (let record; (record = reader.nextRecord()); ) {
+// The logs are written without compression; a compressed chunk is reported, not decoded.
+const records = function* () {
+  try {
+    for (let record; (record = reader.nextRecord()); ) yield record;
+  } catch (error) {
+    problems.push(`the log cannot be read further: ${error.message}`);
+  }
+};
+for (const record of records()) {
   if (record.type === "Schema") {
     schemas.set(record.id, record);
   } else if (record.type === "Channel") {

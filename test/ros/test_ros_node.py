@@ -20,6 +20,7 @@ from rcl_interfaces.msg import Parameter as ParameterMsg  # noqa: E402
 from rcl_interfaces.msg import ParameterType, ParameterValue  # noqa: E402
 from rcl_interfaces.srv import (  # noqa: E402
     DescribeParameters,
+    ListParameters,
     SetParameters,
     SetParametersAtomically,
 )
@@ -267,6 +268,19 @@ def test_parameters_have_descriptors(client):
     assert by_name["resolution.n_rays"].integer_range[0].to_value == 7200
     assert by_name["check.max_poses"].read_only
     assert by_name["frame_id"].read_only
+
+
+def test_a_parameters_file_check_knows_every_parameter_of_the_node(client):
+    """Item 7: the CLI refuses unknown names in a parameters file, so it must know every name
+    the node declares (core.params.NODE_PARAMETERS + the model's + ROS's own), and no more."""
+    from hexapod_workspace.core.manipulator import PARAMETER_DEFAULTS
+    from hexapod_workspace.core.params import NODE_PARAMETERS, ROS_PARAMETERS, unknown_parameter
+
+    listed = client.call(ListParameters, f"{NODE}/list_parameters", ListParameters.Request())
+    names = set(listed.result.names)
+    known = (*PARAMETER_DEFAULTS, *NODE_PARAMETERS, *ROS_PARAMETERS)
+    assert unknown_parameter(names, known) is None
+    assert set(NODE_PARAMETERS) <= names
 
 
 # ---------------------------------------------------------------------------- recording
