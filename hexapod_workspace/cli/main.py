@@ -57,7 +57,6 @@ class _Parser(argparse.ArgumentParser):
     negative number (``-1.3e0``, ``-inf``) for a value, not an option."""
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
-        kwargs.setdefault("formatter_class", argparse.RawDescriptionHelpFormatter)
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = _NEGATIVE_NUMBER
 

@@ -91,6 +91,28 @@ def test_check_poses_matches_core(client, model):
     assert_matches_core(response, expected)
 
 
+def test_check_poses_huge_angles_get_the_verdict_of_their_principal_values(client, model):
+    """Item 1 at the node: phi = 1e300 rad is the orientation of its principal value."""
+    huge = np.array([[1e300, 0.17, 2.6], [0.3, 0.2, -1e20], [1e20, 0.6, 1e20]])
+    principal = np.arctan2(np.sin(huge), np.cos(huge))
+    expected = check(model, principal, model.position)
+    response = client.call(CheckPoses, f"{NODE}/check_poses", check_request(huge))
+    assert response.success, response.message
+    for name in CONSTRAINT_NAMES:
+        got = np.array([getattr(r, f"{name}_margin") for r in response.results])
+        np.testing.assert_allclose(got, expected.margins[name], atol=1e-12)
+    assert [r.reachable for r in response.results] == expected.reachable.tolist()
+
+
+def test_check_poses_huge_position_is_refused_not_answered(client):
+    """Item 2 at the node: no NaN margins with success=true; a refusal with the reason."""
+    request = check_request(np.zeros((1, 3)), (1e300, 0.0, 0.0))
+    response = client.call(CheckPoses, f"{NODE}/check_poses", request)
+    assert not response.success
+    assert "at most 1e+06 m" in response.message
+    assert list(response.results) == []
+
+
 def test_check_poses_at_another_position(client, model):
     angles = sample_angles(50, seed=9)
     position = (0.2, 0.2, -0.95)
