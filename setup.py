@@ -51,7 +51,9 @@ setup(
         (f"share/{PACKAGE}/launch", glob("launch/*.py")),
     ],
     install_requires=[
-        "numpy>=1.24",
+        # Tested with 1.26.4 (Ubuntu 24.04's python3-numpy, next to ROS 2 Jazzy from apt) and
+        # the pinned 2.2.6 (requirements/base.txt).
+        "numpy>=1.26",
         "PyYAML>=5.4",
         "matplotlib>=3.6",
         "mcap>=1.6",

@@ -12,10 +12,7 @@ from hexapod_workspace import logs
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import constraints
 from hexapod_workspace.core.manipulator import Manipulator
-from hexapod_workspace.core.orientation import (
-    OrientationSlice,
-    OrientationWorkspace,
-)
+from hexapod_workspace.core.orientation import OrientationSlice, OrientationWorkspace
 from hexapod_workspace.core.projected import ProjectedWorkspace
 from hexapod_workspace.core.resolution import WorkspaceKind
 from hexapod_workspace.logs import messages
@@ -33,7 +30,7 @@ def check_result(manipulator: Manipulator) -> constraints.CheckResult:
 
 
 def projected_stub(method: str = "torsion_zero", n: int = 36) -> ProjectedWorkspace:
-    """A real ProjectedWorkspace with made-up boundary values (no algorithm needed)."""
+    """A projected workspace built by hand (no algorithm needed): a real result dataclass."""
     phi = np.linspace(-math.pi, math.pi, n, endpoint=False)
     theta = 0.5 + 0.1 * np.cos(3 * phi)
     return ProjectedWorkspace(
@@ -42,25 +39,22 @@ def projected_stub(method: str = "torsion_zero", n: int = 36) -> ProjectedWorksp
         phi=phi,
         theta=theta,
         psi=np.zeros(n) if method != "exact" else 0.1 * phi,
-        limiting=["leg_length"] * n,
         tilt_min=float(theta.min()),
         tilt_max=float(theta.max()),
         solid_angle=1.234,
         tolerance=1e-6,
         elapsed=0.01,
+        limiting=["leg_length"] * n,
     )
 
 
-def orientation_stub(
-    slices: list[OrientationSlice] | None = None,
-) -> OrientationWorkspace:
-    """A real OrientationWorkspace of three circular slices of 8 rays (or the given slices)."""
-    if slices is None:
-        phi = np.linspace(-math.pi, math.pi, 8, endpoint=False)
-        slices = [
-            OrientationSlice(psi=psi, center=np.zeros(2), phi=phi, theta=np.full(8, 0.4))
-            for psi in (-0.1, 0.0, 0.1)
-        ]
+def orientation_stub() -> OrientationWorkspace:
+    """An orientation workspace of three circular slices built by hand: a real dataclass."""
+    phi = np.linspace(-math.pi, math.pi, 8, endpoint=False)
+    slices = [
+        OrientationSlice(psi=psi, center=np.zeros(2), phi=phi, theta=np.full(8, 0.4))
+        for psi in (-0.1, 0.0, 0.1)
+    ]
     return OrientationWorkspace(
         position=np.array([0.0, 0.0, 1.2]),
         slices=slices,

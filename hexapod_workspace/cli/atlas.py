@@ -18,34 +18,45 @@ import argparse
 import json
 import math
 from pathlib import Path
-from typing import Any, TextIO
+from typing import IO, Any
 
 import numpy as np
 
 from ..core.atlas import AtlasGrid, AtlasOptions, dexterous_mask
 from ..errors import InputError
-from .main import CliError, ProgressBar, _add_global_options, _finite, load_manipulator
+from .inputs import CliError, finite, load_manipulator, tolerance_flag
+from .progress import ProgressBar
 
-__all__ = ["MAX_POSITIONS", "add_atlas_parser", "atlas_summary", "cmd_atlas"]
+__all__ = [
+    "ATLAS_DESCRIPTION",
+    "ATLAS_HELP",
+    "MAX_POSITIONS",
+    "atlas_arguments",
+    "atlas_summary",
+    "cmd_atlas",
+]
 
 #: Positions above which the command asks for ``--force`` (about 2 core-hours at 0.3 s each).
 MAX_POSITIONS = 20_000
+#: Default boundary tolerance of the atlas, rad: coarser than a single workspace's
+#: (resolution.DEFAULT_TOLERANCE) because an atlas computes thousands of them.
+ATLAS_TOLERANCE = 1e-4
 #: Seconds per position, for the estimate in the ``--force`` message (example GPM, one core).
 _SECONDS_PER_POSITION = 0.3
 
 
-def add_atlas_parser(commands: Any) -> None:
-    """Register the ``atlas`` command on the CLI's sub-parsers."""
-    sub = commands.add_parser(
-        "atlas",
-        help="orientation capability over a box of positions (Dask, Zarr store)",
-        description="Over the grid x0 + k*step (and y, z) inside the box: whether the reference "
-        "orientation is reachable, the tilt capability (largest cone of tool directions all "
-        "attainable), its torsion-zero value, the largest tilt, the solid angle and the torsion "
-        "range at zero tilt. Runs on a local Dask cluster (or --scheduler) and writes a Zarr "
-        "store chunk by chunk; --resume completes an interrupted run. Needs the 'atlas' extra.",
-    )
-    _add_global_options(sub, top=False)
+ATLAS_HELP = "orientation capability over a box of positions (Dask, Zarr store)"
+ATLAS_DESCRIPTION = (
+    "Over the grid x0 + k*step (and y, z) inside the box: whether the reference "
+    "orientation is reachable, the tilt capability (largest cone of tool directions all "
+    "attainable), its torsion-zero value, the largest tilt, the solid angle and the torsion "
+    "range at zero tilt. Runs on a local Dask cluster (or --scheduler) and writes a Zarr "
+    "store chunk by chunk; --resume completes an interrupted run. Needs the 'atlas' extra."
+)
+
+
+def atlas_arguments(sub: argparse.ArgumentParser) -> None:
+    """The ``atlas`` command's own options."""
     sub.add_argument(
         "--box",
         nargs=6,
@@ -99,12 +110,11 @@ def add_atlas_parser(commands: Any) -> None:
     sub.add_argument(
         "--force", action="store_true", help=f"allow more than {MAX_POSITIONS} positions"
     )
-    sub.set_defaults(handler=cmd_atlas)
 
 
 def _grid(options: argparse.Namespace) -> AtlasGrid:
     """The box grid of the options, within the position cap unless ``--force``."""
-    grid = AtlasGrid.box(_finite(options.box, "--box"), _finite([options.step], "--step")[0])
+    grid = AtlasGrid.box(finite(options.box, "--box", "m"), finite([options.step], "--step", "m")[0])
     if grid.size > MAX_POSITIONS and not options.force:
         hours = grid.size * _SECONDS_PER_POSITION / 3600.0
         msg = (
@@ -147,16 +157,19 @@ def atlas_summary(
     }
 
 
-def cmd_atlas(options: argparse.Namespace, out: TextIO) -> int:
+def cmd_atlas(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
     """``atlas``: compute (or complete, ``--resume``) an atlas store; print its summary."""
-    tilts = [float(t) for t in _finite(options.tilt_required_deg or [], "--tilt-required-deg")]
+    tilts = [
+        float(t) for t in finite(options.tilt_required_deg or [], "--tilt-required-deg", "degrees")
+    ]
     if any(not 0.0 <= t <= 180.0 for t in tilts):
         msg = f"--tilt-required-deg: expected 0 to 180 degrees, got {tilts}"
         raise CliError(msg)
     torsion = None
     if options.torsion_required_deg is not None:
         torsion = [
-            float(v) for v in _finite(options.torsion_required_deg, "--torsion-required-deg")
+            float(v)
+            for v in finite(options.torsion_required_deg, "--torsion-required-deg", "degrees")
         ]
         if not torsion[0] <= 0.0 <= torsion[1]:
             msg = f"--torsion-required-deg: expected LO <= 0 <= HI, got {torsion}"
@@ -168,14 +181,14 @@ def cmd_atlas(options: argparse.Namespace, out: TextIO) -> int:
         msg = "--workers sizes the local cluster: not with --scheduler"
         raise CliError(msg)
     grid = _grid(options)
-    tolerance = 1e-4 if options.tol_deg is None else math.radians(options.tol_deg)
+    tolerance = ATLAS_TOLERANCE if options.tol_deg is None else tolerance_flag(options.tol_deg)
     try:
         atlas_options = AtlasOptions(
             n_phi=options.n_phi, tolerance=tolerance, volume=options.volume
         )
     except InputError as error:
         raise CliError(str(error)) from error
-    manipulator = load_manipulator(options)
+    manipulator = load_manipulator(options.config, None, err)
     from ..atlas import workspace_atlas
 
     bar = ProgressBar("atlas")
@@ -213,7 +226,7 @@ def cmd_atlas(options: argparse.Namespace, out: TextIO) -> int:
     return 0
 
 
-def _summary_text(document: dict[str, Any], out: TextIO) -> None:
+def _summary_text(document: dict[str, Any], out: IO[str]) -> None:
     stats = document["tilt_capability_deg"]
     out.write(
         f"atlas: {document['positions']} positions, {document['reachable_positions']} with the "

@@ -28,6 +28,7 @@ __all__ = [
     "DEFAULT_PSI_STEP",
     "DEFAULT_TOLERANCE",
     "MAX_POINTS",
+    "MAX_POSITION_NORM",
     "MAX_PSI_STEP",
     "MAX_RAYS",
     "MAX_SLICES",
@@ -100,6 +101,11 @@ MAX_SLICES = 20_000
 #: Largest number of boundary points (slices × rays) one orientation workspace may produce.
 MAX_POINTS = 5_000_000
 
+#: Largest accepted distance |OC| of a position from the base origin, m. Far beyond any
+#: machine (legs are metres long), and small enough that every squared length, leg direction and
+#: margin computed from it stays a finite number.
+MAX_POSITION_NORM = 1e6
+
 #: Default azimuths of the projected workspace.
 DEFAULT_N_PHI = 360
 #: Default rays per slice of the orientation workspace.
@@ -144,11 +150,28 @@ def validate_psi_step(psi_step: float, name: str = "psi_step") -> float:
 
 
 def validate_position(manipulator: Manipulator, position: ArrayLike | None) -> NDArray[np.float64]:
-    """The position to use (default ``manipulator.position``), checked: shape (3,), finite, m."""
+    """The position to use (default ``manipulator.position``), checked: shape (3,), finite, m.
+
+    Raises
+    ------
+    InputError
+        Not 3 values, NaN or infinite values, or farther than :data:`MAX_POSITION_NORM` from
+        the base origin (where margins would stop being finite numbers).
+    """
     if position is None:
         return np.array(manipulator.position)
-    array = np.asarray(position, dtype=np.float64)
+    try:
+        array = np.asarray(position, dtype=np.float64)
+    except (TypeError, ValueError) as error:
+        msg = f"position: expected 3 numbers (x, y, z) in m, got {position!r}"
+        raise InputError(msg) from error
     if array.shape != (3,) or not np.all(np.isfinite(array)):
         msg = f"position: expected 3 finite values (x, y, z) in m, got {np.ravel(array).tolist()}"
+        raise InputError(msg)
+    if not float(np.linalg.norm(array)) <= MAX_POSITION_NORM:
+        msg = (
+            f"position: expected a distance from the base origin of at most "
+            f"{MAX_POSITION_NORM:g} m, got {array.tolist()}"
+        )
         raise InputError(msg)
     return array

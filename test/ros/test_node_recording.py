@@ -22,20 +22,31 @@ from ros_support import DISCOVERY_TIMEOUT, require_ros, running_node, write_para
 require_ros()
 
 from hexapod_workspace_msgs.msg import (  # noqa: E402
+    CheckPosesRequest,
+    CheckPosesResponse,
     CommandedPose,
+    ComputeWorkspaceRequest,
+    ComputeWorkspaceResponse,
     ReachabilityResult,
     TiltTorsion,
+    TriggerResponse,
     WorkspaceSummary,
 )
 from hexapod_workspace_msgs.srv import CheckPoses, ComputeWorkspace  # noqa: E402
 from sensor_msgs.msg import PointCloud2  # noqa: E402
+from std_msgs.msg import Empty  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 
 from hexapod_workspace import logs  # noqa: E402
 from hexapod_workspace.core.resolution import WorkspaceKind  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # test/recording_support.py
-from recording_support import plain, read_with_mcap_ros2, read_with_rosbags  # noqa: E402
+from recording_support import (  # noqa: E402
+    plain,
+    read_with_foxglove,
+    read_with_mcap_ros2,
+    read_with_rosbags,
+)
 
 #: Every test runs its node in its own namespace: fresh service names, so no client of an earlier
 #: node (already stopped or killed) can swallow a request.
@@ -148,6 +159,13 @@ def test_sigint_log_holds_exactly_what_the_node_did(ros_domain, ros_client, tmp_
     entries = [(m.topic, m.msgtype, m.message) for m in ours.messages]
     for reader_entries in (read_with_rosbags(path), read_with_mcap_ros2(path)):
         assert by_topic(reader_entries) == by_topic(entries)
+    # Every channel of the node's log opens in Foxglove (its own libraries, test/foxglove).
+    # (read_with_foxglove fails on any refused channel, those without messages included.)
+    opened = read_with_foxglove(path, tmp_path)
+    assert set(opened) == set(ours.topics)
+    assert {topic: channel["count"] for topic, channel in opened.items() if channel["count"]} == {
+        topic: len(items) for topic, items in by_topic(entries).items()
+    }
 
     recorded = by_topic(entries)
     assert recorded[f"{node_name}/check_poses/request"] == [plain(check)]
@@ -226,6 +244,13 @@ def test_recorded_type_hashes_are_the_ones_rclpy_announces(ros_client) -> None:
         "std_srvs/srv/Trigger_Request": Trigger.Request,
         "std_srvs/srv/Trigger_Response": Trigger.Response,
         "sensor_msgs/msg/PointCloud2": PointCloud2,
+        # The message twins service calls are recorded as (logs.recorded_type).
+        "hexapod_workspace_msgs/msg/CheckPosesRequest": CheckPosesRequest,
+        "hexapod_workspace_msgs/msg/CheckPosesResponse": CheckPosesResponse,
+        "hexapod_workspace_msgs/msg/ComputeWorkspaceRequest": ComputeWorkspaceRequest,
+        "hexapod_workspace_msgs/msg/ComputeWorkspaceResponse": ComputeWorkspaceResponse,
+        "hexapod_workspace_msgs/msg/TriggerResponse": TriggerResponse,
+        "std_msgs/msg/Empty": Empty,
     }
     for index, (msgtype, message_class) in enumerate(classes.items()):
         topic = f"/type_hash_check/t{index}"
