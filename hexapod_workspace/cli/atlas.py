@@ -114,7 +114,9 @@ def atlas_arguments(sub: argparse.ArgumentParser) -> None:
 
 def _grid(options: argparse.Namespace) -> AtlasGrid:
     """The box grid of the options, within the position cap unless ``--force``."""
-    grid = AtlasGrid.box(finite(options.box, "--box", "m"), finite([options.step], "--step", "m")[0])
+    grid = AtlasGrid.box(
+        finite(options.box, "--box", "m"), finite([options.step], "--step", "m")[0]
+    )
     if grid.size > MAX_POSITIONS and not options.force:
         hours = grid.size * _SECONDS_PER_POSITION / 3600.0
         msg = (

@@ -35,8 +35,8 @@ from sensor_msgs.msg import PointCloud2, PointField
 
 from ..core.atlas import ATLAS_VARIABLES, AtlasGrid, AtlasOptions, dexterous_mask
 from ..errors import HexapodWorkspaceError
+from ..logs import qos_profile_text
 from ..logs.messages import header_fields
-from ..logs.recording import qos_profile_text
 from .conversions import to_message
 
 __all__ = ["ACTION_NAME", "CLOUD_FIELDS", "CLOUD_TOPIC", "atlas_cloud", "attach_atlas_action"]

@@ -16,7 +16,7 @@ from rclpy.serialization import serialize_message
 
 from hexapod_workspace import Manipulator
 from hexapod_workspace._resources import example_config_path
-from hexapod_workspace.logs.recording import LogWriter
+from hexapod_workspace.logs import LogWriter
 from hexapod_workspace.ros.atlas_action import attach_atlas_action
 
 

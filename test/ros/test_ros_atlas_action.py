@@ -23,7 +23,7 @@ from sensor_msgs.msg import PointCloud2  # noqa: E402
 
 from hexapod_workspace import AtlasOptions  # noqa: E402
 from hexapod_workspace.core.atlas import position_capability  # noqa: E402
-from hexapod_workspace.logs.recording import read_log  # noqa: E402
+from hexapod_workspace.logs import read_log  # noqa: E402
 from hexapod_workspace.ros.atlas_action import CLOUD_FIELDS  # noqa: E402
 
 SERVER = Path(__file__).with_name("atlas_action_server.py")
