@@ -1,0 +1,803 @@
+"""Compiled kernels (numba): the four constraint margins of a pose, and the ray searches.
+
+Everything the workspace computations evaluate per pose runs here, compiled once and cached on
+disk (``cache=True``): the margins of :mod:`hexapod_workspace.core.constraints` (DESIGN.md
+section 2) and the certified march + secant/bisection of :mod:`hexapod_workspace.core.search`
+along whole families of rays, so that a search pays no per-call overhead per step.
+
+The model of a manipulator is packed into one float64 vector (:func:`model_vector`, offsets
+below): the kernels take a handful of arrays, which keeps numba's dispatch cheap (a few
+microseconds per call).
+
+Compilation cache
+-----------------
+numba stores the compiled code next to this file (``__pycache__``) when that directory is
+writable, otherwise in the user cache directory (``$XDG_CACHE_HOME/hexapod_workspace/numba``,
+default ``~/.cache/hexapod_workspace/numba``), so a read-only install (colcon install space,
+system site-packages) compiles once per user. :func:`cache_is_warm` tells whether a run will
+compile; :func:`warm_up` compiles (or loads) every kernel and returns the seconds it took.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = [
+    "CACHE_DIRECTORY",
+    "cache_is_warm",
+    "model_vector",
+    "warm_up",
+]
+
+
+def _writable(directory: Path) -> bool:
+    """Whether files can be created in ``directory`` (created if missing)."""
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=directory):
+            pass
+    except OSError:
+        return False
+    return True
+
+
+def _cache_directory() -> Path | None:
+    """Where numba caches this module's compiled code (None: nowhere writable, no cache)."""
+    configured = os.environ.get("NUMBA_CACHE_DIR")
+    if configured:
+        return Path(configured)
+    in_tree = Path(__file__).resolve().parent / "__pycache__"
+    if _writable(in_tree):
+        return in_tree
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    user = Path(base) / "hexapod_workspace" / "numba"
+    if _writable(user):
+        # Must be set before numba is imported: numba reads it once, at import.
+        os.environ["NUMBA_CACHE_DIR"] = str(user)
+        return user
+    return None
+
+
+#: Directory of the compiled-code cache (None when no directory is writable: then every
+#: process compiles, which takes seconds, and nothing is cached).
+CACHE_DIRECTORY = _cache_directory()
+if CACHE_DIRECTORY is not None and "numba" in sys.modules:
+    # numba was imported earlier by someone else: point its configuration here as well.
+    import numba.core.config
+
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        numba.core.config.CACHE_DIR = os.environ["NUMBA_CACHE_DIR"]
+
+import numba  # noqa: E402
+
+_CACHE = CACHE_DIRECTORY is not None
+
+
+def _jit(function):
+    """Compile in nopython mode, release the GIL, cache on disk."""
+    return numba.njit(cache=_CACHE, nogil=True, error_model="numpy")(function)
+
+
+# ------------------------------------------------------------------------------ model layout
+# Offsets into the model vector. Per-leg 3-vectors are stored leg-major (x, y, z of leg 0, ...).
+A = 0  # base joints a_i, base frame, m (18)
+B = 18  # platform joints b_i, mobile frame, m (18)
+JA = 36  # base joint axes jA_i, base frame (18)
+JB = 54  # platform joint axes jB_i, mobile frame (18)
+LMIN = 72  # leg length minima, m (6)
+LMAX = 78  # leg length maxima, m (6)
+ALPHA = 84  # base joint maximum angles, rad (6)
+BETA = 90  # platform joint maximum angles, rad (6)
+RPAIR = 96  # A_i − A_j for the 15 pairs i < j, m (45)
+RR = 141  # |A_i − A_j|² (15)
+DIAMETER = 156  # D, m
+INTERFERENCE = 157  # 1.0 when the interference check is on (D > 0)
+ALPHA_EQUAL = 158  # 1.0 when every base joint has the same maximum angle
+BETA_EQUAL = 159  # 1.0 when every platform joint has the same maximum angle
+SCALE = 160  # natural scale of each margin (4): see constraints.relative_margins
+RHO = 164  # max |b_i|, m (Lipschitz constants of the search)
+LENGTH_FLOOR = 165  # min ℓmin_i, m
+ESTIMATE_FLOOR = 166  # max(min ℓmin_i, 1e-3), m (fixed Lipschitz constants of the estimate)
+ORDER = 167  # the 15 pair indices, closest pair at the home pose first (as floats)
+MODEL_SIZE = 182
+
+#: Leg pairs (i < j) in the order of numpy.triu_indices(6, 1).
+PAIR_I = np.array([i for i in range(6) for j in range(i + 1, 6)], dtype=np.int64)
+PAIR_J = np.array([j for i in range(6) for j in range(i + 1, 6)], dtype=np.int64)
+
+# Search constants, shared with core.search (which documents them).
+MAX_STEP = 1.0
+SAFETY = 1.0 - 1e-9
+#: Ray kinds: angles along a ray are origin + s·direction in T&T coordinates (φ, θ, ψ), or in
+#: the cylindrical picture (x, y, ψ) with x = θ cos φ, y = θ sin φ.
+KIND_TT, KIND_CYLINDRICAL = 0, 1
+
+
+def model_vector(manipulator) -> NDArray[np.float64]:
+    """The packed model of a manipulator (cached on the immutable manipulator object).
+
+    Parameters
+    ----------
+    manipulator : Manipulator
+
+    Returns
+    -------
+    ndarray, shape (MODEL_SIZE,)
+        Read-only; layout given by the offsets of this module.
+    """
+    cached = manipulator.__dict__.get("_kernel_model")
+    if cached is not None:
+        return cached
+    model = np.zeros(MODEL_SIZE)
+    model[A : A + 18] = manipulator.base_joints.ravel()
+    model[B : B + 18] = manipulator.platform_joints.ravel()
+    model[JA : JA + 18] = manipulator.base_joint_axes.ravel()
+    model[JB : JB + 18] = manipulator.platform_joint_axes.ravel()
+    model[LMIN : LMIN + 6] = manipulator.leg_length_min
+    model[LMAX : LMAX + 6] = manipulator.leg_length_max
+    model[ALPHA : ALPHA + 6] = manipulator.base_joint_max_angle
+    model[BETA : BETA + 6] = manipulator.platform_joint_max_angle
+    r = manipulator.base_joints[PAIR_I] - manipulator.base_joints[PAIR_J]
+    model[RPAIR : RPAIR + 45] = r.ravel()
+    model[RR : RR + 15] = np.einsum("pk,pk->p", r, r)
+    model[DIAMETER] = manipulator.leg_diameter
+    model[INTERFERENCE] = 1.0 if manipulator.leg_diameter > 0.0 else 0.0
+    alpha, beta = manipulator.base_joint_max_angle, manipulator.platform_joint_max_angle
+    model[ALPHA_EQUAL] = 1.0 if np.all(alpha == alpha[0]) else 0.0
+    model[BETA_EQUAL] = 1.0 if np.all(beta == beta[0]) else 0.0
+    model[SCALE : SCALE + 4] = [
+        float(np.mean(manipulator.leg_length_max - manipulator.leg_length_min)) / 2.0,
+        float(np.mean(alpha)),
+        float(np.mean(beta)),
+        manipulator.leg_diameter if manipulator.leg_diameter > 0.0 else 1.0,
+    ]
+    model[RHO] = float(np.max(np.linalg.norm(manipulator.platform_joints, axis=1)))
+    model[LENGTH_FLOOR] = float(np.min(manipulator.leg_length_min))
+    model[ESTIMATE_FLOOR] = max(model[LENGTH_FLOOR], 1e-3)
+    home = manipulator.home_position + manipulator.platform_joints
+    home_distance = [
+        _segment_distance_literal(
+            manipulator.base_joints[i], home[i], manipulator.base_joints[j], home[j]
+        )
+        for i, j in zip(PAIR_I, PAIR_J, strict=True)
+    ]
+    model[ORDER : ORDER + 15] = np.argsort(home_distance, kind="stable")
+    model.setflags(write=False)
+    manipulator.__dict__["_kernel_model"] = model
+    return model
+
+
+def _segment_distance_literal(p0, p1, q0, q1) -> float:
+    """Segment distance by dense sampling of both (only to order the pairs; any estimate
+    works there)."""
+    s = np.linspace(0.0, 1.0, 65)[:, None]
+    first = p0 + s * (p1 - p0)
+    second = q0 + s * (q1 - q0)
+    return float(np.min(np.linalg.norm(first[:, None, :] - second[None, :, :], axis=2)))
+
+
+# ------------------------------------------------------------------------------ one pose
+# Slots of the per-pose result vector ``out``.
+OUT_LEG = 4  # limiting leg of each margin (4 slots, as float)
+OUT_PAIR = 8  # closest pair (2 slots)
+OUT_SHORTEST = 10  # shortest leg length, m
+OUT_SIZE = 11
+
+
+@_jit
+def _clamp01(value):
+    """Clamp to [0, 1]; NaN stays NaN."""
+    if value < 0.0:
+        return 0.0
+    if value > 1.0:
+        return 1.0
+    return value
+
+
+@_jit
+def _pose(model, r, px, py, pz, scratch, out, want_pair):
+    """Margins of one pose into ``out`` (OUT_SIZE,).
+
+    ``r`` (9,) is the rotation matrix row-major, (px, py, pz) the position (m), ``scratch``
+    (5, 6) working memory (leg vector planes and squared lengths). Follows
+    constraints._ChunkModel of the numpy reference operation by operation, so margins agree to
+    rounding: the smallest margin of each constraint and its leg (first one on ties; NaN, a
+    zero-length leg, wins), the closest pair by Ericson's clamped closest points.
+    ``want_pair`` False skips the interference check (margin +inf).
+    """
+    lx = scratch[0]
+    ly = scratch[1]
+    lz = scratch[2]
+    sq = scratch[3]
+    inverse_sq = scratch[4]
+    r00, r01, r02 = r[0], r[1], r[2]
+    r10, r11, r12 = r[3], r[4], r[5]
+    r20, r21, r22 = r[6], r[7], r[8]
+    m_len = np.inf
+    leg_len = 0
+    m_a = np.inf
+    leg_a = 0
+    m_b = np.inf
+    leg_b = 0
+    shortest = np.inf
+    alpha_equal = model[ALPHA_EQUAL] != 0.0
+    beta_equal = model[BETA_EQUAL] != 0.0
+    for k in range(6):
+        bx = model[B + 3 * k]
+        by = model[B + 3 * k + 1]
+        bz = model[B + 3 * k + 2]
+        x = (r00 * bx + r01 * by + r02 * bz) + (px - model[A + 3 * k])
+        y = (r10 * bx + r11 * by + r12 * bz) + (py - model[A + 3 * k + 1])
+        z = (r20 * bx + r21 * by + r22 * bz) + (pz - model[A + 3 * k + 2])
+        lx[k] = x
+        ly[k] = y
+        lz[k] = z
+        squared = x * x + y * y + z * z
+        sq[k] = squared
+        length = math.sqrt(squared)
+        if length < shortest:
+            shortest = length
+        inverse = 1.0 / length
+        inverse_sq[k] = inverse * inverse
+        value = min(length - model[LMIN + k], model[LMAX + k] - length)
+        if value < m_len or (value != value and m_len == m_len):
+            m_len = value
+            leg_len = k
+        # Base joint: angle between jA_i and n_i.
+        cos_a = (
+            model[JA + 3 * k] * x + model[JA + 3 * k + 1] * y + model[JA + 3 * k + 2] * z
+        ) * inverse
+        # Platform joint: angle between R·jB_i and −n_i.
+        jx = model[JB + 3 * k]
+        jy = model[JB + 3 * k + 1]
+        jz = model[JB + 3 * k + 2]
+        cos_b = (
+            (r00 * jx + r01 * jy + r02 * jz) * x
+            + (r10 * jx + r11 * jy + r12 * jz) * y
+            + (r20 * jx + r21 * jy + r22 * jz) * z
+        ) * -inverse
+        # Equal limits: the margin decreases with the angle, the smallest cosine limits (one
+        # arccos per pose, below); otherwise the margin itself per leg.
+        value = cos_a if alpha_equal else model[ALPHA + k] - math.acos(min(max(cos_a, -1.0), 1.0))
+        if value < m_a or (value != value and m_a == m_a):
+            m_a = value
+            leg_a = k
+        value = cos_b if beta_equal else model[BETA + k] - math.acos(min(max(cos_b, -1.0), 1.0))
+        if value < m_b or (value != value and m_b == m_b):
+            m_b = value
+            leg_b = k
+    if alpha_equal:
+        m_a = model[ALPHA] - math.acos(min(max(m_a, -1.0), 1.0))
+    if beta_equal:
+        m_b = model[BETA] - math.acos(min(max(m_b, -1.0), 1.0))
+    out[0] = m_len
+    out[1] = m_a
+    out[2] = m_b
+    out[OUT_LEG] = leg_len
+    out[OUT_LEG + 1] = leg_a
+    out[OUT_LEG + 2] = leg_b
+    out[OUT_SHORTEST] = shortest
+    if not want_pair or model[INTERFERENCE] == 0.0:
+        out[3] = np.inf
+        out[OUT_LEG + 3] = 0
+        out[OUT_PAIR] = 0
+        out[OUT_PAIR + 1] = 0
+        return
+    # Pairs in the model's order (closest at the home pose first). A pair is skipped when an
+    # exact lower bound of its distance cannot beat the best so far: projected on the unit
+    # vector u = r/|r| (r = A_i − A_j), the segments are at least
+    # (|r|² + min(0, c) − max(0, f)) / |r| apart (c = L_i·r, f = L_j·r). The slack covers
+    # rounding, so a skipped pair never holds the minimum.
+    best = np.inf
+    best_squared = np.inf
+    best_pair = 0
+    for rank in range(15):
+        pair = int(model[ORDER + rank])
+        i = PAIR_I[pair]
+        j = PAIR_J[pair]
+        rx = model[RPAIR + 3 * pair]
+        ry = model[RPAIR + 3 * pair + 1]
+        rz = model[RPAIR + 3 * pair + 2]
+        rr = model[RR + pair]
+        xi = lx[i]
+        yi = ly[i]
+        zi = lz[i]
+        xj = lx[j]
+        yj = ly[j]
+        zj = lz[j]
+        c = xi * rx + yi * ry + zi * rz
+        f = xj * rx + yj * ry + zj * rz
+        a = sq[i]
+        e = sq[j]
+        gap = rr + min(c, 0.0) - max(f, 0.0)
+        if gap > 0.0 and gap * gap >= rr * (best_squared + 1e-12 * (rr + a + e)):
+            continue
+        b = xi * xj + yi * yj + zi * zj
+        denom = a * e - b * b
+        if denom > 1e-14 * a * e:
+            s = min(max((b * f - c * e) / denom, 0.0), 1.0)
+            t = min(max((b * s + f) * inverse_sq[j], 0.0), 1.0)
+            s = min(max((b * t - c) * inverse_sq[i], 0.0), 1.0)
+        else:
+            # Parallel or point-like segments (or NaN): start from s = 0.
+            t = 0.0 if e <= 1e-300 else _clamp01(f / e)
+            s = 0.0 if a <= 1e-300 else _clamp01((b * t - c) / a)
+        squared = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
+        # Compare distances, not their squares, where it matters: pairs whose squares differ
+        # in the last bit can have equal distances, and then the lower pair index limits.
+        if squared <= best_squared or squared != squared:
+            distance = math.sqrt(max(squared, 0.0))
+            if (
+                distance < best
+                or (distance == best and pair < best_pair)
+                or (distance != distance and best == best)
+            ):
+                best = distance
+                best_pair = pair
+            best_squared = min(squared, best_squared)
+    out[3] = best - model[DIAMETER]
+    out[OUT_LEG + 3] = PAIR_I[best_pair]
+    out[OUT_PAIR] = PAIR_I[best_pair]
+    out[OUT_PAIR + 1] = PAIR_J[best_pair]
+
+
+@_jit
+def _tt_matrix(phi, theta, psi, r):
+    """R(φ, θ, ψ) = Rz(φ)·Ry(θ)·Rz(ψ − φ) into r (9,), row-major (as rotations.tt_to_matrix)."""
+    gamma = psi - phi
+    ca = math.cos(phi)
+    sa = math.sin(phi)
+    cb = math.cos(theta)
+    sb = math.sin(theta)
+    cg = math.cos(gamma)
+    sg = math.sin(gamma)
+    r[0] = ca * cb * cg - sa * sg
+    r[1] = -ca * cb * sg - sa * cg
+    r[2] = ca * sb
+    r[3] = sa * cb * cg + ca * sg
+    r[4] = -sa * cb * sg + ca * cg
+    r[5] = sa * sb
+    r[6] = -sb * cg
+    r[7] = sb * sg
+    r[8] = cb
+
+
+@_jit
+def _limiting_constraint(model, out):
+    """Index of the smallest relative margin (first on ties; NaN wins)."""
+    best = out[0] / model[SCALE]
+    index = 0
+    for c in range(1, 4):
+        value = out[c] / model[SCALE + c]
+        if value < best or (value != value and best == best):
+            best = value
+            index = c
+    return index
+
+
+@_jit
+def _feasible(out):
+    """Every margin ≥ 0 (NaN counts as violated)."""
+    return out[0] >= 0.0 and out[1] >= 0.0 and out[2] >= 0.0 and out[3] >= 0.0
+
+
+# ------------------------------------------------------------------------------ batches
+@_jit
+def check_angles(
+    model, angles, position, start, stop, margins, legs, pairs, limiting, limiting_leg, reachable
+):
+    """Check poses ``angles[start:stop]`` (N, 3) of T&T angles (rad) at ``position`` (3,), m.
+
+    Writes, for each pose n in [start, stop): ``margins[:, n]`` (4, N); ``legs[:, n]`` (4, N),
+    the 1-based leg with the smallest margin of each constraint; ``pairs[n]`` (N, 2), the
+    1-based closest pair; ``limiting[n]``, the constraint with the smallest relative margin;
+    ``limiting_leg[n]``, its leg; ``reachable[n]``. Legs and pairs of ``leg_interference`` are
+    0 when the check is disabled. Releases the GIL (threads split large batches).
+    """
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    px, py, pz = position[0], position[1], position[2]
+    enabled = 1 if model[INTERFERENCE] != 0.0 else 0
+    for n in range(start, stop):
+        _tt_matrix(angles[n, 0], angles[n, 1], angles[n, 2], r)
+        _pose(model, r, px, py, pz, scratch, out, True)
+        for c in range(3):
+            margins[c, n] = out[c]
+            legs[c, n] = int(out[OUT_LEG + c]) + 1
+        margins[3, n] = out[3]
+        legs[3, n] = (int(out[OUT_LEG + 3]) + 1) * enabled
+        pairs[n, 0] = (int(out[OUT_PAIR]) + 1) * enabled
+        pairs[n, 1] = (int(out[OUT_PAIR + 1]) + 1) * enabled
+        worst = _limiting_constraint(model, out)
+        limiting[n] = worst
+        limiting_leg[n] = legs[worst, n]
+        reachable[n] = _feasible(out)
+
+
+@_jit
+def margins_rotations(model, rotations, positions, interference, margins, legs, pairs):
+    """Margins of N poses given as rotation matrices (N, 3, 3) at positions (M, 3), M ∈ {1, N}.
+
+    Writes ``margins`` (4, N), ``legs`` (4, N) and ``pairs`` (N, 2) as :func:`check_angles`.
+    """
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    shared = positions.shape[0] == 1
+    for n in range(rotations.shape[0]):
+        for i in range(3):
+            for j in range(3):
+                r[3 * i + j] = rotations[n, i, j]
+        p = 0 if shared else n
+        _pose(
+            model, r, positions[p, 0], positions[p, 1], positions[p, 2], scratch, out, interference
+        )
+        for c in range(4):
+            margins[c, n] = out[c]
+            legs[c, n] = int(out[OUT_LEG + c])
+        pairs[n, 0] = int(out[OUT_PAIR])
+        pairs[n, 1] = int(out[OUT_PAIR + 1])
+
+
+@_jit
+def margins_angles(model, angles, position, margins, shortest):
+    """The four margins (4, N) and shortest leg (N,) of poses ``angles`` (N, 3) at position (3,)."""
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    for n in range(angles.shape[0]):
+        _tt_matrix(angles[n, 0], angles[n, 1], angles[n, 2], r)
+        _pose(model, r, position[0], position[1], position[2], scratch, out, True)
+        for c in range(4):
+            margins[c, n] = out[c]
+        shortest[n] = out[OUT_SHORTEST]
+
+
+# ------------------------------------------------------------------------------ ray searches
+@_jit
+def _ray_pose(model, position, kind, origin, direction, s, scratch, out, r):
+    """Margins at parameter s of the ray origin + s·direction (KIND_TT or KIND_CYLINDRICAL)."""
+    if kind == KIND_TT:
+        phi = origin[0] + s * direction[0]
+        theta = origin[1] + s * direction[1]
+        psi = origin[2] + s * direction[2]
+    else:
+        x = origin[0] + s * direction[0]
+        y = origin[1] + s * direction[1]
+        psi = origin[2] + s * direction[2]
+        theta = math.hypot(x, y)
+        phi = math.atan2(y, x) if theta > 0.0 else 0.0
+    _tt_matrix(phi, theta, psi, r)
+    _pose(model, r, position[0], position[1], position[2], scratch, out, True)
+
+
+@_jit
+def _estimate(model, out):
+    """Signed distance estimate min_c m_c / L_c with fixed Lipschitz constants, rad (NaN wins)."""
+    rho = model[RHO]
+    floor = model[ESTIMATE_FLOOR]
+    best = out[0] / rho
+    for value in (out[1] / (rho / floor), out[2] / (1.0 + rho / floor), out[3] / (2.0 * rho)):
+        if value < best or value != value:
+            best = value
+    return best
+
+
+@_jit
+def _fmin(a, b):
+    """numpy.fmin: the smaller, ignoring a NaN."""
+    if a != a:
+        return b
+    if b != b:
+        return a
+    return a if a < b else b
+
+
+@_jit
+def certified_step(model, out):
+    """Length over which no margin can reach zero, from feasible margins (core.search)."""
+    rho = model[RHO]
+    length_min = model[LENGTH_FLOOR]
+    length_now = length_min + max(out[0], 0.0)
+    floor = max(length_min, 0.5 * length_now)
+    step = _fmin(out[0] / rho, out[1] * floor / rho)
+    step = _fmin(step, out[2] / (1.0 + rho / floor))
+    step = _fmin(step, out[3] / (2.0 * rho))
+    step = _fmin(step, 0.5 * length_now / rho)
+    step = _fmin(step, MAX_STEP)
+    if not step > 0.0:  # numpy.fmax(step, 0) (a NaN step becomes 0)
+        step = 0.0
+    return step * SAFETY
+
+
+@_jit
+def recovery_step(model, out):
+    """Length over which a violated pose stays violated (core.search.RaySearch.recovery_step)."""
+    rho = model[RHO]
+    floor = 0.5 * out[OUT_SHORTEST]
+    recover = 0.0
+    bounds = (rho, rho / floor, 1.0 + rho / floor, 2.0 * rho)
+    for c in range(4):
+        value = -out[c] / bounds[c] if out[c] < 0.0 else 0.0
+        if value > recover or value != value:
+            recover = value
+    return min(recover, floor / rho) * SAFETY
+
+
+@_jit
+def search_rays(
+    model,
+    position,
+    kind,
+    origins,
+    directions,
+    s_start,
+    s_end,
+    tolerance,
+    min_step,
+    feasible,
+    violated,
+    limiting,
+    start_feasible,
+):
+    """First violation along rays (the algorithm of core.search.RaySearch.first_violation).
+
+    Parameters
+    ----------
+    model : ndarray, shape (MODEL_SIZE,)
+    position : ndarray, shape (3,)
+        m, base frame.
+    kind : int
+        KIND_TT or KIND_CYLINDRICAL.
+    origins, directions : ndarray, shape (n, 3)
+        Ray i is origins[i] + s·directions[i].
+    s_start, s_end : ndarray, shape (n,)
+        Parameter range of each ray, rad.
+    tolerance, min_step : float
+        Bracket width at which the search stops; shortest march step (rad).
+    feasible, violated, limiting, start_feasible : ndarray, shape (n,)
+        Outputs, see core.search.RaySearchResult.
+
+    Returns
+    -------
+    int
+        Poses evaluated.
+    """
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    evaluations = 0
+    half = 0.25 * tolerance
+    for ray in range(origins.shape[0]):
+        origin = origins[ray]
+        direction = directions[ray]
+        end = s_end[ray]
+        s = s_start[ray]
+        feasible[ray] = np.nan
+        violated[ray] = np.inf
+        limiting[ray] = -1
+        start_feasible[ray] = True
+        low_value = 0.0
+        high_value = 0.0
+        first = True
+        bracketed = False
+        # March with certified steps until the first violated sample or the end of the ray.
+        while True:
+            _ray_pose(model, position, kind, origin, direction, s, scratch, out, r)
+            evaluations += 1
+            estimate = _estimate(model, out)
+            if not _feasible(out):
+                violated[ray] = s
+                high_value = estimate
+                limiting[ray] = _limiting_constraint(model, out)
+                if first:
+                    start_feasible[ray] = False
+                else:
+                    bracketed = True
+                break
+            first = False
+            feasible[ray] = s
+            low_value = estimate
+            step = max(certified_step(model, out), min_step)
+            if s >= end:
+                break
+            s = min(s + step, end)
+        if not bracketed:
+            continue
+        # Secant steps on the distance estimate, safeguarded by bisection; two probes around
+        # each guess (the second only when the first is feasible).
+        low = feasible[ray]
+        high = violated[ray]
+        bisect = False
+        while high - low > tolerance:
+            width = high - low
+            secant = low + low_value / (low_value - high_value) * width
+            guess = low + 0.5 * width if bisect or not math.isfinite(secant) else secant
+            guess = min(max(guess, low + half), high - half)
+            minus = guess - half
+            plus = guess + half
+            _ray_pose(model, position, kind, origin, direction, minus, scratch, out, r)
+            evaluations += 1
+            if not _feasible(out):
+                high = minus
+                high_value = _estimate(model, out)
+                limiting[ray] = _limiting_constraint(model, out)
+            else:
+                minus_value = _estimate(model, out)
+                _ray_pose(model, position, kind, origin, direction, plus, scratch, out, r)
+                evaluations += 1
+                if not _feasible(out):
+                    low = minus
+                    low_value = minus_value
+                    high = plus
+                    high_value = _estimate(model, out)
+                    limiting[ray] = _limiting_constraint(model, out)
+                else:
+                    low = plus
+                    low_value = _estimate(model, out)
+            bisect = (high - low) > 0.5 * width
+        feasible[ray] = low
+        violated[ray] = high
+    return evaluations
+
+
+@_jit
+def torsion_scan(model, position, phi, theta, min_step, max_step, tolerance, edges, rising):
+    """Feasible-torsion transitions over ψ ∈ [−π, π] for one tool direction (φ, θ).
+
+    Scans with certified steps (recovery steps from violated samples), clipped to
+    [min_step, max_step], then bisects every transition, all of them together, until the widest
+    bracket is within the tolerance (as core.orientation.torsion_range did).
+
+    Parameters
+    ----------
+    edges, rising : ndarray, shape (K,)
+        Outputs: the feasible end of each transition, and whether it goes infeasible → feasible.
+        K must be at least the number of transitions (ceil(2π / min_step) + 1 is enough).
+
+    Returns
+    -------
+    count : int
+        Number of transitions written (−1 − count when the outputs were too short).
+    start_ok : bool
+        Whether ψ = −π is feasible.
+    """
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    capacity = edges.shape[0]
+    low = np.empty(capacity)
+    high = np.empty(capacity)
+    count = 0
+    psi = -math.pi
+    previous_ok = False
+    start_ok = False
+    first = True
+    previous = psi
+    while True:
+        _tt_matrix(phi, theta, psi, r)
+        _pose(model, r, position[0], position[1], position[2], scratch, out, True)
+        ok = _feasible(out)
+        if first:
+            start_ok = ok
+        elif ok != previous_ok:
+            if count >= capacity:
+                return -1 - count, start_ok
+            low[count] = previous
+            high[count] = psi
+            rising[count] = ok
+            count += 1
+        first = False
+        previous_ok = ok
+        previous = psi
+        if psi >= math.pi:
+            break
+        step = certified_step(model, out) if ok else recovery_step(model, out)
+        psi = min(psi + min(max(step, min_step), max_step), math.pi)
+    while count > 0:
+        widest = 0.0
+        for k in range(count):
+            widest = max(widest, high[k] - low[k])
+        if not widest > tolerance:
+            break
+        for k in range(count):
+            middle = 0.5 * (low[k] + high[k])
+            _tt_matrix(phi, theta, middle, r)
+            _pose(model, r, position[0], position[1], position[2], scratch, out, True)
+            # Keep the transition inside [low, high]: the side matching the start state moves.
+            if _feasible(out) != rising[k]:
+                low[k] = middle
+            else:
+                high[k] = middle
+    for k in range(count):
+        edges[k] = high[k] if rising[k] else low[k]
+    return count, start_ok
+
+
+# ------------------------------------------------------------------------------ compilation
+def _kernels() -> list:
+    return [check_angles, margins_rotations, margins_angles, search_rays, torsion_scan]
+
+
+def cache_is_warm() -> bool:
+    """Whether every kernel is already compiled in this process or in the on-disk cache.
+
+    False means the next use compiles (seconds). Uses numba's cache index (an internal
+    interface); when it cannot be read, answers False.
+    """
+    try:
+        for kernel in _kernels():
+            if kernel.signatures:
+                continue
+            if kernel._cache is None or not kernel._cache._cache_file._load_index():
+                return False
+    except (AttributeError, OSError, TypeError, ValueError):
+        return False
+    return True
+
+
+def warm_up() -> float:
+    """Compile (first run after install) or load from the cache every kernel; seconds taken.
+
+    Runs each kernel once on a tiny problem of the argument types production uses. For the
+    ROS node to call before it reports ready, and for the CLI.
+    """
+    started = time.perf_counter()
+    model = np.zeros(MODEL_SIZE)
+    model[A : A + 18] = np.tile([1.0, 0.0, 0.0], 6)
+    model[B : B + 18] = np.tile([0.5, 0.0, 0.0], 6)
+    model[SCALE : SCALE + 4] = 1.0
+    model[RHO] = 0.5
+    model[LENGTH_FLOOR] = model[ESTIMATE_FLOOR] = 1e-3
+    model[LMAX : LMAX + 6] = 2.0
+    model[ORDER : ORDER + 15] = np.arange(15)
+    model.setflags(write=False)
+    position = np.array([0.0, 0.0, 1.0])
+    angles = np.zeros((1, 3))
+    margins = np.empty((4, 1))
+    legs = np.empty((4, 1), dtype=np.int64)
+    pairs = np.empty((1, 2), dtype=np.int64)
+    check_angles(
+        model,
+        angles,
+        position,
+        0,
+        1,
+        margins,
+        legs,
+        pairs,
+        np.empty(1, dtype=np.int64),
+        np.empty(1, dtype=np.int64),
+        np.empty(1, dtype=np.bool_),
+    )
+    margins_rotations(model, np.eye(3)[None], position[None], True, margins, legs, pairs)
+    margins_angles(model, angles, position, margins, np.empty(1))
+    ones = np.ones(1)
+    search_rays(
+        model,
+        position,
+        KIND_TT,
+        angles,
+        np.array([[0.0, 1.0, 0.0]]),
+        np.zeros(1),
+        ones,
+        1e-3,
+        1e-3,
+        np.empty(1),
+        np.empty(1),
+        np.empty(1, dtype=np.int64),
+        np.empty(1, dtype=np.bool_),
+    )
+    torsion_scan(
+        model, position, 0.0, 0.0, 1e-3, 0.25, 1e-3, np.empty(8), np.empty(8, dtype=np.bool_)
+    )
+    return time.perf_counter() - started
