@@ -349,16 +349,70 @@ def _pose(model, r, px, py, pz, scratch, out, want_pair):
     out[OUT_PAIR + 1] = PAIR_J[best_pair]
 
 
+# ------------------------------------------------------------------------------ sin and cos
+# Cody–Waite reduction by π/2 in three parts of 33 bits (exact products for |k| < 2**20) and the
+# Cephes polynomials on [−π/4, π/4]: within 1 ulp of libm, and branch-free, so that loops over a
+# block of poses vectorise. Arguments beyond FAST_TRIG_LIMIT use libm (see _check_block).
+PIO2_1 = 1.57079632673412561417e00
+PIO2_2 = 6.07710050630396597660e-11
+PIO2_3 = 2.02226624879595063154e-21
+TWO_OVER_PI = 0.6366197723675814
+FAST_TRIG_LIMIT = 1e5
+SIN_0, SIN_1, SIN_2 = (
+    1.58962301576546568060e-10,
+    -2.50507477628578072866e-8,
+    2.75573136213857245213e-6,
+)
+SIN_3, SIN_4, SIN_5 = (
+    -1.98412698295895385996e-4,
+    8.33333333332211858878e-3,
+    -1.66666666666666307295e-1,
+)
+COS_0, COS_1, COS_2 = (
+    -1.13585365213876817300e-11,
+    2.08757008419747316778e-9,
+    -2.75573141792967388112e-7,
+)
+COS_3, COS_4, COS_5 = (
+    2.48015872888517045348e-5,
+    -1.38888888888730564116e-3,
+    4.16666666666665929218e-2,
+)
+
+
+@numba.njit(inline="always")
+def _sincos(x):
+    """(sin x, cos x) for |x| ≤ FAST_TRIG_LIMIT, branch-free."""
+    k = math.floor(x * TWO_OVER_PI + 0.5)
+    r = ((x - k * PIO2_1) - k * PIO2_2) - k * PIO2_3
+    z = r * r
+    sine = r + r * z * (((((SIN_0 * z + SIN_1) * z + SIN_2) * z + SIN_3) * z + SIN_4) * z + SIN_5)
+    cosine = (
+        1.0
+        - 0.5 * z
+        + z * z * (((((COS_0 * z + COS_1) * z + COS_2) * z + COS_3) * z + COS_4) * z + COS_5)
+    )
+    quadrant = k - 4.0 * math.floor(k * 0.25)
+    odd = quadrant == 1.0 or quadrant == 3.0
+    sin_value = cosine if odd else sine
+    cos_value = sine if odd else cosine
+    sin_value = -sin_value if quadrant >= 2.0 else sin_value
+    cos_value = -cos_value if (quadrant == 1.0 or quadrant == 2.0) else cos_value
+    return sin_value, cos_value
+
+
 @_jit
 def _tt_matrix(phi, theta, psi, r):
     """R(φ, θ, ψ) = Rz(φ)·Ry(θ)·Rz(ψ − φ) into r (9,), row-major (as rotations.tt_to_matrix)."""
     gamma = psi - phi
-    ca = math.cos(phi)
-    sa = math.sin(phi)
-    cb = math.cos(theta)
-    sb = math.sin(theta)
-    cg = math.cos(gamma)
-    sg = math.sin(gamma)
+    if max(abs(phi), abs(theta), abs(gamma)) <= FAST_TRIG_LIMIT:
+        sa, ca = _sincos(phi)
+        sb, cb = _sincos(theta)
+        sg, cg = _sincos(gamma)
+    else:
+        ca, sa = math.cos(phi), math.sin(phi)
+        cb, sb = math.cos(theta), math.sin(theta)
+        cg, sg = math.cos(gamma), math.sin(gamma)
     r[0] = ca * cb * cg - sa * sg
     r[1] = -ca * cb * sg - sa * cg
     r[2] = ca * sb
@@ -389,6 +443,251 @@ def _feasible(out):
     return out[0] >= 0.0 and out[1] >= 0.0 and out[2] >= 0.0 and out[3] >= 0.0
 
 
+# ------------------------------------------------------------------------------ blocks of poses
+#: Poses per block of the vectorised check (its working planes stay in the L1/L2 cache).
+BLOCK = 128
+# Rows of the block scratch (each a plane of BLOCK poses).
+_CA, _SA, _CB, _SB, _CG, _SG = 0, 1, 2, 3, 4, 5
+_R = 6  # 9 rows: rotation matrix, row-major
+_LX, _LY, _LZ, _SQ, _INV = 15, 21, 27, 33, 39  # 6 rows each: leg planes
+_M_LEN, _LEG_LEN, _M_A, _LEG_A, _M_B, _LEG_B, _BEST, _PAIR, _FIX = (
+    45,
+    46,
+    47,
+    48,
+    49,
+    50,
+    51,
+    52,
+    53,
+)
+_COS_A, _COS_B = 54, 60  # 6 rows each: per-leg cosines (unequal limits)
+_PHI, _THETA, _PSI = 66, 67, 68
+_BLOCK_ROWS = 69
+
+
+@numba.njit(inline="always")
+def _leg_planes(model, work, count, k, px, py, pz):
+    """Leg k of a block: vectors, squared lengths, 1/ℓ², running minima of the leg-length
+    margin and of both joint cosines, with their legs. ``k`` is a literal at every call site:
+    rows are then constants and the loop vectorises."""
+    bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
+    ox, oy, oz = px - model[A + 3 * k], py - model[A + 3 * k + 1], pz - model[A + 3 * k + 2]
+    jax, jay, jaz = model[JA + 3 * k], model[JA + 3 * k + 1], model[JA + 3 * k + 2]
+    jbx, jby, jbz = model[JB + 3 * k], model[JB + 3 * k + 1], model[JB + 3 * k + 2]
+    lmin, lmax, kf = model[LMIN + k], model[LMAX + k], float(k)
+    for n in range(count):
+        r00, r01, r02 = (
+            work[_R * BLOCK + n],
+            work[(_R + 1) * BLOCK + n],
+            work[(_R + 2) * BLOCK + n],
+        )
+        r10, r11, r12 = (
+            work[(_R + 3) * BLOCK + n],
+            work[(_R + 4) * BLOCK + n],
+            work[(_R + 5) * BLOCK + n],
+        )
+        r20, r21, r22 = (
+            work[(_R + 6) * BLOCK + n],
+            work[(_R + 7) * BLOCK + n],
+            work[(_R + 8) * BLOCK + n],
+        )
+        x = (r00 * bx + r01 * by + r02 * bz) + ox
+        y = (r10 * bx + r11 * by + r12 * bz) + oy
+        z = (r20 * bx + r21 * by + r22 * bz) + oz
+        work[(_LX + k) * BLOCK + n] = x
+        work[(_LY + k) * BLOCK + n] = y
+        work[(_LZ + k) * BLOCK + n] = z
+        squared = x * x + y * y + z * z
+        work[(_SQ + k) * BLOCK + n] = squared
+        length = math.sqrt(squared)
+        inverse = 1.0 / length
+        work[(_INV + k) * BLOCK + n] = inverse * inverse
+        value = min(length - lmin, lmax - length)
+        # Running minimum and its leg, written so that the loop vectorises (one select
+        # per statement): the first leg wins ties.
+        smallest = work[_M_LEN * BLOCK + n]
+        work[_LEG_LEN * BLOCK + n] = kf if value < smallest else work[_LEG_LEN * BLOCK + n]
+        work[_M_LEN * BLOCK + n] = min(value, smallest)
+        cos_a = (jax * x + jay * y + jaz * z) * inverse
+        cos_b = (
+            (r00 * jbx + r01 * jby + r02 * jbz) * x
+            + (r10 * jbx + r11 * jby + r12 * jbz) * y
+            + (r20 * jbx + r21 * jby + r22 * jbz) * z
+        ) * -inverse
+        work[(_COS_A + k) * BLOCK + n] = cos_a
+        work[(_COS_B + k) * BLOCK + n] = cos_b
+        smallest = work[_M_A * BLOCK + n]
+        work[_LEG_A * BLOCK + n] = kf if cos_a < smallest else work[_LEG_A * BLOCK + n]
+        work[_M_A * BLOCK + n] = min(cos_a, smallest)
+        smallest = work[_M_B * BLOCK + n]
+        work[_LEG_B * BLOCK + n] = kf if cos_b < smallest else work[_LEG_B * BLOCK + n]
+        work[_M_B * BLOCK + n] = min(cos_b, smallest)
+        work[_FIX * BLOCK + n] = max(work[_FIX * BLOCK + n], 0.0 if squared > 1e-300 else 1.0)
+
+
+@numba.njit(inline="always")
+def _pair_plane(model, work, count, pair, i, j):
+    """Segment distance of legs i < j (pair index ``pair``) over a block, running minimum and
+    its pair; flags parallel or point-like legs for the exact path. Literal arguments, as in
+    :func:`_leg_planes`."""
+    rx = model[RPAIR + 3 * pair]
+    ry = model[RPAIR + 3 * pair + 1]
+    rz = model[RPAIR + 3 * pair + 2]
+    rr, pf = model[RR + pair], float(pair)
+    for n in range(count):
+        xi, yi, zi, a = (
+            work[(_LX + i) * BLOCK + n],
+            work[(_LY + i) * BLOCK + n],
+            work[(_LZ + i) * BLOCK + n],
+            work[(_SQ + i) * BLOCK + n],
+        )
+        xj, yj, zj, e = (
+            work[(_LX + j) * BLOCK + n],
+            work[(_LY + j) * BLOCK + n],
+            work[(_LZ + j) * BLOCK + n],
+            work[(_SQ + j) * BLOCK + n],
+        )
+        b = xi * xj + yi * yj + zi * zj
+        c = xi * rx + yi * ry + zi * rz
+        f = xj * rx + yj * ry + zj * rz
+        denom = a * e - b * b
+        s = min(max((b * f - c * e) / denom, 0.0), 1.0)
+        t = min(max((b * s + f) * work[(_INV + j) * BLOCK + n], 0.0), 1.0)
+        s = min(max((b * t - c) * work[(_INV + i) * BLOCK + n], 0.0), 1.0)
+        squared = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
+        distance = math.sqrt(max(squared, 0.0))
+        smallest = work[_BEST * BLOCK + n]
+        work[_PAIR * BLOCK + n] = pf if distance < smallest else work[_PAIR * BLOCK + n]
+        work[_BEST * BLOCK + n] = min(distance, smallest)
+        regular = 0.0 if denom > 1e-14 * a * e else 1.0
+        work[_FIX * BLOCK + n] = max(work[_FIX * BLOCK + n], regular)
+
+
+@_jit
+def _check_block(model, angles, position, first, count, work, scratch, out, r):
+    """Margins of poses angles[first : first + count] (count ≤ BLOCK) into ``work`` planes.
+
+    Every stage is a loop over the poses of the block without branches, which the compiler
+    vectorises; poses that need care (a zero-length leg, parallel or point-like legs, huge
+    angles) are flagged in the _FIX row and recomputed one by one by :func:`_pose` with libm's
+    sin and cos. Leaves in ``work``: margins in rows 0..3, legs in 4..7, pair in 8..9 (as floats).
+    """
+    px, py, pz = position[0], position[1], position[2]
+    for n in range(count):  # strided reads: a loop of its own (it does not vectorise)
+        work[_PHI * BLOCK + n] = angles[first + n, 0]
+        work[_THETA * BLOCK + n] = angles[first + n, 1]
+        work[_PSI * BLOCK + n] = angles[first + n, 2]
+    for n in range(count):
+        phi = work[_PHI * BLOCK + n]
+        theta = work[_THETA * BLOCK + n]
+        gamma = work[_PSI * BLOCK + n] - phi
+        work[_SA * BLOCK + n], work[_CA * BLOCK + n] = _sincos(phi)
+        work[_SB * BLOCK + n], work[_CB * BLOCK + n] = _sincos(theta)
+        work[_SG * BLOCK + n], work[_CG * BLOCK + n] = _sincos(gamma)
+        largest = max(abs(phi), abs(theta), abs(gamma))
+        work[_FIX * BLOCK + n] = 1.0 if largest > FAST_TRIG_LIMIT else 0.0
+        work[_M_LEN * BLOCK + n] = np.inf
+        work[_M_A * BLOCK + n] = np.inf
+        work[_M_B * BLOCK + n] = np.inf
+        work[_LEG_LEN * BLOCK + n] = 0.0
+        work[_LEG_A * BLOCK + n] = 0.0
+        work[_LEG_B * BLOCK + n] = 0.0
+        work[_BEST * BLOCK + n] = np.inf
+        work[_PAIR * BLOCK + n] = 0.0
+    for n in range(count):
+        ca, sa = work[_CA * BLOCK + n], work[_SA * BLOCK + n]
+        cb, sb = work[_CB * BLOCK + n], work[_SB * BLOCK + n]
+        cg, sg = work[_CG * BLOCK + n], work[_SG * BLOCK + n]
+        work[_R * BLOCK + n] = ca * cb * cg - sa * sg
+        work[(_R + 1) * BLOCK + n] = -ca * cb * sg - sa * cg
+        work[(_R + 2) * BLOCK + n] = ca * sb
+        work[(_R + 3) * BLOCK + n] = sa * cb * cg + ca * sg
+        work[(_R + 4) * BLOCK + n] = -sa * cb * sg + ca * cg
+        work[(_R + 5) * BLOCK + n] = sa * sb
+        work[(_R + 6) * BLOCK + n] = -sb * cg
+        work[(_R + 7) * BLOCK + n] = sb * sg
+        work[(_R + 8) * BLOCK + n] = cb
+    _leg_planes(model, work, count, 0, px, py, pz)
+    _leg_planes(model, work, count, 1, px, py, pz)
+    _leg_planes(model, work, count, 2, px, py, pz)
+    _leg_planes(model, work, count, 3, px, py, pz)
+    _leg_planes(model, work, count, 4, px, py, pz)
+    _leg_planes(model, work, count, 5, px, py, pz)
+    interference = model[INTERFERENCE] != 0.0
+    if interference:
+        # Pairs in index order (the first pair wins ties, as in the reference).
+        _pair_plane(model, work, count, 0, 0, 1)
+        _pair_plane(model, work, count, 1, 0, 2)
+        _pair_plane(model, work, count, 2, 0, 3)
+        _pair_plane(model, work, count, 3, 0, 4)
+        _pair_plane(model, work, count, 4, 0, 5)
+        _pair_plane(model, work, count, 5, 1, 2)
+        _pair_plane(model, work, count, 6, 1, 3)
+        _pair_plane(model, work, count, 7, 1, 4)
+        _pair_plane(model, work, count, 8, 1, 5)
+        _pair_plane(model, work, count, 9, 2, 3)
+        _pair_plane(model, work, count, 10, 2, 4)
+        _pair_plane(model, work, count, 11, 2, 5)
+        _pair_plane(model, work, count, 12, 3, 4)
+        _pair_plane(model, work, count, 13, 3, 5)
+        _pair_plane(model, work, count, 14, 4, 5)
+    # Per pose: the joint-angle margins (arccos), the rare poses that need care, the outputs.
+    alpha_equal = model[ALPHA_EQUAL] != 0.0
+    beta_equal = model[BETA_EQUAL] != 0.0
+    for n in range(count):
+        if work[_FIX * BLOCK + n] != 0.0:
+            _tt_matrix(angles[first + n, 0], angles[first + n, 1], angles[first + n, 2], r)
+            _pose(model, r, px, py, pz, scratch, out, True)
+            for slot in range(OUT_SHORTEST):
+                work[(slot) * BLOCK + n] = out[slot]
+            continue
+        work[(0) * BLOCK + n] = work[_M_LEN * BLOCK + n]
+        work[OUT_LEG * BLOCK + n] = work[_LEG_LEN * BLOCK + n]
+        if alpha_equal:
+            work[(1) * BLOCK + n] = model[ALPHA] - math.acos(
+                min(max(work[_M_A * BLOCK + n], -1.0), 1.0)
+            )
+            work[(OUT_LEG + 1) * BLOCK + n] = work[_LEG_A * BLOCK + n]
+        else:
+            work[(1) * BLOCK + n], work[(OUT_LEG + 1) * BLOCK + n] = _per_leg_angle(
+                model, ALPHA, work, _COS_A, n
+            )
+        if beta_equal:
+            work[(2) * BLOCK + n] = model[BETA] - math.acos(
+                min(max(work[_M_B * BLOCK + n], -1.0), 1.0)
+            )
+            work[(OUT_LEG + 2) * BLOCK + n] = work[_LEG_B * BLOCK + n]
+        else:
+            work[(2) * BLOCK + n], work[(OUT_LEG + 2) * BLOCK + n] = _per_leg_angle(
+                model, BETA, work, _COS_B, n
+            )
+        if interference:
+            pair = int(work[_PAIR * BLOCK + n])
+            work[(3) * BLOCK + n] = work[_BEST * BLOCK + n] - model[DIAMETER]
+            work[(OUT_LEG + 3) * BLOCK + n] = PAIR_I[pair]
+            work[OUT_PAIR * BLOCK + n] = PAIR_I[pair]
+            work[(OUT_PAIR + 1) * BLOCK + n] = PAIR_J[pair]
+        else:
+            work[(3) * BLOCK + n] = np.inf
+            work[(OUT_LEG + 3) * BLOCK + n] = 0.0
+            work[OUT_PAIR * BLOCK + n] = 0.0
+            work[(OUT_PAIR + 1) * BLOCK + n] = 0.0
+
+
+@_jit
+def _per_leg_angle(model, limits, work, row, n):
+    """min_i (limit_i − arccos(cos_i)) and its leg, for per-leg joint limits."""
+    best = np.inf
+    leg = 0.0
+    for k in range(6):
+        value = model[limits + k] - math.acos(min(max(work[(row + k) * BLOCK + n], -1.0), 1.0))
+        if value < best:
+            best = value
+            leg = float(k)
+    return best, leg
+
+
 # ------------------------------------------------------------------------------ batches
 @_jit
 def check_angles(
@@ -405,22 +704,26 @@ def check_angles(
     scratch = np.empty((5, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
-    px, py, pz = position[0], position[1], position[2]
+    work = np.empty(_BLOCK_ROWS * BLOCK)
     enabled = 1 if model[INTERFERENCE] != 0.0 else 0
-    for n in range(start, stop):
-        _tt_matrix(angles[n, 0], angles[n, 1], angles[n, 2], r)
-        _pose(model, r, px, py, pz, scratch, out, True)
-        for c in range(3):
-            margins[c, n] = out[c]
-            legs[c, n] = int(out[OUT_LEG + c]) + 1
-        margins[3, n] = out[3]
-        legs[3, n] = (int(out[OUT_LEG + 3]) + 1) * enabled
-        pairs[n, 0] = (int(out[OUT_PAIR]) + 1) * enabled
-        pairs[n, 1] = (int(out[OUT_PAIR + 1]) + 1) * enabled
-        worst = _limiting_constraint(model, out)
-        limiting[n] = worst
-        limiting_leg[n] = legs[worst, n]
-        reachable[n] = _feasible(out)
+    for first in range(start, stop, BLOCK):
+        count = min(BLOCK, stop - first)
+        _check_block(model, angles, position, first, count, work, scratch, out, r)
+        for m in range(count):
+            n = first + m
+            for c in range(3):
+                margins[c, n] = work[(c) * BLOCK + m]
+                legs[c, n] = int(work[(OUT_LEG + c) * BLOCK + m]) + 1
+            margins[3, n] = work[(3) * BLOCK + m]
+            legs[3, n] = (int(work[(OUT_LEG + 3) * BLOCK + m]) + 1) * enabled
+            pairs[n, 0] = (int(work[OUT_PAIR * BLOCK + m]) + 1) * enabled
+            pairs[n, 1] = (int(work[(OUT_PAIR + 1) * BLOCK + m]) + 1) * enabled
+            for slot in range(4):
+                out[slot] = work[slot * BLOCK + m]
+            worst = _limiting_constraint(model, out)
+            limiting[n] = worst
+            limiting_leg[n] = legs[worst, n]
+            reachable[n] = _feasible(out)
 
 
 @_jit
@@ -449,35 +752,35 @@ def margins_rotations(model, rotations, positions, interference, margins, legs, 
 
 
 @_jit
-def margins_angles(model, angles, position, margins, shortest):
-    """The four margins (4, N) and shortest leg (N,) of poses ``angles`` (N, 3) at position (3,)."""
+def margins_angles(model, angles, position, margins):
+    """The four margins (4, N) of poses ``angles`` (N, 3) of T&T angles (rad) at position (3,)."""
+    work = np.empty(_BLOCK_ROWS * BLOCK)
     scratch = np.empty((5, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
-    for n in range(angles.shape[0]):
-        _tt_matrix(angles[n, 0], angles[n, 1], angles[n, 2], r)
-        _pose(model, r, position[0], position[1], position[2], scratch, out, True)
-        for c in range(4):
-            margins[c, n] = out[c]
-        shortest[n] = out[OUT_SHORTEST]
+    for first in range(0, angles.shape[0], BLOCK):
+        size = min(BLOCK, angles.shape[0] - first)
+        _check_block(model, angles, position, first, size, work, scratch, out, r)
+        for m in range(size):
+            for c in range(4):
+                margins[c, first + m] = work[c * BLOCK + m]
 
 
 # ------------------------------------------------------------------------------ ray searches
 @_jit
-def _ray_pose(model, position, kind, origin, direction, s, scratch, out, r):
-    """Margins at parameter s of the ray origin + s·direction (KIND_TT or KIND_CYLINDRICAL)."""
+def _ray_angles(kind, origin, direction, s, angles, row):
+    """T&T angles of the ray origin + s·direction (KIND_TT or KIND_CYLINDRICAL) into angles[row]."""
     if kind == KIND_TT:
-        phi = origin[0] + s * direction[0]
-        theta = origin[1] + s * direction[1]
-        psi = origin[2] + s * direction[2]
+        angles[row, 0] = origin[0] + s * direction[0]
+        angles[row, 1] = origin[1] + s * direction[1]
+        angles[row, 2] = origin[2] + s * direction[2]
     else:
         x = origin[0] + s * direction[0]
         y = origin[1] + s * direction[1]
-        psi = origin[2] + s * direction[2]
         theta = math.hypot(x, y)
-        phi = math.atan2(y, x) if theta > 0.0 else 0.0
-    _tt_matrix(phi, theta, psi, r)
-    _pose(model, r, position[0], position[1], position[2], scratch, out, True)
+        angles[row, 0] = math.atan2(y, x) if theta > 0.0 else 0.0
+        angles[row, 1] = theta
+        angles[row, 2] = origin[2] + s * direction[2]
 
 
 @_jit
@@ -533,6 +836,10 @@ def recovery_step(model, out):
     return min(recover, floor / rho) * SAFETY
 
 
+# Phases of a ray in search_rays.
+_MARCH, _GUESS, _PLUS, _DONE = 0, 1, 2, 3
+
+
 @_jit
 def search_rays(
     model,
@@ -549,7 +856,13 @@ def search_rays(
     limiting,
     start_feasible,
 ):
-    """First violation along rays (the algorithm of core.search.RaySearch.first_violation).
+    """First violation along rays (the algorithm of core.search, all rays in lockstep).
+
+    Each round takes the next probe of every unfinished ray and evaluates them together with
+    the vectorised block kernel; per ray, the sequence of probes is that of a search along it
+    alone: a march with certified steps, then secant guesses on the distance estimate
+    (bisection when a secant step fails to halve the bracket), two probes around each guess,
+    the second only when the first is feasible.
 
     Parameters
     ----------
@@ -572,81 +885,112 @@ def search_rays(
     int
         Poses evaluated.
     """
-    scratch = np.empty((5, 6))
-    out = np.empty(OUT_SIZE)
-    r = np.empty(9)
-    evaluations = 0
-    half = 0.25 * tolerance
-    for ray in range(origins.shape[0]):
-        origin = origins[ray]
-        direction = directions[ray]
-        end = s_end[ray]
-        s = s_start[ray]
+    count = origins.shape[0]
+    phase = np.zeros(count, dtype=np.int64)
+    s = s_start.copy()
+    low_value = np.zeros(count)
+    high_value = np.zeros(count)
+    minus_value = np.zeros(count)
+    minus = np.zeros(count)
+    plus = np.zeros(count)
+    width = np.zeros(count)
+    bisect = np.zeros(count, dtype=np.bool_)
+    first = np.ones(count, dtype=np.bool_)
+    for ray in range(count):
         feasible[ray] = np.nan
         violated[ray] = np.inf
         limiting[ray] = -1
         start_feasible[ray] = True
-        low_value = 0.0
-        high_value = 0.0
-        first = True
-        bracketed = False
-        # March with certified steps until the first violated sample or the end of the ray.
-        while True:
-            _ray_pose(model, position, kind, origin, direction, s, scratch, out, r)
-            evaluations += 1
-            estimate = _estimate(model, out)
-            if not _feasible(out):
-                violated[ray] = s
-                high_value = estimate
-                limiting[ray] = _limiting_constraint(model, out)
-                if first:
-                    start_feasible[ray] = False
+    rays = np.empty(count, dtype=np.int64)
+    angles = np.empty((count, 3))
+    work = np.empty(_BLOCK_ROWS * BLOCK)
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    half = 0.25 * tolerance
+    evaluations = 0
+    while True:
+        # The next probe of every unfinished ray.
+        probes = 0
+        for ray in range(count):
+            state = phase[ray]
+            if state == _DONE:
+                continue
+            if state == _MARCH:
+                probe = s[ray]
+            elif state == _GUESS:
+                low, high = feasible[ray], violated[ray]
+                if not high - low > tolerance:
+                    phase[ray] = _DONE
+                    continue
+                width[ray] = high - low
+                secant = low + low_value[ray] / (low_value[ray] - high_value[ray]) * width[ray]
+                if bisect[ray] or not math.isfinite(secant):
+                    guess = low + 0.5 * width[ray]
                 else:
-                    bracketed = True
-                break
-            first = False
-            feasible[ray] = s
-            low_value = estimate
-            step = max(certified_step(model, out), min_step)
-            if s >= end:
-                break
-            s = min(s + step, end)
-        if not bracketed:
-            continue
-        # Secant steps on the distance estimate, safeguarded by bisection; two probes around
-        # each guess (the second only when the first is feasible).
-        low = feasible[ray]
-        high = violated[ray]
-        bisect = False
-        while high - low > tolerance:
-            width = high - low
-            secant = low + low_value / (low_value - high_value) * width
-            guess = low + 0.5 * width if bisect or not math.isfinite(secant) else secant
-            guess = min(max(guess, low + half), high - half)
-            minus = guess - half
-            plus = guess + half
-            _ray_pose(model, position, kind, origin, direction, minus, scratch, out, r)
-            evaluations += 1
-            if not _feasible(out):
-                high = minus
-                high_value = _estimate(model, out)
-                limiting[ray] = _limiting_constraint(model, out)
+                    guess = secant
+                guess = min(max(guess, low + half), high - half)
+                minus[ray] = guess - half
+                plus[ray] = guess + half
+                probe = minus[ray]
             else:
-                minus_value = _estimate(model, out)
-                _ray_pose(model, position, kind, origin, direction, plus, scratch, out, r)
-                evaluations += 1
-                if not _feasible(out):
-                    low = minus
-                    low_value = minus_value
-                    high = plus
-                    high_value = _estimate(model, out)
-                    limiting[ray] = _limiting_constraint(model, out)
-                else:
-                    low = plus
-                    low_value = _estimate(model, out)
-            bisect = (high - low) > 0.5 * width
-        feasible[ray] = low
-        violated[ray] = high
+                probe = plus[ray]
+            _ray_angles(kind, origins[ray], directions[ray], probe, angles, probes)
+            rays[probes] = ray
+            probes += 1
+        if probes == 0:
+            break
+        evaluations += probes
+        for block in range(0, probes, BLOCK):
+            size = min(BLOCK, probes - block)
+            _check_block(model, angles, position, block, size, work, scratch, out, r)
+            for m in range(size):
+                ray = rays[block + m]
+                for slot in range(4):
+                    out[slot] = work[slot * BLOCK + m]
+                ok = _feasible(out)
+                estimate = _estimate(model, out)
+                state = phase[ray]
+                if state == _MARCH:
+                    if not ok:
+                        violated[ray] = s[ray]
+                        high_value[ray] = estimate
+                        limiting[ray] = _limiting_constraint(model, out)
+                        if first[ray]:
+                            start_feasible[ray] = False
+                            phase[ray] = _DONE
+                        else:
+                            phase[ray] = _GUESS
+                        continue
+                    first[ray] = False
+                    feasible[ray] = s[ray]
+                    low_value[ray] = estimate
+                    step = max(certified_step(model, out), min_step)
+                    if s[ray] >= s_end[ray]:
+                        phase[ray] = _DONE
+                    else:
+                        s[ray] = min(s[ray] + step, s_end[ray])
+                elif state == _GUESS:  # the probe below the guess
+                    if not ok:
+                        violated[ray] = minus[ray]
+                        high_value[ray] = estimate
+                        limiting[ray] = _limiting_constraint(model, out)
+                        bisect[ray] = (violated[ray] - feasible[ray]) > 0.5 * width[ray]
+                    else:
+                        minus_value[ray] = estimate
+                        phase[ray] = _PLUS
+                else:  # the probe above the guess
+                    if not ok:
+                        feasible[ray] = minus[ray]
+                        low_value[ray] = minus_value[ray]
+                        violated[ray] = plus[ray]
+                        high_value[ray] = estimate
+                        limiting[ray] = _limiting_constraint(model, out)
+                    else:
+                        feasible[ray] = plus[ray]
+                        low_value[ray] = estimate
+                    bisect[ray] = (violated[ray] - feasible[ray]) > 0.5 * width[ray]
+                    phase[ray] = _GUESS
     return evaluations
 
 
@@ -780,7 +1124,7 @@ def warm_up() -> float:
         np.empty(1, dtype=np.bool_),
     )
     margins_rotations(model, np.eye(3)[None], position[None], True, margins, legs, pairs)
-    margins_angles(model, angles, position, margins, np.empty(1))
+    margins_angles(model, angles, position, margins)
     ones = np.ones(1)
     search_rays(
         model,

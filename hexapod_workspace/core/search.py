@@ -124,9 +124,7 @@ class RaySearch:
         """The four margins of poses (n, 3) at the search position; shape (4, n)."""
         angles = np.ascontiguousarray(angles, dtype=np.float64)
         margins = np.empty((4, angles.shape[0]))
-        kernels.margins_angles(
-            self.model, angles, self.position, margins, np.empty(angles.shape[0])
-        )
+        kernels.margins_angles(self.model, angles, self.position, margins)
         self.evaluations += angles.shape[0]
         return margins
 
