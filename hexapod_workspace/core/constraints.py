@@ -22,9 +22,11 @@ large batches of :func:`check` are split over the available cores.
 from __future__ import annotations
 
 import itertools
+import math
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -37,8 +39,10 @@ __all__ = [
     "CONSTRAINT_NAMES",
     "CheckResult",
     "LegKinematics",
+    "PoseCheck",
     "PoseMargins",
     "check",
+    "check_pose",
     "inverse_kinematics",
     "pose_margins",
     "relative_margins",
@@ -383,42 +387,40 @@ def check(
     if angles.ndim != 2 or angles.shape[1] != 3:
         msg = f"angles: expected shape (N, 3) of (phi, theta, psi), got {angles.shape}"
         raise InputError(msg)
-    if angles.shape[0] > MAX_POSES:
-        msg = f"angles: at most {MAX_POSES} poses per call, got {angles.shape[0]}"
+    count = angles.shape[0]
+    if count > MAX_POSES:
+        msg = f"angles: at most {MAX_POSES} poses per call, got {count}"
         raise InputError(msg)
-    if not np.all(np.isfinite(angles)):
-        bad = int(np.flatnonzero(~np.all(np.isfinite(angles), axis=1))[0])
-        msg = f"angles: expected finite values, pose {bad} is {angles[bad].tolist()}"
-        raise InputError(msg)
+    angles = np.ascontiguousarray(angles)
     position = np.array(manipulator.position if position is None else position, dtype=float)
     if position.shape != (3,):
+        _require_finite_angles(angles)
         msg = f"position: expected 3 values (x, y, z), got shape {position.shape}"
         raise InputError(msg)
-    if not np.all(np.isfinite(position)):
-        msg = f"position: expected finite values, got {position.tolist()}"
-        raise InputError(msg)
 
-    count = angles.shape[0]
-    angles = np.ascontiguousarray(angles)
     margins = np.empty((4, count))
-    legs = np.empty((4, count), dtype=np.int64)
+    ints = np.empty((6, count), dtype=np.int64)
     pairs = np.empty((count, 2), dtype=np.int64)
-    limiting = np.empty(count, dtype=np.int64)
-    limiting_leg = np.empty(count, dtype=np.int64)
     reachable = np.empty(count, dtype=np.bool_)
     model = kernels.model_vector(manipulator)
-    outputs = (margins, legs, pairs, limiting, limiting_leg, reachable)
+    outputs = (margins, ints, pairs, reachable)
     workers = _cores() if count >= PARALLEL_POSES else 1
     if workers == 1:
-        kernels.check_angles(model, angles, position, 0, count, *outputs)
+        status = kernels.check_angles(model, angles, position, 0, count, *outputs)
     else:
+        _require_finite_angles(angles)
         bounds = np.linspace(0, count, workers + 1).astype(int)
         jobs = [
             _pool().submit(kernels.check_angles, model, angles, position, start, stop, *outputs)
             for start, stop in itertools.pairwise(bounds)
         ]
-        for job in jobs:
-            job.result()
+        status = min(job.result() for job in jobs)
+    if status >= 0:
+        _require_finite_angles(angles)
+    if status == -2:
+        msg = f"position: expected finite values, got {position.tolist()}"
+        raise InputError(msg)
+    legs = ints[:4]
     return CheckResult(
         position=position,
         angles=angles,
@@ -426,9 +428,100 @@ def check(
         margins={name: margins[k] for k, name in enumerate(CONSTRAINT_NAMES)},
         limiting_legs={name: legs[k] for k, name in enumerate(CONSTRAINT_NAMES)},
         limiting_pair=pairs,
-        limiting_constraint=limiting,
-        limiting_leg=limiting_leg,
+        limiting_constraint=ints[4],
+        limiting_leg=ints[5],
     )
+
+
+class PoseCheck(NamedTuple):
+    """Reachability of one pose (:func:`check_pose`): plain Python numbers, no arrays.
+
+    Attributes
+    ----------
+    reachable : bool
+        Every constraint holds.
+    margins : tuple of 4 float
+        Signed margins in :data:`CONSTRAINT_NAMES` order (m, rad, rad, m).
+    limiting_legs : tuple of 4 int
+        1-based leg with the smallest margin of each constraint (``leg_interference``: the
+        lower leg of the closest pair; 0 when the check is disabled).
+    limiting_pair : tuple of 2 int
+        1-based closest pair (0, 0 when the check is disabled).
+    limiting_constraint : int
+        Index into :data:`CONSTRAINT_NAMES` of the smallest relative margin.
+    limiting_leg : int
+        1-based leg of the limiting constraint.
+    """
+
+    reachable: bool
+    margins: tuple[float, float, float, float]
+    limiting_legs: tuple[int, int, int, int]
+    limiting_pair: tuple[int, int]
+    limiting_constraint: int
+    limiting_leg: int
+
+
+def check_pose(
+    manipulator: Manipulator,
+    phi: float,
+    theta: float,
+    psi: float,
+    position: ArrayLike | None = None,
+) -> PoseCheck:
+    """Check one orientation: the same verdict and margins as :func:`check`, in microseconds.
+
+    Parameters
+    ----------
+    manipulator : Manipulator
+    phi, theta, psi : float
+        Tilt-and-Torsion angles, rad.
+    position : array_like, shape (3,), optional
+        Tool-tip position OC, base frame, m. Default: ``manipulator.position``.
+
+    Returns
+    -------
+    PoseCheck
+
+    Raises
+    ------
+    InputError
+        NaN or infinite values, a position that is not 3 values.
+    """
+    angles = (float(phi), float(theta), float(psi))
+    if not all(map(math.isfinite, angles)):
+        msg = f"angles: expected finite values, pose 0 is {list(angles)}"
+        raise InputError(msg)
+    if position is None:
+        x, y, z = manipulator.position.tolist()
+    else:
+        values = np.asarray(position, dtype=np.float64)
+        if values.shape != (3,):
+            msg = f"position: expected 3 values (x, y, z), got shape {values.shape}"
+            raise InputError(msg)
+        x, y, z = values.tolist()
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+            msg = f"position: expected finite values, got {[x, y, z]}"
+            raise InputError(msg)
+    result = np.empty(12)
+    kernels.check_one(kernels.model_vector(manipulator), *angles, x, y, z, result)
+    m_len, m_a, m_b, m_i, l_len, l_a, l_b, l_i, p_i, p_j, worst, leg = result.tolist()
+    return PoseCheck(
+        m_len >= 0.0 and m_a >= 0.0 and m_b >= 0.0 and m_i >= 0.0,
+        (m_len, m_a, m_b, m_i),
+        (int(l_len), int(l_a), int(l_b), int(l_i)),
+        (int(p_i), int(p_j)),
+        int(worst),
+        int(leg),
+    )
+
+
+def _require_finite_angles(angles: NDArray[np.float64]) -> None:
+    """Raise InputError naming the first pose (N, 3) with a non-finite angle, if any."""
+    finite = np.isfinite(angles).all(axis=1)
+    if not finite.all():
+        bad = int(np.flatnonzero(~finite)[0])
+        msg = f"angles: expected finite values, pose {bad} is {angles[bad].tolist()}"
+        raise InputError(msg)
 
 
 _POOL: ThreadPoolExecutor | None = None

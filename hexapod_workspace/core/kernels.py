@@ -446,122 +446,101 @@ def _feasible(out):
 # ------------------------------------------------------------------------------ blocks of poses
 #: Poses per block of the vectorised check (its working planes stay in the L1/L2 cache).
 BLOCK = 128
-# Rows of the block scratch (each a plane of BLOCK poses).
+# Rows of the block scratch (each a plane of BLOCK poses, in one flat array).
 _CA, _SA, _CB, _SB, _CG, _SG = 0, 1, 2, 3, 4, 5
 _R = 6  # 9 rows: rotation matrix, row-major
-_LX, _LY, _LZ, _SQ, _INV = 15, 21, 27, 33, 39  # 6 rows each: leg planes
-_M_LEN, _LEG_LEN, _M_A, _LEG_A, _M_B, _LEG_B, _BEST, _PAIR, _FIX = (
-    45,
-    46,
-    47,
-    48,
-    49,
-    50,
-    51,
-    52,
-    53,
-)
-_COS_A, _COS_B = 54, 60  # 6 rows each: per-leg cosines (unequal limits)
-_PHI, _THETA, _PSI = 66, 67, 68
-_BLOCK_ROWS = 69
+_PHI, _THETA, _PSI = 15, 16, 17
+_MIN = 18  # 9 rows: running minima, see the offsets below
+_LEGS = 27  # 7 rows per leg, see the offsets below
+_BLOCK_ROWS = _LEGS + 6 * 7
+# Rows of the running minima (offsets from _MIN): margins or cosines and their leg or pair.
+_M_LEN, _LEG_LEN, _M_A, _LEG_A, _M_B, _LEG_B, _BEST, _PAIR, _FIX = range(9)
+# Rows of one leg (offsets from _LEGS + 7·k): vector, squared length, 1/ℓ², joint cosines.
+_LX, _LY, _LZ, _SQ, _INV, _COS_A, _COS_B = range(7)
 
 
-@numba.njit(inline="always")
-def _leg_planes(model, work, count, k, px, py, pz):
-    """Leg k of a block: vectors, squared lengths, 1/ℓ², running minima of the leg-length
-    margin and of both joint cosines, with their legs. ``k`` is a literal at every call site:
-    rows are then constants and the loop vectorises."""
+@_jit
+def _planes(work, row, rows):
+    """The planes [row, row + rows) of a block scratch, as one flat view."""
+    return work[row * BLOCK : (row + rows) * BLOCK]
+
+
+# The leg and pair stages take their planes as separate views with constant row offsets inside:
+# the compiler then needs only a few run-time overlap checks between views, and vectorises.
+@_jit
+def _leg_planes(model, rotation, leg, minima, count, k, px, py, pz):
+    """Leg k over a block: vector, squared length, 1/ℓ², joint cosines; updates the running
+    minima of the leg-length margin and of both cosines with their legs (first leg on ties)."""
     bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
     ox, oy, oz = px - model[A + 3 * k], py - model[A + 3 * k + 1], pz - model[A + 3 * k + 2]
     jax, jay, jaz = model[JA + 3 * k], model[JA + 3 * k + 1], model[JA + 3 * k + 2]
     jbx, jby, jbz = model[JB + 3 * k], model[JB + 3 * k + 1], model[JB + 3 * k + 2]
     lmin, lmax, kf = model[LMIN + k], model[LMAX + k], float(k)
     for n in range(count):
-        r00, r01, r02 = (
-            work[_R * BLOCK + n],
-            work[(_R + 1) * BLOCK + n],
-            work[(_R + 2) * BLOCK + n],
-        )
-        r10, r11, r12 = (
-            work[(_R + 3) * BLOCK + n],
-            work[(_R + 4) * BLOCK + n],
-            work[(_R + 5) * BLOCK + n],
-        )
-        r20, r21, r22 = (
-            work[(_R + 6) * BLOCK + n],
-            work[(_R + 7) * BLOCK + n],
-            work[(_R + 8) * BLOCK + n],
-        )
+        r00, r01, r02 = rotation[n], rotation[BLOCK + n], rotation[2 * BLOCK + n]
+        r10, r11, r12 = rotation[3 * BLOCK + n], rotation[4 * BLOCK + n], rotation[5 * BLOCK + n]
+        r20, r21, r22 = rotation[6 * BLOCK + n], rotation[7 * BLOCK + n], rotation[8 * BLOCK + n]
         x = (r00 * bx + r01 * by + r02 * bz) + ox
         y = (r10 * bx + r11 * by + r12 * bz) + oy
         z = (r20 * bx + r21 * by + r22 * bz) + oz
-        work[(_LX + k) * BLOCK + n] = x
-        work[(_LY + k) * BLOCK + n] = y
-        work[(_LZ + k) * BLOCK + n] = z
+        leg[_LX * BLOCK + n] = x
+        leg[_LY * BLOCK + n] = y
+        leg[_LZ * BLOCK + n] = z
         squared = x * x + y * y + z * z
-        work[(_SQ + k) * BLOCK + n] = squared
+        leg[_SQ * BLOCK + n] = squared
         length = math.sqrt(squared)
         inverse = 1.0 / length
-        work[(_INV + k) * BLOCK + n] = inverse * inverse
+        leg[_INV * BLOCK + n] = inverse * inverse
         value = min(length - lmin, lmax - length)
-        # Running minimum and its leg, written so that the loop vectorises (one select
-        # per statement): the first leg wins ties.
-        smallest = work[_M_LEN * BLOCK + n]
-        work[_LEG_LEN * BLOCK + n] = kf if value < smallest else work[_LEG_LEN * BLOCK + n]
-        work[_M_LEN * BLOCK + n] = min(value, smallest)
+        # Running minimum and its leg, one select per statement (so that the loop vectorises).
+        smallest = minima[_M_LEN * BLOCK + n]
+        minima[_LEG_LEN * BLOCK + n] = kf if value < smallest else minima[_LEG_LEN * BLOCK + n]
+        minima[_M_LEN * BLOCK + n] = min(value, smallest)
         cos_a = (jax * x + jay * y + jaz * z) * inverse
         cos_b = (
             (r00 * jbx + r01 * jby + r02 * jbz) * x
             + (r10 * jbx + r11 * jby + r12 * jbz) * y
             + (r20 * jbx + r21 * jby + r22 * jbz) * z
         ) * -inverse
-        work[(_COS_A + k) * BLOCK + n] = cos_a
-        work[(_COS_B + k) * BLOCK + n] = cos_b
-        smallest = work[_M_A * BLOCK + n]
-        work[_LEG_A * BLOCK + n] = kf if cos_a < smallest else work[_LEG_A * BLOCK + n]
-        work[_M_A * BLOCK + n] = min(cos_a, smallest)
-        smallest = work[_M_B * BLOCK + n]
-        work[_LEG_B * BLOCK + n] = kf if cos_b < smallest else work[_LEG_B * BLOCK + n]
-        work[_M_B * BLOCK + n] = min(cos_b, smallest)
-        work[_FIX * BLOCK + n] = max(work[_FIX * BLOCK + n], 0.0 if squared > 1e-300 else 1.0)
+        leg[_COS_A * BLOCK + n] = cos_a
+        leg[_COS_B * BLOCK + n] = cos_b
+        smallest = minima[_M_A * BLOCK + n]
+        minima[_LEG_A * BLOCK + n] = kf if cos_a < smallest else minima[_LEG_A * BLOCK + n]
+        minima[_M_A * BLOCK + n] = min(cos_a, smallest)
+        smallest = minima[_M_B * BLOCK + n]
+        minima[_LEG_B * BLOCK + n] = kf if cos_b < smallest else minima[_LEG_B * BLOCK + n]
+        minima[_M_B * BLOCK + n] = min(cos_b, smallest)
+        degenerate = 0.0 if squared > 1e-300 else 1.0
+        minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], degenerate)
 
 
-@numba.njit(inline="always")
-def _pair_plane(model, work, count, pair, i, j):
-    """Segment distance of legs i < j (pair index ``pair``) over a block, running minimum and
-    its pair; flags parallel or point-like legs for the exact path. Literal arguments, as in
-    :func:`_leg_planes`."""
+@_jit
+def _pair_plane(model, leg_i, leg_j, minima, count, pair):
+    """Segment distance of two legs (pair index ``pair``) over a block (Ericson's clamped
+    closest points, as the reference); updates the running minimum and its pair (first pair on
+    ties) and flags parallel or point-like legs for the exact path."""
     rx = model[RPAIR + 3 * pair]
     ry = model[RPAIR + 3 * pair + 1]
     rz = model[RPAIR + 3 * pair + 2]
     rr, pf = model[RR + pair], float(pair)
     for n in range(count):
-        xi, yi, zi, a = (
-            work[(_LX + i) * BLOCK + n],
-            work[(_LY + i) * BLOCK + n],
-            work[(_LZ + i) * BLOCK + n],
-            work[(_SQ + i) * BLOCK + n],
-        )
-        xj, yj, zj, e = (
-            work[(_LX + j) * BLOCK + n],
-            work[(_LY + j) * BLOCK + n],
-            work[(_LZ + j) * BLOCK + n],
-            work[(_SQ + j) * BLOCK + n],
-        )
+        xi, yi, zi = leg_i[_LX * BLOCK + n], leg_i[_LY * BLOCK + n], leg_i[_LZ * BLOCK + n]
+        xj, yj, zj = leg_j[_LX * BLOCK + n], leg_j[_LY * BLOCK + n], leg_j[_LZ * BLOCK + n]
+        a, e = leg_i[_SQ * BLOCK + n], leg_j[_SQ * BLOCK + n]
         b = xi * xj + yi * yj + zi * zj
         c = xi * rx + yi * ry + zi * rz
         f = xj * rx + yj * ry + zj * rz
         denom = a * e - b * b
         s = min(max((b * f - c * e) / denom, 0.0), 1.0)
-        t = min(max((b * s + f) * work[(_INV + j) * BLOCK + n], 0.0), 1.0)
-        s = min(max((b * t - c) * work[(_INV + i) * BLOCK + n], 0.0), 1.0)
+        t = min(max((b * s + f) * leg_j[_INV * BLOCK + n], 0.0), 1.0)
+        s = min(max((b * t - c) * leg_i[_INV * BLOCK + n], 0.0), 1.0)
         squared = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
         distance = math.sqrt(max(squared, 0.0))
-        smallest = work[_BEST * BLOCK + n]
-        work[_PAIR * BLOCK + n] = pf if distance < smallest else work[_PAIR * BLOCK + n]
-        work[_BEST * BLOCK + n] = min(distance, smallest)
+        smallest = minima[_BEST * BLOCK + n]
+        minima[_PAIR * BLOCK + n] = pf if distance < smallest else minima[_PAIR * BLOCK + n]
+        minima[_BEST * BLOCK + n] = min(distance, smallest)
         regular = 0.0 if denom > 1e-14 * a * e else 1.0
-        work[_FIX * BLOCK + n] = max(work[_FIX * BLOCK + n], regular)
+        minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], regular)
 
 
 @_jit
@@ -586,15 +565,15 @@ def _check_block(model, angles, position, first, count, work, scratch, out, r):
         work[_SB * BLOCK + n], work[_CB * BLOCK + n] = _sincos(theta)
         work[_SG * BLOCK + n], work[_CG * BLOCK + n] = _sincos(gamma)
         largest = max(abs(phi), abs(theta), abs(gamma))
-        work[_FIX * BLOCK + n] = 1.0 if largest > FAST_TRIG_LIMIT else 0.0
-        work[_M_LEN * BLOCK + n] = np.inf
-        work[_M_A * BLOCK + n] = np.inf
-        work[_M_B * BLOCK + n] = np.inf
-        work[_LEG_LEN * BLOCK + n] = 0.0
-        work[_LEG_A * BLOCK + n] = 0.0
-        work[_LEG_B * BLOCK + n] = 0.0
-        work[_BEST * BLOCK + n] = np.inf
-        work[_PAIR * BLOCK + n] = 0.0
+        work[(_MIN + _FIX) * BLOCK + n] = 1.0 if largest > FAST_TRIG_LIMIT else 0.0
+        work[(_MIN + _M_LEN) * BLOCK + n] = np.inf
+        work[(_MIN + _M_A) * BLOCK + n] = np.inf
+        work[(_MIN + _M_B) * BLOCK + n] = np.inf
+        work[(_MIN + _LEG_LEN) * BLOCK + n] = 0.0
+        work[(_MIN + _LEG_A) * BLOCK + n] = 0.0
+        work[(_MIN + _LEG_B) * BLOCK + n] = 0.0
+        work[(_MIN + _BEST) * BLOCK + n] = np.inf
+        work[(_MIN + _PAIR) * BLOCK + n] = 0.0
     for n in range(count):
         ca, sa = work[_CA * BLOCK + n], work[_SA * BLOCK + n]
         cb, sb = work[_CB * BLOCK + n], work[_SB * BLOCK + n]
@@ -608,63 +587,52 @@ def _check_block(model, angles, position, first, count, work, scratch, out, r):
         work[(_R + 6) * BLOCK + n] = -sb * cg
         work[(_R + 7) * BLOCK + n] = sb * sg
         work[(_R + 8) * BLOCK + n] = cb
-    _leg_planes(model, work, count, 0, px, py, pz)
-    _leg_planes(model, work, count, 1, px, py, pz)
-    _leg_planes(model, work, count, 2, px, py, pz)
-    _leg_planes(model, work, count, 3, px, py, pz)
-    _leg_planes(model, work, count, 4, px, py, pz)
-    _leg_planes(model, work, count, 5, px, py, pz)
+    rotation = _planes(work, _R, 9)
+    minima = _planes(work, _MIN, 9)
+    for k in range(6):
+        _leg_planes(model, rotation, _planes(work, _LEGS + 7 * k, 7), minima, count, k, px, py, pz)
     interference = model[INTERFERENCE] != 0.0
     if interference:
-        # Pairs in index order (the first pair wins ties, as in the reference).
-        _pair_plane(model, work, count, 0, 0, 1)
-        _pair_plane(model, work, count, 1, 0, 2)
-        _pair_plane(model, work, count, 2, 0, 3)
-        _pair_plane(model, work, count, 3, 0, 4)
-        _pair_plane(model, work, count, 4, 0, 5)
-        _pair_plane(model, work, count, 5, 1, 2)
-        _pair_plane(model, work, count, 6, 1, 3)
-        _pair_plane(model, work, count, 7, 1, 4)
-        _pair_plane(model, work, count, 8, 1, 5)
-        _pair_plane(model, work, count, 9, 2, 3)
-        _pair_plane(model, work, count, 10, 2, 4)
-        _pair_plane(model, work, count, 11, 2, 5)
-        _pair_plane(model, work, count, 12, 3, 4)
-        _pair_plane(model, work, count, 13, 3, 5)
-        _pair_plane(model, work, count, 14, 4, 5)
+        pair = 0
+        for i in range(5):  # pairs in index order: the first pair wins ties, as the reference
+            for j in range(i + 1, 6):
+                leg_i = _planes(work, _LEGS + 7 * i, 7)
+                leg_j = _planes(work, _LEGS + 7 * j, 7)
+                _pair_plane(model, leg_i, leg_j, minima, count, pair)
+                pair += 1
     # Per pose: the joint-angle margins (arccos), the rare poses that need care, the outputs.
     alpha_equal = model[ALPHA_EQUAL] != 0.0
     beta_equal = model[BETA_EQUAL] != 0.0
     for n in range(count):
-        if work[_FIX * BLOCK + n] != 0.0:
+        if work[(_MIN + _FIX) * BLOCK + n] != 0.0:
             _tt_matrix(angles[first + n, 0], angles[first + n, 1], angles[first + n, 2], r)
             _pose(model, r, px, py, pz, scratch, out, True)
             for slot in range(OUT_SHORTEST):
                 work[(slot) * BLOCK + n] = out[slot]
             continue
-        work[(0) * BLOCK + n] = work[_M_LEN * BLOCK + n]
-        work[OUT_LEG * BLOCK + n] = work[_LEG_LEN * BLOCK + n]
+        work[(0) * BLOCK + n] = work[(_MIN + _M_LEN) * BLOCK + n]
+        work[OUT_LEG * BLOCK + n] = work[(_MIN + _LEG_LEN) * BLOCK + n]
         if alpha_equal:
             work[(1) * BLOCK + n] = model[ALPHA] - math.acos(
-                min(max(work[_M_A * BLOCK + n], -1.0), 1.0)
+                min(max(work[(_MIN + _M_A) * BLOCK + n], -1.0), 1.0)
             )
-            work[(OUT_LEG + 1) * BLOCK + n] = work[_LEG_A * BLOCK + n]
+            work[(OUT_LEG + 1) * BLOCK + n] = work[(_MIN + _LEG_A) * BLOCK + n]
         else:
             work[(1) * BLOCK + n], work[(OUT_LEG + 1) * BLOCK + n] = _per_leg_angle(
                 model, ALPHA, work, _COS_A, n
             )
         if beta_equal:
             work[(2) * BLOCK + n] = model[BETA] - math.acos(
-                min(max(work[_M_B * BLOCK + n], -1.0), 1.0)
+                min(max(work[(_MIN + _M_B) * BLOCK + n], -1.0), 1.0)
             )
-            work[(OUT_LEG + 2) * BLOCK + n] = work[_LEG_B * BLOCK + n]
+            work[(OUT_LEG + 2) * BLOCK + n] = work[(_MIN + _LEG_B) * BLOCK + n]
         else:
             work[(2) * BLOCK + n], work[(OUT_LEG + 2) * BLOCK + n] = _per_leg_angle(
                 model, BETA, work, _COS_B, n
             )
         if interference:
-            pair = int(work[_PAIR * BLOCK + n])
-            work[(3) * BLOCK + n] = work[_BEST * BLOCK + n] - model[DIAMETER]
+            pair = int(work[(_MIN + _PAIR) * BLOCK + n])
+            work[(3) * BLOCK + n] = work[(_MIN + _BEST) * BLOCK + n] - model[DIAMETER]
             work[(OUT_LEG + 3) * BLOCK + n] = PAIR_I[pair]
             work[OUT_PAIR * BLOCK + n] = PAIR_I[pair]
             work[(OUT_PAIR + 1) * BLOCK + n] = PAIR_J[pair]
@@ -677,11 +645,13 @@ def _check_block(model, angles, position, first, count, work, scratch, out, r):
 
 @_jit
 def _per_leg_angle(model, limits, work, row, n):
-    """min_i (limit_i − arccos(cos_i)) and its leg, for per-leg joint limits."""
+    """min_i (limit_i − arccos(cos_i)) and its leg, for per-leg joint limits (``row`` is the
+    cosine row within each leg's planes)."""
     best = np.inf
     leg = 0.0
     for k in range(6):
-        value = model[limits + k] - math.acos(min(max(work[(row + k) * BLOCK + n], -1.0), 1.0))
+        cosine = work[(_LEGS + 7 * k + row) * BLOCK + n]
+        value = model[limits + k] - math.acos(min(max(cosine, -1.0), 1.0))
         if value < best:
             best = value
             leg = float(k)
@@ -690,17 +660,32 @@ def _per_leg_angle(model, limits, work, row, n):
 
 # ------------------------------------------------------------------------------ batches
 @_jit
-def check_angles(
-    model, angles, position, start, stop, margins, legs, pairs, limiting, limiting_leg, reachable
-):
+def check_angles(model, angles, position, start, stop, margins, ints, pairs, reachable):
     """Check poses ``angles[start:stop]`` (N, 3) of T&T angles (rad) at ``position`` (3,), m.
 
-    Writes, for each pose n in [start, stop): ``margins[:, n]`` (4, N); ``legs[:, n]`` (4, N),
-    the 1-based leg with the smallest margin of each constraint; ``pairs[n]`` (N, 2), the
-    1-based closest pair; ``limiting[n]``, the constraint with the smallest relative margin;
-    ``limiting_leg[n]``, its leg; ``reachable[n]``. Legs and pairs of ``leg_interference`` are
-    0 when the check is disabled. Releases the GIL (threads split large batches).
+    Writes, for each pose n in [start, stop): ``margins[:, n]`` (4, N); ``ints[:4, n]`` (6, N),
+    the 1-based leg with the smallest margin of each constraint, ``ints[4, n]`` the constraint
+    with the smallest relative margin and ``ints[5, n]`` its leg; ``pairs[n]`` (N, 2), the
+    1-based closest pair; ``reachable[n]``. Legs and pairs of ``leg_interference`` are 0 when
+    the check is disabled. Releases the GIL (threads split large batches).
+
+    Returns
+    -------
+    int
+        −1 when every input is finite (and the outputs are written); otherwise nothing is
+        written and it is the first pose in [start, stop) with a non-finite angle, or −2 when
+        the angles are finite and the position is not.
     """
+    for n in range(start, stop):
+        if not (
+            math.isfinite(angles[n, 0])
+            and math.isfinite(angles[n, 1])
+            and math.isfinite(angles[n, 2])
+        ):
+            return n
+    for k in range(3):
+        if not math.isfinite(position[k]):
+            return -2
     scratch = np.empty((5, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
@@ -711,19 +696,43 @@ def check_angles(
         _check_block(model, angles, position, first, count, work, scratch, out, r)
         for m in range(count):
             n = first + m
-            for c in range(3):
-                margins[c, n] = work[(c) * BLOCK + m]
-                legs[c, n] = int(work[(OUT_LEG + c) * BLOCK + m]) + 1
-            margins[3, n] = work[(3) * BLOCK + m]
-            legs[3, n] = (int(work[(OUT_LEG + 3) * BLOCK + m]) + 1) * enabled
+            for c in range(4):
+                out[c] = work[c * BLOCK + m]
+                margins[c, n] = out[c]
+                ints[c, n] = int(work[(OUT_LEG + c) * BLOCK + m]) + 1
+            ints[3, n] *= enabled
             pairs[n, 0] = (int(work[OUT_PAIR * BLOCK + m]) + 1) * enabled
             pairs[n, 1] = (int(work[(OUT_PAIR + 1) * BLOCK + m]) + 1) * enabled
-            for slot in range(4):
-                out[slot] = work[slot * BLOCK + m]
             worst = _limiting_constraint(model, out)
-            limiting[n] = worst
-            limiting_leg[n] = legs[worst, n]
+            ints[4, n] = worst
+            ints[5, n] = ints[worst, n]
             reachable[n] = _feasible(out)
+    return -1
+
+
+@_jit
+def check_one(model, phi, theta, psi, px, py, pz, result):
+    """One pose (φ, θ, ψ) rad at (px, py, pz) m, finite; the fast path of constraints.check_pose.
+
+    Writes ``result`` (12,): margins (4), 1-based limiting legs (4; the interference leg 0 when
+    the check is disabled), closest pair (2, 1-based; 0 when disabled), the limiting constraint
+    and its leg.
+    """
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    _tt_matrix(phi, theta, psi, r)
+    _pose(model, r, px, py, pz, scratch, out, True)
+    enabled = 1.0 if model[INTERFERENCE] != 0.0 else 0.0
+    for c in range(4):
+        result[c] = out[c]
+        result[4 + c] = out[OUT_LEG + c] + 1.0
+    result[7] *= enabled
+    result[8] = (out[OUT_PAIR] + 1.0) * enabled
+    result[9] = (out[OUT_PAIR + 1] + 1.0) * enabled
+    worst = _limiting_constraint(model, out)
+    result[10] = worst
+    result[11] = result[4 + worst]
 
 
 @_jit
@@ -749,21 +758,6 @@ def margins_rotations(model, rotations, positions, interference, margins, legs, 
             legs[c, n] = int(out[OUT_LEG + c])
         pairs[n, 0] = int(out[OUT_PAIR])
         pairs[n, 1] = int(out[OUT_PAIR + 1])
-
-
-@_jit
-def margins_angles(model, angles, position, margins):
-    """The four margins (4, N) of poses ``angles`` (N, 3) of T&T angles (rad) at position (3,)."""
-    work = np.empty(_BLOCK_ROWS * BLOCK)
-    scratch = np.empty((5, 6))
-    out = np.empty(OUT_SIZE)
-    r = np.empty(9)
-    for first in range(0, angles.shape[0], BLOCK):
-        size = min(BLOCK, angles.shape[0] - first)
-        _check_block(model, angles, position, first, size, work, scratch, out, r)
-        for m in range(size):
-            for c in range(4):
-                margins[c, first + m] = work[c * BLOCK + m]
 
 
 # ------------------------------------------------------------------------------ ray searches
@@ -1069,7 +1063,7 @@ def torsion_scan(model, position, phi, theta, min_step, max_step, tolerance, edg
 
 # ------------------------------------------------------------------------------ compilation
 def _kernels() -> list:
-    return [check_angles, margins_rotations, margins_angles, search_rays, torsion_scan]
+    return [check_angles, check_one, margins_rotations, search_rays, torsion_scan]
 
 
 def cache_is_warm() -> bool:
@@ -1117,14 +1111,12 @@ def warm_up() -> float:
         0,
         1,
         margins,
-        legs,
+        np.empty((6, 1), dtype=np.int64),
         pairs,
-        np.empty(1, dtype=np.int64),
-        np.empty(1, dtype=np.int64),
         np.empty(1, dtype=np.bool_),
     )
+    check_one(model, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, np.empty(12))
     margins_rotations(model, np.eye(3)[None], position[None], True, margins, legs, pairs)
-    margins_angles(model, angles, position, margins)
     ones = np.ones(1)
     search_rays(
         model,

@@ -123,9 +123,20 @@ class RaySearch:
     def margins(self, angles: NDArray[np.float64]) -> NDArray[np.float64]:
         """The four margins of poses (n, 3) at the search position; shape (4, n)."""
         angles = np.ascontiguousarray(angles, dtype=np.float64)
-        margins = np.empty((4, angles.shape[0]))
-        kernels.margins_angles(self.model, angles, self.position, margins)
-        self.evaluations += angles.shape[0]
+        count = angles.shape[0]
+        margins = np.empty((4, count))
+        kernels.check_angles(
+            self.model,
+            angles,
+            self.position,
+            0,
+            count,
+            margins,
+            np.empty((6, count), dtype=np.int64),
+            np.empty((count, 2), dtype=np.int64),
+            np.empty(count, dtype=np.bool_),
+        )
+        self.evaluations += count
         return margins
 
     def rays(
