@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 
 from .. import __version__
 from .._resources import example_config_path
+from ..core import kernels
 from ..core.constraints import CONSTRAINT_NAMES, CheckResult, check
 from ..core.manipulator import Manipulator
 from ..core.orientation import OrientationWorkspace, orientation_workspace, torsion_range
@@ -699,7 +700,8 @@ def main(argv: Sequence[str] | None = None, *, out: TextIO | None = None) -> int
     try:
         options = parser.parse_args(argv)
         handler: Callable[[argparse.Namespace, TextIO], int] = options.handler
-        return handler(options, out)
+        with kernels.compile_notice(lambda message: print(f"{PROG}: {message}", file=sys.stderr)):
+            return handler(options, out)
     except (CliError, HexapodWorkspaceError) as error:
         reason = " ".join(str(error).split())
         print(f"{PROG}: error: {reason}", file=sys.stderr)

@@ -20,11 +20,13 @@ compile; :func:`warm_up` compiles (or loads) every kernel and returns the second
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import sys
 import tempfile
 import time
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -33,6 +35,7 @@ from numpy.typing import NDArray
 __all__ = [
     "CACHE_DIRECTORY",
     "cache_is_warm",
+    "compile_notice",
     "model_vector",
     "warm_up",
 ]
@@ -77,6 +80,7 @@ if CACHE_DIRECTORY is not None and "numba" in sys.modules:
         numba.core.config.CACHE_DIR = os.environ["NUMBA_CACHE_DIR"]
 
 import numba  # noqa: E402
+import numba.core.event  # noqa: E402
 
 _CACHE = CACHE_DIRECTORY is not None
 
@@ -1137,3 +1141,36 @@ def warm_up() -> float:
         model, position, 0.0, 0.0, 1e-3, 0.25, 1e-3, np.empty(8), np.empty(8, dtype=np.bool_)
     )
     return time.perf_counter() - started
+
+
+class _CompileAnnouncer(numba.core.event.Listener):
+    """Calls ``announce`` once, when the first kernel of this module starts compiling."""
+
+    def __init__(self, announce: Callable[[str], None]) -> None:
+        self.announce = announce
+        self.announced = False
+
+    def on_start(self, event: numba.core.event.Event) -> None:
+        dispatcher = (event.data or {}).get("dispatcher")
+        function = getattr(dispatcher, "py_func", None)
+        if self.announced or getattr(function, "__module__", None) != __name__:
+            return
+        self.announced = True
+        where = CACHE_DIRECTORY if CACHE_DIRECTORY is not None else "nowhere writable: not cached"
+        self.announce(
+            f"compiling the numerical kernels, once after install (about 10 s; cache: {where})"
+        )
+
+    def on_end(self, event: numba.core.event.Event) -> None:
+        """Nothing to do when a compilation ends."""
+
+
+@contextlib.contextmanager
+def compile_notice(announce: Callable[[str], None]) -> Iterator[None]:
+    """While active, ``announce(message)`` is called once if a kernel has to be compiled.
+
+    Loading compiled kernels from the cache says nothing; only a real compilation (the first
+    run after install, or after an upgrade) does. For the CLI's one line on stderr.
+    """
+    with numba.core.event.install_listener("numba:compile", _CompileAnnouncer(announce)):
+        yield
