@@ -50,7 +50,10 @@ setup(
         (f"share/{PACKAGE}/launch", glob("launch/*.py")),
     ],
     install_requires=[
+        # Lower bounds a ROS 2 Jazzy user on Ubuntu 24.04 meets with apt (python3-numpy 1.26,
+        # python3-numba 0.59); tested against those in a venv (see README, Benchmarks).
         "numpy>=1.24",
+        "numba>=0.59",
         "PyYAML>=5.4",
         "matplotlib>=3.6",
         "mcap>=1.6",

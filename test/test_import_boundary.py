@@ -1,4 +1,4 @@
-"""The core must import without ROS: numpy and the standard library only."""
+"""The core must import without ROS: numpy, numba and the standard library only."""
 
 from __future__ import annotations
 
