@@ -387,7 +387,8 @@ def orientation_workspace(
     slices = lower[:0:-1] + upper
     areas = np.array([piece.area() for piece in slices])
     psis = np.array([piece.psi for piece in slices])
-    volume = float(np.trapezoid(areas, psis)) if len(slices) > 1 else 0.0
+    # Trapezoid rule written out: numpy.trapezoid needs numpy >= 2 (Ubuntu 24.04 has 1.26).
+    volume = float(np.sum(0.5 * (areas[1:] + areas[:-1]) * np.diff(psis)))
     # Cones from the end slices to the extreme torsions (area shrinking to zero).
     volume += 0.5 * areas[-1] * (psi_max - psis[-1]) + 0.5 * areas[0] * (psis[0] - psi_min)
     if progress:
