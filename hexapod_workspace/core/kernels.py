@@ -86,8 +86,14 @@ _CACHE = CACHE_DIRECTORY is not None
 
 
 def _jit(function):
-    """Compile in nopython mode, release the GIL, cache on disk."""
+    """An entry point: nopython mode, releases the GIL, cached on disk (with its callees)."""
     return numba.njit(cache=_CACHE, nogil=True, error_model="numpy")(function)
+
+
+def _helper(function):
+    """A function only kernels call: compiled into them, so not cached on its own (a process
+    that loads the kernels from the cache then never touches it)."""
+    return numba.njit(nogil=True, error_model="numpy")(function)
 
 
 # ------------------------------------------------------------------------------ model layout
@@ -196,7 +202,7 @@ OUT_SHORTEST = 10  # shortest leg length, m
 OUT_SIZE = 11
 
 
-@_jit
+@_helper
 def _clamp01(value):
     """Clamp to [0, 1]; NaN stays NaN."""
     if value < 0.0:
@@ -206,7 +212,7 @@ def _clamp01(value):
     return value
 
 
-@_jit
+@_helper
 def _pose(model, r, px, py, pz, scratch, out, want_pair):
     """Margins of one pose into ``out`` (OUT_SIZE,).
 
@@ -405,7 +411,7 @@ def _sincos(x):
     return sin_value, cos_value
 
 
-@_jit
+@_helper
 def _tt_matrix(phi, theta, psi, r):
     """R(φ, θ, ψ) = Rz(φ)·Ry(θ)·Rz(ψ − φ) into r (9,), row-major (as rotations.tt_to_matrix)."""
     gamma = psi - phi
@@ -428,7 +434,7 @@ def _tt_matrix(phi, theta, psi, r):
     r[8] = cb
 
 
-@_jit
+@_helper
 def _limiting_constraint(model, out):
     """Index of the smallest relative margin (first on ties; NaN wins)."""
     best = out[0] / model[SCALE]
@@ -441,7 +447,7 @@ def _limiting_constraint(model, out):
     return index
 
 
-@_jit
+@_helper
 def _feasible(out):
     """Every margin ≥ 0 (NaN counts as violated)."""
     return out[0] >= 0.0 and out[1] >= 0.0 and out[2] >= 0.0 and out[3] >= 0.0
@@ -463,7 +469,7 @@ _M_LEN, _LEG_LEN, _M_A, _LEG_A, _M_B, _LEG_B, _BEST, _PAIR, _FIX = range(9)
 _LX, _LY, _LZ, _SQ, _INV, _COS_A, _COS_B = range(7)
 
 
-@_jit
+@_helper
 def _planes(work, row, rows):
     """The planes [row, row + rows) of a block scratch, as one flat view."""
     return work[row * BLOCK : (row + rows) * BLOCK]
@@ -471,7 +477,7 @@ def _planes(work, row, rows):
 
 # The leg and pair stages take their planes as separate views with constant row offsets inside:
 # the compiler then needs only a few run-time overlap checks between views, and vectorises.
-@_jit
+@_helper
 def _leg_planes(model, rotation, leg, minima, count, k, px, py, pz):
     """Leg k over a block: vector, squared length, 1/ℓ², joint cosines; updates the running
     minima of the leg-length margin and of both cosines with their legs (first leg on ties)."""
@@ -518,7 +524,7 @@ def _leg_planes(model, rotation, leg, minima, count, k, px, py, pz):
         minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], degenerate)
 
 
-@_jit
+@_helper
 def _pair_plane(model, leg_i, leg_j, minima, count, pair):
     """Segment distance of two legs (pair index ``pair``) over a block (Ericson's clamped
     closest points, as the reference); updates the running minimum and its pair (first pair on
@@ -547,7 +553,7 @@ def _pair_plane(model, leg_i, leg_j, minima, count, pair):
         minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], regular)
 
 
-@_jit
+@_helper
 def _check_block(model, angles, position, first, count, work, scratch, out, r):
     """Margins of poses angles[first : first + count] (count ≤ BLOCK) into ``work`` planes.
 
@@ -647,7 +653,7 @@ def _check_block(model, angles, position, first, count, work, scratch, out, r):
             work[(OUT_PAIR + 1) * BLOCK + n] = 0.0
 
 
-@_jit
+@_helper
 def _per_leg_angle(model, limits, work, row, n):
     """min_i (limit_i − arccos(cos_i)) and its leg, for per-leg joint limits (``row`` is the
     cosine row within each leg's planes)."""
@@ -765,7 +771,7 @@ def margins_rotations(model, rotations, positions, interference, margins, legs, 
 
 
 # ------------------------------------------------------------------------------ ray searches
-@_jit
+@_helper
 def _ray_angles(kind, origin, direction, s, angles, row):
     """T&T angles of the ray origin + s·direction (KIND_TT or KIND_CYLINDRICAL) into angles[row]."""
     if kind == KIND_TT:
@@ -781,7 +787,7 @@ def _ray_angles(kind, origin, direction, s, angles, row):
         angles[row, 2] = origin[2] + s * direction[2]
 
 
-@_jit
+@_helper
 def _estimate(model, out):
     """Signed distance estimate min_c m_c / L_c with fixed Lipschitz constants, rad (NaN wins)."""
     rho = model[RHO]
@@ -793,7 +799,7 @@ def _estimate(model, out):
     return best
 
 
-@_jit
+@_helper
 def _fmin(a, b):
     """numpy.fmin: the smaller, ignoring a NaN."""
     if a != a:
@@ -803,7 +809,7 @@ def _fmin(a, b):
     return a if a < b else b
 
 
-@_jit
+@_helper
 def certified_step(model, out):
     """Length over which no margin can reach zero, from feasible margins (core.search)."""
     rho = model[RHO]
@@ -820,7 +826,7 @@ def certified_step(model, out):
     return step * SAFETY
 
 
-@_jit
+@_helper
 def recovery_step(model, out):
     """Length over which a violated pose stays violated (core.search.RaySearch.recovery_step)."""
     rho = model[RHO]
