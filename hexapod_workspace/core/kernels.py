@@ -5,6 +5,11 @@ disk (``cache=True``): the margins of :mod:`hexapod_workspace.core.constraints` 
 section 2) and the certified march + secant/bisection of :mod:`hexapod_workspace.core.search`
 along whole families of rays, so that a search pays no per-call overhead per step.
 
+Batches are evaluated 128 poses at a time as planes of one flat array, stage by stage
+(:func:`_check_block`), so that every loop vectorises; single poses and the rare poses that need
+care go through the scalar :func:`_pose`. Both follow the numpy reference of
+``test/reference.py`` operation by operation: margins agree to rounding.
+
 The model of a manipulator is packed into one float64 vector (:func:`model_vector`, offsets
 below): the kernels take a handful of arrays, which keeps numba's dispatch cheap (a few
 microseconds per call).
@@ -217,10 +222,10 @@ def _pose(model, r, px, py, pz, scratch, out, want_pair):
     """Margins of one pose into ``out`` (OUT_SIZE,).
 
     ``r`` (9,) is the rotation matrix row-major, (px, py, pz) the position (m), ``scratch``
-    (5, 6) working memory (leg vector planes and squared lengths). Follows
-    constraints._ChunkModel of the numpy reference operation by operation, so margins agree to
-    rounding: the smallest margin of each constraint and its leg (first one on ties; NaN, a
-    zero-length leg, wins), the closest pair by Ericson's clamped closest points.
+    (5, 6) working memory (leg vector planes and squared lengths). Follows the numpy reference
+    (test/reference.py, BatchedMargins) operation by operation, so margins agree to rounding:
+    the smallest margin of each constraint and its leg (first one on ties; NaN, a zero-length
+    leg, wins), the closest pair by Ericson's clamped closest points.
     ``want_pair`` False skips the interference check (margin +inf).
     """
     lx = scratch[0]
@@ -559,8 +564,9 @@ def _check_block(model, angles, position, first, count, work, scratch, out, r):
 
     Every stage is a loop over the poses of the block without branches, which the compiler
     vectorises; poses that need care (a zero-length leg, parallel or point-like legs, huge
-    angles) are flagged in the _FIX row and recomputed one by one by :func:`_pose` with libm's
-    sin and cos. Leaves in ``work``: margins in rows 0..3, legs in 4..7, pair in 8..9 (as floats).
+    angles) are flagged in the _FIX row and recomputed one by one by :func:`_pose` (with libm's
+    sin and cos for huge angles). Leaves in ``work``: margins in rows 0..3, legs in 4..7, pair
+    in 8..9 (as floats).
     """
     px, py, pz = position[0], position[1], position[2]
     for n in range(count):  # strided reads: a loop of its own (it does not vectorise)
@@ -828,7 +834,9 @@ def certified_step(model, out):
 
 @_helper
 def recovery_step(model, out):
-    """Length over which a violated pose stays violated (core.search.RaySearch.recovery_step)."""
+    """Length over which a violated pose stays violated: the most violated constraint, in
+    Lipschitz units, cannot climb back to zero within |m_c| / L_c; joint-angle bounds use half
+    the current shortest leg, and the step keeps every leg at least that long."""
     rho = model[RHO]
     floor = 0.5 * out[OUT_SHORTEST]
     recover = 0.0
