@@ -16,6 +16,7 @@ from .core.orientation import (
     orientation_workspace,
     torsion_range,
 )
+from .core.paths import PathCheck, TorsionPlan, check_path, plan_torsion
 from .core.projected import ProjectedWorkspace, projected_workspace
 from .errors import (
     ConfigError,
@@ -42,13 +43,17 @@ __all__ = [
     "Manipulator",
     "OrientationSlice",
     "OrientationWorkspace",
+    "PathCheck",
     "ProjectedWorkspace",
     "RecordingError",
     "ResolutionError",
+    "TorsionPlan",
     "TorsionRange",
     "UnreachableReferenceError",
     "check",
+    "check_path",
     "orientation_workspace",
+    "plan_torsion",
     "projected_workspace",
     "torsion_range",
 ]
