@@ -200,7 +200,9 @@ def test_orientation_forms_agree(example, rng):
     by_rotations = check_path(example, positions, rotations=rotations)
     for other in (by_quaternions, by_rotations):
         np.testing.assert_array_equal(other.segments.ok, by_angles.segments.ok)
-        np.testing.assert_allclose(other.waypoints.margins, by_angles.waypoints.margins, atol=1e-12)
+        np.testing.assert_allclose(
+            other.waypoints.margin_array, by_angles.waypoints.margin_array, atol=1e-12
+        )
     # Waypoint results equal the pose check at each position.
     for k in range(0, count, 7):
         single = check(example, angles[k], positions[k])
@@ -214,7 +216,7 @@ def test_huge_angles_are_reduced_before_combining(example):
     reduced = wrap_angle(huge)
     a = check_path(example, positions, angles=huge)
     b = check_path(example, positions, angles=reduced)
-    np.testing.assert_array_equal(a.waypoints.margins, b.waypoints.margins)
+    np.testing.assert_array_equal(a.waypoints.margin_array, b.waypoints.margin_array)
     np.testing.assert_array_equal(a.segments.ok, b.segments.ok)
 
 

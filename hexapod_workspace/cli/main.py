@@ -28,6 +28,7 @@ from ..core.manipulator import Manipulator
 from ..core.orientation import OrientationWorkspace, orientation_workspace, torsion_range
 from ..core.projected import ProjectedWorkspace, projected_workspace
 from ..errors import HexapodWorkspaceError, InputError, UnreachableReferenceError
+from .check_path import add_check_path_command
 
 __all__ = ["main", "read_poses_file"]
 
@@ -650,6 +651,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub.add_argument("--tol-deg", type=float, metavar="T", help="boundary tolerance, degrees")
     sub.set_defaults(handler=cmd_torsion_range)
+
+    add_check_path_command(commands, _add_global_options)
 
     sub = commands.add_parser(
         "replay",

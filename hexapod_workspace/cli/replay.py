@@ -21,6 +21,7 @@ import numpy as np
 
 from hexapod_workspace.errors import LogReadError
 from hexapod_workspace.logs import messages
+from hexapod_workspace.logs.paths import path_call_fields, path_call_line, path_call_report
 from hexapod_workspace.logs.recording import (
     RESULT_QOS,
     SERVICE_QOS,
@@ -51,6 +52,8 @@ _WORKSPACE_RESPONSE = "hexapod_workspace_msgs/srv/ComputeWorkspace_Response"
 _CHECK_REQUEST = "hexapod_workspace_msgs/srv/CheckPoses_Request"
 _CHECK_RESPONSE = "hexapod_workspace_msgs/srv/CheckPoses_Response"
 _TRIGGER_RESPONSE = "std_srvs/srv/Trigger_Response"
+_PATH_REQUEST = "hexapod_workspace_msgs/srv/CheckPath_Request"
+_PATH_RESPONSE = "hexapod_workspace_msgs/srv/CheckPath_Response"
 _DISCOVERY = "ROS_AUTOMATIC_DISCOVERY_RANGE"
 
 
@@ -110,6 +113,7 @@ class LogSummary:
     checks: list[PoseCheckCall] = field(default_factory=list)
     reachability: list[dict[str, Any]] = field(default_factory=list)
     triggers: list[dict[str, Any]] = field(default_factory=list)
+    paths: list[dict[str, Any]] = field(default_factory=list)
     decoded: int = 0
 
 
@@ -195,6 +199,8 @@ def summarize_log(
             fields = message_to_fields(item.message)
             fields["log_time_ns"] = item.log_time_ns
             summary.reachability.append(fields)
+        elif msgtype in (_PATH_REQUEST, _PATH_RESPONSE):
+            path_call_fields(summary.paths, item.topic, item.log_time_ns, item.message)
         elif msgtype == _TRIGGER_RESPONSE:
             fields = message_to_fields(item.message)
             fields.update(topic=item.topic, log_time_ns=item.log_time_ns)
@@ -299,6 +305,9 @@ def _report(summary: LogSummary) -> dict[str, Any]:
             "unreachable": sum(bool(r["success"] and not r["check"]["reachable"]) for r in reach),
             "invalid": sum(not r["success"] for r in reach),
         },
+        "path_checks": [
+            path_call_report(i + 1, call, start) for i, call in enumerate(summary.paths)
+        ],
         "trigger_calls": [
             {
                 "topic": t["topic"],
@@ -360,6 +369,10 @@ def _print_text(report: dict[str, Any], out: IO[str]) -> None:
             f"reachability results: {reach['count']} ({reach['reachable']} reachable, "
             f"{reach['unreachable']} unreachable, {reach['invalid']} invalid)\n"
         )
+    if report["path_checks"]:
+        out.write(f"path checks: {len(report['path_checks'])}\n")
+        for call in report["path_checks"]:
+            out.write(f"  {path_call_line(call)}\n")
     for call in report["trigger_calls"]:
         out.write(
             f"  trigger {call['topic']} +{call['time_s']:.3f} s: "

@@ -172,9 +172,9 @@ class WaypointChecks:
     angles : ndarray, shape (N, 3)
         (φ, θ, ψ) in rad, canonical ranges.
     reachable : ndarray, shape (N,), bool
-    margins : ndarray, shape (4, N)
-        Signed margins in :data:`CONSTRAINT_NAMES` order (m, rad, rad, m; +inf when the
-        interference check is disabled).
+    margins : dict of str to ndarray, shape (N,)
+        Signed margin of each constraint (keys :data:`CONSTRAINT_NAMES`; m, rad, rad, m; +inf
+        when the interference check is disabled), as in :class:`CheckResult`.
     relative : ndarray, shape (N,)
         Smallest relative margin (dimensionless, see :func:`relative_margins`).
     limiting_constraint : ndarray, shape (N,), int
@@ -188,7 +188,7 @@ class WaypointChecks:
     positions: NDArray[np.float64]
     angles: NDArray[np.float64]
     reachable: NDArray[np.bool_]
-    margins: NDArray[np.float64]
+    margins: dict[str, NDArray[np.float64]]
     relative: NDArray[np.float64]
     limiting_constraint: NDArray[np.int64]
     limiting_leg: NDArray[np.int64]
@@ -198,9 +198,14 @@ class WaypointChecks:
         return int(self.reachable.shape[0])
 
     @property
+    def margin_array(self) -> NDArray[np.float64]:
+        """The margins as one array, shape (4, N), rows in :data:`CONSTRAINT_NAMES` order."""
+        return np.stack([self.margins[name] for name in CONSTRAINT_NAMES])
+
+    @property
     def violated(self) -> list[list[str]]:
         """Per waypoint, the names of the violated constraints."""
-        return violated_names(self.margins)
+        return violated_names(self.margin_array)
 
 
 @dataclass(frozen=True)
@@ -775,7 +780,7 @@ def _waypoint_checks(
         positions=positions,
         angles=matrix_to_tt(rotations),
         reachable=found.reachable,
-        margins=found.margins,
+        margins={name: found.margins[k] for k, name in enumerate(CONSTRAINT_NAMES)},
         relative=certifier.relative(found.margins),
         limiting_constraint=limiting,
         limiting_leg=found.limiting_legs[limiting, columns] + 1,
