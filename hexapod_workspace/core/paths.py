@@ -1199,9 +1199,10 @@ class _Planner:
         """The plan (ψ per waypoint, rad), its objective and the break point (without a plan)."""
         while True:
             best = int(self._forward(optimistic=False)[-1].max())
+            # Optimistic bottleneck of the best path through each move (recomputed after every
+            # batch: the checks lower it, and that is what prunes the remaining moves).
             forward = self._forward(optimistic=True)
             backward = self._backward()
-            # Optimistic bottleneck of the best path through each move.
             through = np.minimum(forward[:-1, :, None], self.value)
             np.minimum(through, backward[1:][:, self.dest], out=through)
             relevant = (self.status == _UNKNOWN) & (through > best)
