@@ -79,8 +79,10 @@ grid of step ``psi_step`` over (−π, π]. Objective, lexicographic:
    rounded down to levels of ``margin_resolution`` (0.005 by default): a bottleneck (max-min)
    dynamic programme over waypoints × grid, exact on the grid for these levels, so the plan's
    margin is within one level of the best grid plan;
-2. among the plans reaching that optimum, minimise the total torsion travel Σ|Δψ| (a min-sum
-   programme over the known moves at that level), so the profile does not zigzag.
+2. among the plans reaching that optimum, maximise the sum of the moves' certified margins (in
+   levels), so the margin stays high where the bottleneck does not bind;
+3. then minimise the total torsion travel Σ|Δψ|, so the profile does not zigzag between equal
+   choices. (2 and 3 are one min-sum programme over the known moves at the optimum's level.)
 
 A move between two grid torsions counts when its certified check is ok (tolerance ``tol``) and,
 with ``max_dpsi``, when ``|wrap(ψ_{k+1} − ψ_k)| ≤ max_dpsi``. Moves certified by their end
@@ -1174,7 +1176,8 @@ class _Planner:
         return back
 
     def _check(self, k: NDArray, g: NDArray, b: NDArray) -> None:
-        """Full certified check of moves (k, g, b); updates status, value and stopped."""
+        """Full certified check of moves (k, g, b), sampled as :func:`check_path` samples them
+        (so a plan's re-check reproduces these bounds); updates status, value and stopped."""
         h = self.dest[g, b]
         moves = self._moves(k, g, h)
         raw = _check_moves(
@@ -1183,7 +1186,7 @@ class _Planner:
             self.margins[:, k, g],
             self.margins[:, k + 1, h],
             self.tolerance,
-            math.inf,
+            DEFAULT_MAX_SAMPLE_ANGLE,
         )
         self.moves_checked += k.size
         self.status[k, g, b] = np.where(raw.ok, _KNOWN, _NO)
@@ -1218,14 +1221,19 @@ class _Planner:
         return self._smoothest(best), best * self.resolution, None
 
     def _smoothest(self, best: int) -> NDArray[np.float64]:
-        """Min Σ|Δψ| over the known moves whose level reaches the objective; ψ (N,), rad."""
+        """Among the known moves whose level reaches the objective: the largest sum of move
+        levels, then the least torsion travel Σ|Δψ|; ψ (N,), rad."""
         size = self.grid_size
         columns = np.arange(self.offsets.size)
+        # cost = −Σ levels · scale + Σ|Δψ|: scale exceeds any total travel (N·π), so the sum of
+        # levels decides and the travel only breaks ties (exact in float64 for these sizes).
+        scale = float(self.status.shape[0] + 1) * 4.0
         cost = np.where(self.levels[0] >= best, 0.0, np.inf)
         back = []
         usable = (self.status == _KNOWN) & (self.value >= best)
+        step_cost = np.where(usable, -self.value.astype(np.float64) * scale, np.inf)
         for k in range(self.status.shape[0]):
-            total = np.where(usable[k], cost[:, None] + self.travel, np.inf)[self.source, columns]
+            total = (cost[:, None] + step_cost[k] + self.travel)[self.source, columns]
             choice = np.argmin(total, axis=1)  # offset index per target h
             cost = total[np.arange(size), choice]
             back.append(self.source[np.arange(size), choice])
