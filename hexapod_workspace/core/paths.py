@@ -136,6 +136,7 @@ __all__ = [
     "TorsionPlan",
     "WaypointChecks",
     "check_path",
+    "check_waypoints",
     "plan_torsion",
 ]
 
@@ -396,13 +397,13 @@ def violated_names(margins: NDArray[np.float64]) -> list[list[str]]:
 
 
 # ============================================================================ inputs
-def _validate_positions(positions: ArrayLike) -> NDArray[np.float64]:
+def _validate_positions(positions: ArrayLike, minimum: int = 2) -> NDArray[np.float64]:
     array = np.asarray(positions, dtype=np.float64)
     if array.ndim != 2 or array.shape[1] != 3:
         msg = f"positions: expected shape (N, 3) in m, got {array.shape}"
         raise InputError(msg)
-    if not 2 <= array.shape[0] <= MAX_WAYPOINTS:
-        msg = f"positions: expected 2 to {MAX_WAYPOINTS} waypoints, got {array.shape[0]}"
+    if not minimum <= array.shape[0] <= MAX_WAYPOINTS:
+        msg = f"positions: expected {minimum} to {MAX_WAYPOINTS} waypoints, got {array.shape[0]}"
         raise InputError(msg)
     bad = ~np.all(np.isfinite(array) & (np.abs(array) <= MAX_POSITION), axis=1)
     if np.any(bad):
@@ -789,6 +790,32 @@ def _waypoint_checks(
         limiting_pair=found.limiting_pairs + 1 if enabled else found.limiting_pairs,
     )
     return result, found
+
+
+def check_waypoints(
+    manipulator: Manipulator,
+    positions: ArrayLike,
+    *,
+    angles: ArrayLike | None = None,
+    quaternions: ArrayLike | None = None,
+    rotations: ArrayLike | None = None,
+) -> WaypointChecks:
+    """Check N poses, each at its own position (what ROS poses are), without the moves.
+
+    Parameters are those of :func:`check_path` (N ≥ 1).
+
+    Returns
+    -------
+    WaypointChecks
+
+    Raises
+    ------
+    InputError
+        As :func:`check_path`.
+    """
+    positions = _validate_positions(positions, minimum=1)
+    matrices = _orientations(positions.shape[0], angles, quaternions, rotations)
+    return _waypoint_checks(_Certifier(manipulator), positions, matrices)[0]
 
 
 def check_path(
