@@ -16,7 +16,7 @@ from .core.orientation import (
     orientation_workspace,
     torsion_range,
 )
-from .core.paths import PathCheck, TorsionPlan, check_path, plan_torsion
+from .core.paths import PathCheck, TorsionPlan, check_path, check_waypoints, plan_torsion
 from .core.projected import ProjectedWorkspace, projected_workspace
 from .errors import (
     ConfigError,
@@ -52,6 +52,7 @@ __all__ = [
     "UnreachableReferenceError",
     "check",
     "check_path",
+    "check_waypoints",
     "orientation_workspace",
     "plan_torsion",
     "projected_workspace",

@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 import pytest
+from path_support import random_large_moves
 
 from hexapod_workspace import InputError, check, check_path, plan_torsion
 from hexapod_workspace.core.constraints import inverse_kinematics, pose_margins
@@ -61,16 +62,7 @@ def dense_violations(manipulator, positions, angles, k, interpolation, samples):
 @pytest.fixture(scope="module")
 def random_moves(example):
     """Large random moves (±0.3 m, tilts to 30°) around the example's working volume."""
-    rng = np.random.default_rng(3)  # seed with both kinds of interior violation
-    count = 3000
-    positions = np.array([0.0, 0.0, -1.15]) + rng.uniform(-0.3, 0.3, (count, 3))
-    angles = np.column_stack(
-        [
-            rng.uniform(-np.pi, np.pi, count),
-            rng.uniform(0.0, np.radians(30.0), count),
-            rng.uniform(-0.6, 0.6, count),
-        ]
-    )
+    positions, angles = random_large_moves()
     results = {
         interpolation: check_path(example, positions, angles=angles, interpolation=interpolation)
         for interpolation in ("slerp", "tilt-torsion")
@@ -367,3 +359,14 @@ def test_no_plan_at_a_move_is_named_and_matches_brute_force(example):
 def test_plan_refuses_bad_axes(example, axes, match):
     with pytest.raises(InputError, match=match):
         plan_torsion(example, np.tile([0, 0, -1.3], (2, 1)), axes)
+
+
+def test_singular_ends_take_the_other_azimuth_and_keep_their_rotation():
+    from hexapod_workspace.core.paths import _align_singular
+
+    angles = np.array([[0.3, np.pi, 0.7], [0.2, 0.0, -0.4], [0.1, 0.5, 0.2]])
+    other = np.array([[1.1, 0.5, 0.0], [-2.0, 0.3, 0.1], [3.0, 0.4, 0.0]])
+    aligned = _align_singular(angles, other)
+    np.testing.assert_allclose(tt_to_matrix(aligned), tt_to_matrix(angles), atol=1e-14)
+    np.testing.assert_array_equal(aligned[:2, 0], other[:2, 0])
+    np.testing.assert_array_equal(aligned[2], angles[2])  # regular: unchanged

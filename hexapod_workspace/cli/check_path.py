@@ -292,11 +292,17 @@ def _text(result: PathCheck | TorsionPlan, document: dict[str, Any], out: TextIO
             out.write(f"  no plan: {plan.breakpoint.reason}\n")
     failing_w = [w for w in waypoints if not w["reachable"]]
     failing_s = [s for s in segments if not s["ok"]]
-    margins = [s["min_relative_margin"] for s in segments if s["ok"]]
+    sampled = [s["min_relative_margin"] for s in segments if s["ok"]]
+    bounds = [s["min_relative_margin_bound"] for s in segments if s["ok"]]
     out.write(
         f"  waypoints reachable: {len(waypoints) - len(failing_w)}/{len(waypoints)}; "
         f"moves ok: {len(segments) - len(failing_s)}/{len(segments)}"
-        + (f"; smallest relative margin on ok moves {min(margins):.3f}\n" if margins else "\n")
+        + (
+            f"; smallest relative margin on ok moves {min(sampled):.3f} sampled, "
+            f">= {min(bounds):.3f} certified\n"
+            if sampled
+            else "\n"
+        )
     )
     for w in failing_w[:10]:
         out.write(

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from path_support import random_large_moves
 from ros_support import require_ros
 
 require_ros()
@@ -195,16 +196,7 @@ def test_commanded_pose_is_checked_as_a_move_from_the_current_pose(client, model
 
 def interior_violation(model):
     """Two reachable poses whose straight move (slerp) leaves the workspace (seeded search)."""
-    rng = np.random.default_rng(3)
-    count = 3000
-    positions = np.array([0.0, 0.0, -1.15]) + rng.uniform(-0.3, 0.3, (count, 3))
-    angles = np.column_stack(
-        [
-            rng.uniform(-np.pi, np.pi, count),
-            rng.uniform(0.0, np.radians(30.0), count),
-            rng.uniform(-0.6, 0.6, count),
-        ]
-    )
+    positions, angles = random_large_moves()
     result = check_path(model, positions, angles=angles)
     ends = result.waypoints.reachable[:-1] & result.waypoints.reachable[1:]
     k = int(np.flatnonzero(ends & ~result.segments.ok)[0])
