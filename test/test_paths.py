@@ -348,6 +348,14 @@ def test_no_plan_at_a_move_is_named_and_matches_brute_force(example):
         assert tuple(index) in set(feasible_free)
 
 
+def test_huge_and_tiny_axes_keep_their_direction(example):
+    positions = np.tile([0.0, 0.0, -1.3], (3, 1))
+    axes = np.array([[0.0, 0.0, 1.0], [1e300, 0.0, 3e300], [1e-310, 0.0, 3e-310]])
+    plan = plan_torsion(example, positions, axes, psi_step=np.radians(30.0))
+    np.testing.assert_allclose(plan.directions[1], plan.directions[2], atol=1e-12)
+    np.testing.assert_allclose(plan.directions[1], [0.0, np.arctan2(1.0, 3.0)], atol=1e-12)
+
+
 @pytest.mark.parametrize(
     ("axes", "match"),
     [

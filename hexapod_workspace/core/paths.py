@@ -475,13 +475,16 @@ def _unit_rows(
     if array.shape != (count, width):
         msg = f"{name}: expected shape ({count}, {width}) of {what}, got {array.shape}"
         raise InputError(msg)
-    with np.errstate(over="ignore", invalid="ignore"):
-        norm = np.linalg.norm(array, axis=1)
-    row = _first_bad_row(np.isfinite(norm) & (norm > 1e-150))
+    # Scale each row by its largest component first: huge or tiny finite rows keep their
+    # direction instead of overflowing or underflowing in the norm.
+    with np.errstate(invalid="ignore"):
+        scale = np.max(np.abs(array), axis=1)
+    row = _first_bad_row(np.all(np.isfinite(array), axis=1) & (scale > 0.0))
     if row is not None:
         msg = f"{name}: expected finite non-zero values, waypoint {row} is {array[row].tolist()}"
         raise InputError(msg)
-    return array / norm[:, None]
+    scaled = array / scale[:, None]
+    return scaled / np.linalg.norm(scaled, axis=1, keepdims=True)
 
 
 def _validate_interpolation(interpolation: str) -> str:
