@@ -6,10 +6,13 @@ ROS-free core computed here from the same parameters file.
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
+from cli_support import run_cli
 from path_support import random_large_moves
+from recording_support import plain, read_with_mcap_ros2, read_with_rosbags
 from ros_support import require_ros
 
 require_ros()
@@ -201,3 +204,30 @@ def interior_violation(model):
     ends = result.waypoints.reachable[:-1] & result.waypoints.reachable[1:]
     k = int(np.flatnonzero(ends & ~result.segments.ok)[0])
     return positions[k], angles[k], positions[k + 1], angles[k + 1]
+
+
+def test_path_calls_are_recorded_and_replayed(client, workspace_node):
+    """Last in the module: stops the node (SIGINT finishes its log) and reads the log back."""
+    positions, t = cone(8)
+    angles = np.column_stack([t, np.full(8, np.radians(10.0)), np.zeros(8)])
+    request = CheckPath.Request(poses=ros_poses(positions, angles))
+    response = client.call(CheckPath, f"{NODE}/check_path", request)
+    assert response.success and response.ok
+    assert workspace_node.stop() == 0
+    logs = sorted(workspace_node.record_dir.glob("*.mcap"))
+    assert len(logs) == 1
+    for reader in (read_with_rosbags, read_with_mcap_ros2):
+        recorded = [
+            (topic, plain(message))
+            for topic, _, message in reader(logs[0])
+            if topic.startswith(f"{NODE}/check_path/")
+        ]
+        requests = [m for topic, m in recorded if topic.endswith("/request")]
+        responses = [m for topic, m in recorded if topic.endswith("/response")]
+        assert len(requests) == len(responses) >= 1
+        assert requests[-1] == plain(request)
+        assert responses[-1] == plain(response)
+    replay = run_cli("replay", str(logs[0]), "--json")
+    assert replay.returncode == 0, replay.stderr
+    calls = json.loads(replay.stdout)["path_checks"]
+    assert calls and calls[-1]["ok"] is True and calls[-1]["n_waypoints"] == 8
