@@ -90,6 +90,8 @@ from hexapod_workspace.logs import (
 )
 
 from .conversions import angles_from_orientations, position_from_point, to_message, type_name
+from .paths import attach as attach_paths
+from .paths import check_poses_from_poses, commanded_target
 from .worker import WorkspaceJob, WorkspaceWorker
 
 __all__ = ["NODE_NAME", "WorkspaceNode", "main"]
@@ -443,6 +445,9 @@ class WorkspaceNode(Node):
         self._model_names = [s.name for s in specs if s.name in _MODEL_DESCRIPTIONS]
         for spec in specs:
             self.declare_parameter(spec.name, spec.default, spec.descriptor())
+        # ~/check_path, Pose inputs and the current-pose parameter (hexapod_workspace.ros.paths)
+        self._paths = attach_paths(self, lambda: self._state.manipulator, self._recorder)
+        self._parameter_names += self._paths.parameter_names
         self._warn_unknown_overrides()
         self._state = _state_from(self._parameter_values(), self._model_names)
         self._warn_home_pose()
@@ -578,6 +583,8 @@ class WorkspaceNode(Node):
 
     # ------------------------------------------------------------------ pose checks
     def _check_response(self, state: _State, request: CheckPoses.Request) -> dict[str, Any]:
+        if len(request.poses):  # geometry_msgs/Pose form
+            return check_poses_from_poses(state.manipulator, request, state.settings.max_poses)
         count = len(request.orientations)
         if count == 0:
             reason = "orientations: expected at least one pose, got none"
@@ -613,8 +620,10 @@ class WorkspaceNode(Node):
     def _on_commanded_pose(self, command: CommandedPose) -> None:
         self._recorder.write(self._commanded_subscription.topic_name, command)
         state = self._state
-        position = position_from_point(command.position)
-        angles = angles_from_orientations([command.orientation])
+        try:
+            position, angles = commanded_target(command)  # T&T or geometry_msgs/Pose
+        except InputError:
+            position, angles = np.full(3, np.nan), np.full((1, 3), np.nan)
         common = {
             "position": position,
             "angles": angles[0],
@@ -625,6 +634,7 @@ class WorkspaceNode(Node):
         try:
             result = check(state.manipulator, angles, position)
             fields = messages.reachability_result_fields(result, **common)
+            fields = self._paths.with_motion(fields, state.manipulator, position, angles)
         except InputError as error:
             fields = messages.reachability_result_fields(None, message=str(error), **common)
         except Exception as error:
