@@ -1,6 +1,7 @@
 # Entry points for humans and CI. Everything runs in .venv (tools/venv.sh), created on demand.
 #   make demo   CLI demo (no ROS needed): venv with base requirements + the package
 #   make ros    colcon build of hexapod_workspace_msgs and hexapod_workspace (full venv)
+#   make lint   ruff (lint + format check) and mypy (config in pyproject.toml, strict on the core)
 #   make test   full venv + colcon build + ruff + Foxglove's npm libraries (npm ci, pinned by
 #               test/foxglove/package-lock.json) + the whole pytest suite over real DDS
 #   make clean  remove build/ install/ log/ demo_out/ (keeps .venv)
@@ -37,6 +38,7 @@ ros: venv-full
 lint: venv-full
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
+	$(VENV)/bin/mypy
 
 # npm ci only when the lock file changed; its output goes to log/npm_ci.out (shown on failure).
 $(FOXGLOVE)/node_modules/.package-lock.json: $(FOXGLOVE)/package.json $(FOXGLOVE)/package-lock.json

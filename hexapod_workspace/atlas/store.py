@@ -236,6 +236,7 @@ def check_resumable(path: Path, attrs: dict[str, Any]) -> None:
         msg = f"cannot resume {path}: not an atlas store ({error})"
         raise AtlasError(msg) from error
     for key, value in attrs.items():
+        old: Any
         if key == "chunk_shape":
             value, old = list(value), list(stored.get(key, []))
         else:

@@ -12,11 +12,15 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from ..core.atlas import AtlasGrid
+
+if TYPE_CHECKING:
+    from matplotlib.artist import Artist
+    from mpl_toolkits.mplot3d import Axes3D
 
 __all__ = ["plot_atlas", "plot_dexterous_3d", "plot_tilt_slices"]
 
@@ -40,7 +44,7 @@ def plot_tilt_slices(
     from matplotlib.patches import Patch, Rectangle
 
     capability = np.degrees(dataset["tilt_capability"].values)  # (nx, ny, nz)
-    x, y, z = grid.x, grid.y, grid.z
+    x, y, z = grid.box_axes
     chosen = _slices(z.size)[::-1]  # top slice first (z up)
     columns = min(4, len(chosen))
     rows = -(-len(chosen) // columns)
@@ -95,7 +99,9 @@ def plot_tilt_slices(
     if image is not None:
         bar = figure.colorbar(image, ax=axes, shrink=0.9)
         bar.set_label("tilt capability [deg]")
-    handles = [Patch(facecolor="0.85", hatch="//", edgecolor="0.6", label="reference unreachable")]
+    handles: list[Artist] = [
+        Patch(facecolor="0.85", hatch="//", edgecolor="0.6", label="reference unreachable")
+    ]
     handles += [
         Line2D([], [], color=color, linewidth=1.6, label=f"θ_req = {level:g}°")
         for level, color in zip(tilts_deg, _LEVEL_COLORS, strict=False)
@@ -118,17 +124,15 @@ def plot_dexterous_3d(
     capability = np.degrees(dataset["tilt_capability"].values)
     reachable = dataset["reference_reachable"].values.astype(bool)
     step = grid.step or 1.0
-    edges = [
-        np.append(axis - 0.5 * step, axis[-1] + 0.5 * step) for axis in (grid.x, grid.y, grid.z)
-    ]
+    edges = [np.append(axis - 0.5 * step, axis[-1] + 0.5 * step) for axis in grid.box_axes]
     xe, ye, ze = np.meshgrid(*edges, indexing="ij")
     figure = Figure(figsize=(7.5, 6.8))
-    axis = figure.add_subplot(projection="3d")
+    axis = cast("Axes3D", figure.add_subplot(projection="3d"))
     colors = mpl.colormaps["plasma"](np.linspace(0.15, 0.85, max(1, len(tilts_deg))))
     handles = []
     levels = sorted(tilts_deg)
     # Cut away the quadrant facing the viewer (x > 0, y < 0) so that inner shells show.
-    xs, ys, _ = np.meshgrid(grid.x, grid.y, grid.z, indexing="ij")
+    xs, ys, _ = np.meshgrid(*grid.box_axes, indexing="ij")
     kept = ~((xs > 0.25 * step) & (ys < -0.25 * step))
     with np.errstate(invalid="ignore"):
         for index, level in enumerate(levels):

@@ -17,7 +17,7 @@ import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any, TextIO
+from typing import IO, TYPE_CHECKING, Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -36,6 +36,9 @@ from ..core.paths import (
 from ..core.rotations import matrix_to_quaternion, tt_to_matrix
 from ..errors import InputError
 from .inputs import PLOT_FORMATS, load_manipulator, output_file
+
+if TYPE_CHECKING:
+    from matplotlib.projections.polar import PolarAxes
 
 __all__ = [
     "CHECK_PATH_DESCRIPTION",
@@ -171,6 +174,19 @@ def _number(value: float) -> float | None:
     return float(value) if math.isfinite(value) else None
 
 
+def _reported(result: PathCheck | TorsionPlan) -> tuple[PathCheck, TorsionPlan | None]:
+    """The path a result reports (a plan that is ok: its path; otherwise the ψ = 0 baseline),
+    and the plan (None for a path check)."""
+    if isinstance(result, TorsionPlan):
+        return (result.path if result.ok and result.path is not None else result.baseline), result
+    return result, None
+
+
+def _no_plan_reason(plan: TorsionPlan) -> str:
+    """Why a plan that is not ok found no torsion (its break point says)."""
+    return plan.breakpoint.reason if plan.breakpoint is not None else "no break point recorded"
+
+
 def path_to_json(
     result: PathCheck | TorsionPlan,
     baseline: PathCheck,
@@ -187,8 +203,7 @@ def path_to_json(
     degrees : ndarray, shape (N, 3), optional
         The fixed orientations as the user wrote them (reported as given).
     """
-    plan = result if isinstance(result, TorsionPlan) else None
-    path = result if plan is None else (plan.path if plan.ok else plan.baseline)
+    path, plan = _reported(result)
     waypoints, segments = path.waypoints, path.segments
     angles_deg = np.degrees(waypoints.angles) if degrees is None else degrees
     violated = waypoints.violated
@@ -273,7 +288,7 @@ def psi_zero_baseline(manipulator: Manipulator, path: PathCheck) -> PathCheck:
 
 
 # ---------------------------------------------------------------------------- text
-def _text(result: PathCheck | TorsionPlan, document: dict[str, Any], out: TextIO) -> None:
+def _text(result: PathCheck | TorsionPlan, document: dict[str, Any], out: IO[str]) -> None:
     plan = result if isinstance(result, TorsionPlan) else None
     waypoints, segments = document["waypoints"], document["segments"]
     mode = "tool axes, torsion planned" if plan is not None else "fixed orientations"
@@ -282,7 +297,7 @@ def _text(result: PathCheck | TorsionPlan, document: dict[str, Any], out: TextIO
         f"{document['interpolation']}, tolerance {document['tolerance_deg']:.3g} deg\n"
     )
     if plan is not None:
-        if plan.ok:
+        if plan.ok and plan.psi is not None:
             psi = np.degrees(plan.psi)
             out.write(
                 f"  planned torsion: {psi.min():.1f} .. {psi.max():.1f} deg "
@@ -290,7 +305,7 @@ def _text(result: PathCheck | TorsionPlan, document: dict[str, Any], out: TextIO
                 f"margin {plan.objective:.3f}, {plan.elapsed:.2f} s\n"
             )
         else:
-            out.write(f"  no plan: {plan.breakpoint.reason}\n")
+            out.write(f"  no plan: {_no_plan_reason(plan)}\n")
     failing_w = [w for w in waypoints if not w["reachable"]]
     failing_s = [s for s in segments if not s["ok"]]
     sampled = [s["min_relative_margin"] for s in segments if s["ok"]]
@@ -327,7 +342,7 @@ def _text(result: PathCheck | TorsionPlan, document: dict[str, Any], out: TextIO
 def _where(document: dict[str, Any], result: PathCheck | TorsionPlan) -> str:
     """Where the path fails, one line for stderr."""
     if isinstance(result, TorsionPlan) and not result.ok:
-        return f"no torsion plan: {result.breakpoint.reason}"
+        return f"no torsion plan: {_no_plan_reason(result)}"
     waypoints = [w["index"] for w in document["waypoints"] if not w["reachable"]]
     moves = [s for s in document["segments"] if not s["ok"]]
     parts = []
@@ -366,8 +381,7 @@ def plot_path(
 
     from ..core.projected import projected_workspace
 
-    plan = result if isinstance(result, TorsionPlan) else None
-    checked = result if plan is None else (plan.path if plan.ok else plan.baseline)
+    checked, plan = _reported(result)
     waypoints = checked.waypoints
     count = len(waypoints)
     index = np.arange(count)
@@ -426,7 +440,7 @@ def plot_path(
     torsion_axes.legend(fontsize=7, loc="best")
     torsion_axes.grid(alpha=0.3)
 
-    polar = figure.add_subplot(grid[:, 1], projection="polar")
+    polar = cast("PolarAxes", figure.add_subplot(grid[:, 1], projection="polar"))
     center = waypoints.positions.mean(axis=0)
     at_center = manipulator.with_position(center)
     for method, color, style in (("torsion_zero", "tab:red", "--"), ("exact", "tab:green", "-")):
@@ -536,7 +550,7 @@ def cmd_check_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> i
     )
     psi_step = _radians(options.psi_step_deg, "--psi-step-deg")
     result: PathCheck | TorsionPlan
-    if waypoints.free_torsion:
+    if waypoints.axes is not None:  # free torsion
         result = plan_torsion(
             manipulator,
             waypoints.positions,
@@ -549,6 +563,7 @@ def cmd_check_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> i
         degrees = None
         orientation = np.column_stack([result.directions, np.zeros(len(waypoints.positions))])
     else:
+        assert waypoints.degrees is not None  # read_path_file gives axes or angles
         degrees = _principal_degrees(waypoints.degrees)
         orientation = np.radians(degrees)
         result = check_path(

@@ -132,7 +132,10 @@ def run_demo(
                 "tilt_max_deg": math.degrees(torsion_zero.tilt_max),
                 "exact_tilt_min_deg": math.degrees(exact.tilt_min),
                 "exact_tilt_max_deg": math.degrees(exact.tilt_max),
-                "torsion_zero_gap_max_deg": math.degrees(float(np.max(exact.gap))),
+                # The exact method always reports its gap to the torsion-zero boundary.
+                "torsion_zero_gap_max_deg": math.degrees(float(np.max(exact.gap)))
+                if exact.gap is not None
+                else math.nan,
                 "solid_angle_sr": torsion_zero.solid_angle,
                 "exact_solid_angle_sr": exact.solid_angle,
                 "psi_min_deg": math.degrees(solid.psi_min),

@@ -7,12 +7,12 @@ and radians. The core still checks everything again; this layer only re-phrases.
 
 from __future__ import annotations
 
-import io
 import math
 import re
 import sys
 import warnings
 from pathlib import Path
+from typing import IO
 
 import numpy as np
 from numpy.typing import NDArray
@@ -100,7 +100,7 @@ def poses_from_degrees(degrees: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def load_manipulator(
-    config: str | Path | None, position: NDArray[np.float64] | None, err: io.TextIOBase
+    config: str | Path | None, position: NDArray[np.float64] | None, err: IO[str]
 ) -> Manipulator:
     """The manipulator of ``--config`` (default: the packaged example), at ``--position``.
 

@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .. import __version__
 from ..core import kernels, resolution
@@ -170,7 +171,7 @@ def _check_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _check_run(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
-    parts = []
+    parts: list[NDArray[np.float64]] = []
     if options.pose:
         parts.append(finite(options.pose, "--pose", "degrees").reshape(-1, 3))
     if options.poses_file:

@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -24,9 +25,13 @@ from numpy.typing import NDArray
 from ..core.orientation import OrientationWorkspace
 from ..core.projected import ProjectedWorkspace
 
+if TYPE_CHECKING:
+    from matplotlib.projections.polar import PolarAxes
+    from mpl_toolkits.mplot3d import Axes3D
+
 __all__ = ["plot_orientation", "plot_projected"]
 
-_STYLE = {
+_STYLE: dict[str, dict[str, Any]] = {
     # exact underneath (wider, dashed), torsion_zero on top: both stay visible where they meet
     "exact": {"color": "tab:red", "linestyle": "--", "linewidth": 2.2, "zorder": 3},
     "torsion_zero": {"color": "tab:blue", "linestyle": "-", "linewidth": 1.4, "zorder": 4},
@@ -58,7 +63,7 @@ def _label_angle(curves: Sequence[tuple[NDArray, NDArray]], ticks: NDArray) -> f
     """The azimuth (deg) at which radial tick labels sit farthest from every curve (between
     the 45° spokes, so they never meet the azimuth labels either)."""
     candidates = np.arange(22.5, 360.0, 45.0)
-    clearance = [float(np.min(_curve_distances(curves, ticks, a))) for a in candidates]
+    clearance = [float(np.min(_curve_distances(curves, ticks, float(a)))) for a in candidates]
     return float(candidates[int(np.argmax(clearance))])
 
 
@@ -86,7 +91,7 @@ def plot_projected(
     from matplotlib.figure import Figure
 
     figure = Figure(figsize=(6.4, 6.8), layout="constrained")
-    axes = figure.add_subplot(projection="polar")
+    axes = cast("PolarAxes", figure.add_subplot(projection="polar"))
     curves = []
     largest = 0.0
     for workspace in workspaces:
@@ -110,9 +115,9 @@ def plot_projected(
     axes.set_rlabel_position(angle)
     # A label that would still sit on a curve is left out (its ring stays).
     crowded = _curve_distances(curves, ticks, angle) < 0.035 * top
-    for label, hidden in zip(axes.get_yticklabels(), crowded, strict=True):
-        label.set_visible(not hidden)
-        label.set_bbox({"facecolor": "white", "edgecolor": "none", "alpha": 0.8, "pad": 1.0})
+    for tick_label, hidden in zip(axes.get_yticklabels(), crowded, strict=True):
+        tick_label.set_visible(not hidden)
+        tick_label.set_bbox({"facecolor": "white", "edgecolor": "none", "alpha": 0.8, "pad": 1.0})
     axes.set_xticks(np.radians(np.arange(0, 360, 45)))
     axes.grid(True, linewidth=0.4)
     axes.set_title(
@@ -162,7 +167,7 @@ def plot_orientation(
 
     figure = Figure(figsize=(13.5, 5.8), layout="constrained")
     grid = figure.add_gridspec(1, 2, width_ratios=(1.0, 1.0))
-    surface_axes = figure.add_subplot(grid[0, 0], projection="3d")
+    surface_axes = cast("Axes3D", figure.add_subplot(grid[0, 0], projection="3d"))
     top_axes = figure.add_subplot(grid[0, 1])
     rings = [np.degrees(piece.xy()) for piece in workspace.slices]
     psi = np.degrees([piece.psi for piece in workspace.slices])

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import sys
-from typing import TextIO
+from typing import IO
 
 __all__ = ["ProgressBar"]
 
@@ -11,7 +11,7 @@ __all__ = ["ProgressBar"]
 class ProgressBar:
     """A one-line progress bar on stderr, drawn only when stderr is a terminal."""
 
-    def __init__(self, label: str, *, stream: TextIO | None = None) -> None:
+    def __init__(self, label: str, *, stream: IO[str] | None = None) -> None:
         self.stream = sys.stderr if stream is None else stream
         self.enabled = bool(getattr(self.stream, "isatty", lambda: False)())
         self.label = label

@@ -27,6 +27,9 @@ from .commands import PROG
 def _rebuild(record: WorkspaceRecord) -> Any:
     """Rebuild the core result dataclass from a recorded summary and boundary cloud."""
     summary, points = record.summary, record.points
+    if points is None:
+        msg = "no boundary points recorded"
+        raise ValueError(msg)
     position = np.array([summary["position"][k] for k in "xyz"])
     kind = int(summary["kind"])
     if kind == WorkspaceKind.ORIENTATION:

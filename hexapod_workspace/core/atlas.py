@@ -47,7 +47,8 @@ from ..errors import InputError
 from .constraints import check
 from .manipulator import Manipulator
 from .orientation import orientation_workspace, torsion_range
-from .projected import projected_workspace, validate_rays, validate_tolerance
+from .projected import projected_workspace
+from .resolution import validate_rays, validate_tolerance
 
 __all__ = [
     "ATLAS_VARIABLES",
@@ -123,12 +124,12 @@ class AtlasGrid:
     step: float | None = None
 
     @classmethod
-    def box(cls, bounds: Sequence[float], step: float) -> AtlasGrid:
+    def box(cls, bounds: ArrayLike, step: float) -> AtlasGrid:
         """Grid ``x0 + k·step`` (and likewise y, z) inside the box [x0, x1]×[y0, y1]×[z0, z1].
 
         Parameters
         ----------
-        bounds : sequence of 6 float
+        bounds : array_like, shape (6,)
             x0, x1, y0, y1, z0, z1, base frame, m; ``x0 <= x1`` and so on (equal ends give a
             single plane).
         step : float
@@ -172,6 +173,20 @@ class AtlasGrid:
     def is_box(self) -> bool:
         """Whether this is a box grid (dims x, y, z) rather than a list (dim position)."""
         return self.positions is None
+
+    @property
+    def box_axes(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """The grid planes (x, y, z) of a box grid, m, shapes (nx,), (ny,), (nz,).
+
+        Raises
+        ------
+        InputError
+            The grid is a list of explicit positions.
+        """
+        if self.x is None or self.y is None or self.z is None:
+            msg = "grid: explicit positions have no x, y, z grid planes"
+            raise InputError(msg)
+        return self.x, self.y, self.z
 
     @property
     def dims(self) -> tuple[str, ...]:
@@ -343,7 +358,9 @@ def positions_capability(
         msg = "positions: expected finite x, y, z in m"
         raise InputError(msg)
     names = [variable.name for variable in options.variables()]
-    columns = {name: np.full(positions.shape[0], np.nan) for name in names}
+    columns: dict[str, NDArray[np.float64]] = {
+        name: np.full(positions.shape[0], np.nan) for name in names
+    }
     for row, position in enumerate(positions):
         for name, value in position_capability(manipulator, position, options).items():
             columns[name][row] = value

@@ -250,7 +250,8 @@ class PoseMargins:
     @property
     def reachable(self) -> NDArray[np.bool_]:
         """Shape (N,): every margin ≥ 0."""
-        return np.all(self.margins >= 0.0, axis=0)
+        reachable: NDArray[np.bool_] = np.all(self.margins >= 0.0, axis=0)
+        return reachable
 
 
 def pose_margins(

@@ -33,9 +33,13 @@ import tempfile
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from .manipulator import Manipulator
 
 __all__ = [
     "CACHE_DIRECTORY",
@@ -89,16 +93,29 @@ import numba.core.event  # noqa: E402
 
 _CACHE = CACHE_DIRECTORY is not None
 
+# numba ships no type information: the decorators below are typed as returning the function they
+# compile, so that mypy checks the kernels' signatures at every call (the returned Dispatcher is
+# called exactly like the function).
+_F = TypeVar("_F", bound=Callable[..., Any])
 
-def _jit(function):
+
+def _jit(function: _F) -> _F:
     """An entry point: nopython mode, releases the GIL, cached on disk (with its callees)."""
-    return numba.njit(cache=_CACHE, nogil=True, error_model="numpy")(function)
+    compiled: _F = numba.njit(cache=_CACHE, nogil=True, error_model="numpy")(function)
+    return compiled
 
 
-def _helper(function):
+def _helper(function: _F) -> _F:
     """A function only kernels call: compiled into them, so not cached on its own (a process
     that loads the kernels from the cache then never touches it)."""
-    return numba.njit(nogil=True, error_model="numpy")(function)
+    compiled: _F = numba.njit(nogil=True, error_model="numpy")(function)
+    return compiled
+
+
+def _inline(function: _F) -> _F:
+    """A small helper inlined into its callers at the numba IR level."""
+    compiled: _F = numba.njit(inline="always")(function)
+    return compiled
 
 
 # ------------------------------------------------------------------------------ model layout
@@ -136,7 +153,7 @@ SAFETY = 1.0 - 1e-9
 KIND_TT, KIND_CYLINDRICAL = 0, 1
 
 
-def model_vector(manipulator) -> NDArray[np.float64]:
+def model_vector(manipulator: Manipulator) -> NDArray[np.float64]:
     """The packed model of a manipulator (cached on the immutable manipulator object).
 
     Parameters
@@ -148,7 +165,7 @@ def model_vector(manipulator) -> NDArray[np.float64]:
     ndarray, shape (MODEL_SIZE,)
         Read-only; layout given by the offsets of this module.
     """
-    cached = manipulator.__dict__.get("_kernel_model")
+    cached: NDArray[np.float64] | None = manipulator.__dict__.get("_kernel_model")
     if cached is not None:
         return cached
     model = np.zeros(MODEL_SIZE)
@@ -190,7 +207,12 @@ def model_vector(manipulator) -> NDArray[np.float64]:
     return model
 
 
-def _segment_distance_literal(p0, p1, q0, q1) -> float:
+def _segment_distance_literal(
+    p0: NDArray[np.float64],
+    p1: NDArray[np.float64],
+    q0: NDArray[np.float64],
+    q1: NDArray[np.float64],
+) -> float:
     """Segment distance by dense sampling of both (only to order the pairs; any estimate
     works there)."""
     s = np.linspace(0.0, 1.0, 65)[:, None]
@@ -208,7 +230,7 @@ OUT_SIZE = 11
 
 
 @_helper
-def _clamp01(value):
+def _clamp01(value: float) -> float:
     """Clamp to [0, 1]; NaN stays NaN."""
     if value < 0.0:
         return 0.0
@@ -218,7 +240,16 @@ def _clamp01(value):
 
 
 @_helper
-def _pose(model, r, px, py, pz, scratch, out, want_pair):
+def _pose(
+    model: NDArray[np.float64],
+    r: NDArray[np.float64],
+    px: float,
+    py: float,
+    pz: float,
+    scratch: NDArray[np.float64],
+    out: NDArray[np.float64],
+    want_pair: bool,
+) -> None:
     """Margins of one pose into ``out`` (OUT_SIZE,).
 
     ``r`` (9,) is the rotation matrix row-major, (px, py, pz) the position (m), ``scratch``
@@ -395,8 +426,8 @@ COS_3, COS_4, COS_5 = (
 )
 
 
-@numba.njit(inline="always")
-def _sincos(x):
+@_inline
+def _sincos(x: float) -> tuple[float, float]:
     """(sin x, cos x) for |x| ≤ FAST_TRIG_LIMIT, branch-free."""
     k = math.floor(x * TWO_OVER_PI + 0.5)
     r = ((x - k * PIO2_1) - k * PIO2_2) - k * PIO2_3
@@ -417,7 +448,7 @@ def _sincos(x):
 
 
 @_helper
-def _tt_matrix(phi, theta, psi, r):
+def _tt_matrix(phi: float, theta: float, psi: float, r: NDArray[np.float64]) -> None:
     """R(φ, θ, ψ) = Rz(φ)·Ry(θ)·Rz(ψ − φ) into r (9,), row-major (as rotations.tt_to_matrix).
 
     Huge angles are first reduced to their principal values (libm reduces exactly): ψ − φ of
@@ -448,7 +479,7 @@ def _tt_matrix(phi, theta, psi, r):
 
 
 @_helper
-def _limiting_constraint(model, out):
+def _limiting_constraint(model: NDArray[np.float64], out: NDArray[np.float64]) -> int:
     """Index of the smallest relative margin (first on ties; NaN wins)."""
     best = out[0] / model[SCALE]
     index = 0
@@ -461,9 +492,10 @@ def _limiting_constraint(model, out):
 
 
 @_helper
-def _feasible(out):
+def _feasible(out: NDArray[np.float64]) -> bool:
     """Every margin ≥ 0 (NaN counts as violated)."""
-    return out[0] >= 0.0 and out[1] >= 0.0 and out[2] >= 0.0 and out[3] >= 0.0
+    feasible: bool = out[0] >= 0.0 and out[1] >= 0.0 and out[2] >= 0.0 and out[3] >= 0.0
+    return feasible
 
 
 # ------------------------------------------------------------------------------ blocks of poses
@@ -483,7 +515,7 @@ _LX, _LY, _LZ, _SQ, _INV, _COS_A, _COS_B = range(7)
 
 
 @_helper
-def _planes(work, row, rows):
+def _planes(work: NDArray[np.float64], row: int, rows: int) -> NDArray[np.float64]:
     """The planes [row, row + rows) of a block scratch, as one flat view."""
     return work[row * BLOCK : (row + rows) * BLOCK]
 
@@ -491,7 +523,17 @@ def _planes(work, row, rows):
 # The leg and pair stages take their planes as separate views with constant row offsets inside:
 # the compiler then needs only a few run-time overlap checks between views, and vectorises.
 @_helper
-def _leg_planes(model, rotation, leg, minima, count, k, px, py, pz):
+def _leg_planes(
+    model: NDArray[np.float64],
+    rotation: NDArray[np.float64],
+    leg: NDArray[np.float64],
+    minima: NDArray[np.float64],
+    count: int,
+    k: int,
+    px: float,
+    py: float,
+    pz: float,
+) -> None:
     """Leg k over a block: vector, squared length, 1/ℓ², joint cosines; updates the running
     minima of the leg-length margin and of both cosines with their legs (first leg on ties)."""
     bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
@@ -538,7 +580,14 @@ def _leg_planes(model, rotation, leg, minima, count, k, px, py, pz):
 
 
 @_helper
-def _pair_plane(model, leg_i, leg_j, minima, count, pair):
+def _pair_plane(
+    model: NDArray[np.float64],
+    leg_i: NDArray[np.float64],
+    leg_j: NDArray[np.float64],
+    minima: NDArray[np.float64],
+    count: int,
+    pair: int,
+) -> None:
     """Segment distance of two legs (pair index ``pair``) over a block (Ericson's clamped
     closest points, as the reference); updates the running minimum and its pair (first pair on
     ties) and flags parallel or point-like legs for the exact path."""
@@ -567,7 +616,17 @@ def _pair_plane(model, leg_i, leg_j, minima, count, pair):
 
 
 @_helper
-def _check_block(model, angles, position, first, count, work, scratch, out, r):
+def _check_block(
+    model: NDArray[np.float64],
+    angles: NDArray[np.float64],
+    position: NDArray[np.float64],
+    first: int,
+    count: int,
+    work: NDArray[np.float64],
+    scratch: NDArray[np.float64],
+    out: NDArray[np.float64],
+    r: NDArray[np.float64],
+) -> None:
     """Margins of poses angles[first : first + count] (count ≤ BLOCK) into ``work`` planes.
 
     Every stage is a loop over the poses of the block without branches, which the compiler
@@ -668,7 +727,9 @@ def _check_block(model, angles, position, first, count, work, scratch, out, r):
 
 
 @_helper
-def _per_leg_angle(model, limits, work, row, n):
+def _per_leg_angle(
+    model: NDArray[np.float64], limits: int, work: NDArray[np.float64], row: int, n: int
+) -> tuple[float, float]:
     """min_i (limit_i − arccos(cos_i)) and its leg, for per-leg joint limits (``row`` is the
     cosine row within each leg's planes)."""
     best = np.inf
@@ -684,7 +745,17 @@ def _per_leg_angle(model, limits, work, row, n):
 
 # ------------------------------------------------------------------------------ batches
 @_jit
-def check_angles(model, angles, position, start, stop, margins, ints, pairs, reachable):
+def check_angles(
+    model: NDArray[np.float64],
+    angles: NDArray[np.float64],
+    position: NDArray[np.float64],
+    start: int,
+    stop: int,
+    margins: NDArray[np.float64],
+    ints: NDArray[np.int64],
+    pairs: NDArray[np.int64],
+    reachable: NDArray[np.bool_],
+) -> int:
     """Check poses ``angles[start:stop]`` (N, 3) of T&T angles (rad) at ``position`` (3,), m.
 
     Writes, for each pose n in [start, stop): ``margins[:, n]`` (4, N); ``ints[:4, n]`` (6, N),
@@ -735,7 +806,16 @@ def check_angles(model, angles, position, start, stop, margins, ints, pairs, rea
 
 
 @_jit
-def check_one(model, phi, theta, psi, px, py, pz, result):
+def check_one(
+    model: NDArray[np.float64],
+    phi: float,
+    theta: float,
+    psi: float,
+    px: float,
+    py: float,
+    pz: float,
+    result: NDArray[np.float64],
+) -> None:
     """One pose (φ, θ, ψ) rad at (px, py, pz) m, finite; the fast path of constraints.check_pose.
 
     Writes ``result`` (12,): margins (4), 1-based limiting legs (4; the interference leg 0 when
@@ -760,7 +840,15 @@ def check_one(model, phi, theta, psi, px, py, pz, result):
 
 
 @_jit
-def margins_rotations(model, rotations, positions, interference, margins, legs, pairs):
+def margins_rotations(
+    model: NDArray[np.float64],
+    rotations: NDArray[np.float64],
+    positions: NDArray[np.float64],
+    interference: bool,
+    margins: NDArray[np.float64],
+    legs: NDArray[np.int64],
+    pairs: NDArray[np.int64],
+) -> None:
     """Margins of N poses given as rotation matrices (N, 3, 3) at positions (M, 3), M ∈ {1, N}.
 
     Writes ``margins`` (4, N), ``legs`` (4, N) and ``pairs`` (N, 2) as :func:`check_angles`.
@@ -786,7 +874,14 @@ def margins_rotations(model, rotations, positions, interference, margins, legs, 
 
 # ------------------------------------------------------------------------------ ray searches
 @_helper
-def _ray_angles(kind, origin, direction, s, angles, row):
+def _ray_angles(
+    kind: int,
+    origin: NDArray[np.float64],
+    direction: NDArray[np.float64],
+    s: float,
+    angles: NDArray[np.float64],
+    row: int,
+) -> None:
     """T&T angles of the ray origin + s·direction (KIND_TT or KIND_CYLINDRICAL) into angles[row]."""
     if kind == KIND_TT:
         angles[row, 0] = origin[0] + s * direction[0]
@@ -802,11 +897,11 @@ def _ray_angles(kind, origin, direction, s, angles, row):
 
 
 @_helper
-def _estimate(model, out):
+def _estimate(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
     """Signed distance estimate min_c m_c / L_c with fixed Lipschitz constants, rad (NaN wins)."""
     rho = model[RHO]
     floor = model[ESTIMATE_FLOOR]
-    best = out[0] / rho
+    best: float = out[0] / rho
     for value in (out[1] / (rho / floor), out[2] / (1.0 + rho / floor), out[3] / (2.0 * rho)):
         if value < best or value != value:
             best = value
@@ -814,7 +909,7 @@ def _estimate(model, out):
 
 
 @_helper
-def _fmin(a, b):
+def _fmin(a: float, b: float) -> float:
     """numpy.fmin: the smaller, ignoring a NaN."""
     if a != a:
         return b
@@ -824,7 +919,7 @@ def _fmin(a, b):
 
 
 @_helper
-def certified_step(model, out):
+def certified_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
     """Length over which no margin can reach zero, from feasible margins (core.search)."""
     rho = model[RHO]
     length_min = model[LENGTH_FLOOR]
@@ -841,12 +936,12 @@ def certified_step(model, out):
 
 
 @_helper
-def recovery_step(model, out):
+def recovery_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
     """Length over which a violated pose stays violated: the most violated constraint, in
     Lipschitz units, cannot climb back to zero within |m_c| / L_c; joint-angle bounds use half
     the current shortest leg, and the step keeps every leg at least that long."""
-    rho = model[RHO]
-    floor = 0.5 * out[OUT_SHORTEST]
+    rho: float = model[RHO]
+    floor: float = 0.5 * out[OUT_SHORTEST]
     recover = 0.0
     bounds = (rho, rho / floor, 1.0 + rho / floor, 2.0 * rho)
     for c in range(4):
@@ -862,20 +957,20 @@ _MARCH, _GUESS, _PLUS, _DONE = 0, 1, 2, 3
 
 @_jit
 def search_rays(
-    model,
-    position,
-    kind,
-    origins,
-    directions,
-    s_start,
-    s_end,
-    tolerance,
-    min_step,
-    feasible,
-    violated,
-    limiting,
-    start_feasible,
-):
+    model: NDArray[np.float64],
+    position: NDArray[np.float64],
+    kind: int,
+    origins: NDArray[np.float64],
+    directions: NDArray[np.float64],
+    s_start: NDArray[np.float64],
+    s_end: NDArray[np.float64],
+    tolerance: float,
+    min_step: float,
+    feasible: NDArray[np.float64],
+    violated: NDArray[np.float64],
+    limiting: NDArray[np.int64],
+    start_feasible: NDArray[np.bool_],
+) -> int:
     """First violation along rays (the algorithm of core.search, all rays in lockstep).
 
     Each round takes the next probe of every unfinished ray and evaluates them together with
@@ -1015,7 +1110,17 @@ def search_rays(
 
 
 @_jit
-def torsion_scan(model, position, phi, theta, min_step, max_step, tolerance, edges, rising):
+def torsion_scan(
+    model: NDArray[np.float64],
+    position: NDArray[np.float64],
+    phi: float,
+    theta: float,
+    min_step: float,
+    max_step: float,
+    tolerance: float,
+    edges: NDArray[np.float64],
+    rising: NDArray[np.bool_],
+) -> tuple[int, bool]:
     """Feasible-torsion transitions over ψ ∈ [−π, π] for one tool direction (φ, θ).
 
     Scans with certified steps (recovery steps from violated samples), clipped to
@@ -1088,7 +1193,8 @@ def torsion_scan(model, position, phi, theta, min_step, max_step, tolerance, edg
 
 
 # ------------------------------------------------------------------------------ compilation
-def _kernels() -> list:
+def _kernels() -> list[Any]:
+    """The cached entry points, as numba Dispatchers (untyped: numba ships no stubs)."""
     return [check_angles, check_one, margins_rotations, search_rays, torsion_scan]
 
 
@@ -1165,10 +1271,10 @@ def warm_up() -> float:
     return time.perf_counter() - started
 
 
-class _CompileAnnouncer(numba.core.event.Listener):
+class _CompileAnnouncer(numba.core.event.Listener):  # type: ignore[misc]  # numba: no stubs
     """Calls ``announce`` once, when the first kernel of this module starts compiling."""
 
-    def __init__(self, announce: Callable[[str], None]) -> None:
+    def __init__(self, announce: Callable[[str], object]) -> None:
         self.announce = announce
         self.announced = False
 
@@ -1188,7 +1294,7 @@ class _CompileAnnouncer(numba.core.event.Listener):
 
 
 @contextlib.contextmanager
-def compile_notice(announce: Callable[[str], None]) -> Iterator[None]:
+def compile_notice(announce: Callable[[str], object]) -> Iterator[None]:
     """While active, ``announce(message)`` is called once if a kernel has to be compiled.
 
     Loading compiled kernels from the cache says nothing; only a real compilation (the first

@@ -113,7 +113,8 @@ def _axes(name: str, value: Any) -> NDArray[np.float64] | None:
     if zero.size:
         msg = f"{name}: expected non-zero axes, axis of joint {zero[0] + 1} is zero"
         raise GeometryError(msg)
-    return axes / norms[:, None]
+    unit: NDArray[np.float64] = axes / norms[:, None]
+    return unit
 
 
 def _frozen(array: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -187,17 +187,22 @@ def _polygon_area_centroid(xy: NDArray[np.float64]) -> tuple[float, NDArray[np.f
     return abs(area), np.array([cx, cy])
 
 
-def _xy_to_angles(x: NDArray, y: NDArray, psi: NDArray | float) -> NDArray[np.float64]:
+def _xy_to_angles(
+    x: NDArray[np.float64], y: NDArray[np.float64], psi: NDArray[np.float64] | float
+) -> NDArray[np.float64]:
     """T&T angles (n, 3) of cylindrical points (x, y) at torsion psi."""
     theta = np.hypot(x, y)
     phi = np.where(theta > 0.0, np.arctan2(y, x), 0.0)
     return np.column_stack([phi, theta, np.broadcast_to(psi, theta.shape)])
 
 
-def _ray_ends(center: NDArray[np.float64], directions: NDArray[np.float64]) -> NDArray:
+def _ray_ends(center: NDArray[np.float64], directions: NDArray[np.float64]) -> NDArray[np.float64]:
     """Parameter where each ray c + s·u leaves the disk θ ≤ π; shape (n,)."""
     cu = directions @ center
-    return -cu + np.sqrt(np.maximum(cu * cu - center @ center + math.pi**2, 0.0))
+    ends: NDArray[np.float64] = -cu + np.sqrt(
+        np.maximum(cu * cu - center @ center + math.pi**2, 0.0)
+    )
+    return ends
 
 
 # ---------------------------------------------------------------------------- the computation
@@ -242,9 +247,12 @@ class _Slicer:
             return None
         comfort = relative_margins(self.search.manipulator, margins).min(axis=0)
         comfort[~feasible] = -np.inf
-        return candidates[int(np.argmax(comfort))]
+        best: NDArray[np.float64] = candidates[int(np.argmax(comfort))]
+        return best
 
-    def torsion_limit(self, last: OrientationSlice, sign: float) -> tuple[float, NDArray]:
+    def torsion_limit(
+        self, last: OrientationSlice, sign: float
+    ) -> tuple[float, NDArray[np.float64]]:
         """ψmax (sign +1) or ψmin (−1) beyond the last non-empty slice, and where it is."""
         _, centroid = _polygon_area_centroid(last.xy())
         candidates = np.vstack([last.center, centroid, 0.5 * (last.xy() + centroid)])
@@ -344,7 +352,7 @@ def orientation_workspace(
     growing = {1.0: True, -1.0: True}
     limits: dict[float, tuple[float, NDArray[np.float64]]] = {}
     while any(growing.values()):
-        centers, psis, signs = [], [], []
+        centers, next_psis, signs = [], [], []
         for sign, stack in ((1.0, upper), (-1.0, lower)):
             if not growing[sign]:
                 continue
@@ -363,12 +371,12 @@ def orientation_workspace(
                     continue
                 center = point
             centers.append(center)
-            psis.append(psi)
+            next_psis.append(psi)
             signs.append(sign)
         if not centers:
             break
         for sign, piece in zip(
-            signs, slicer.slices(np.array(centers), np.array(psis)), strict=True
+            signs, slicer.slices(np.array(centers), np.array(next_psis)), strict=True
         ):
             (upper if sign > 0 else lower).append(piece)
         if progress:
@@ -443,8 +451,8 @@ def torsion_range(
         raise InputError(msg)
     search = RaySearch(manipulator, position)
     capacity = math.ceil(2.0 * math.pi / search.min_step) + 2
-    edges = np.empty(capacity)
-    rising = np.empty(capacity, dtype=np.bool_)
+    edges: NDArray[np.float64] = np.empty(capacity)
+    rising: NDArray[np.bool_] = np.empty(capacity, dtype=np.bool_)
     count, start_feasible = kernels.torsion_scan(
         search.model,
         search.position,

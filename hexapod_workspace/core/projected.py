@@ -226,7 +226,7 @@ def projected_workspace(
     search = RaySearch(manipulator, position)
     require_reachable_reference(search)
     phi = 2.0 * math.pi * np.arange(n_phi) / n_phi
-    zero = np.zeros(n_phi)
+    zero: NDArray[np.float64] = np.zeros(n_phi)
     theta_zero, limiting_zero = tilt_rays(search, phi, zero, tolerance)
     theta, psi, limiting = theta_zero, zero.copy(), limiting_zero
     gap = None
@@ -255,6 +255,11 @@ def projected_workspace(
         evaluations=search.evaluations,
         gap=gap,
     )
+
+
+#: Three arrays per azimuth: (theta, psi, limiting) of the best points of :func:`_exact` so far,
+#: or (psi, theta, limiting) of its trial points.
+_Triple = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]
 
 
 def _exact(
@@ -304,7 +309,7 @@ def _exact(
     high = grid[np.minimum(best + 1, grid.size - 1)]
     ratio = (math.sqrt(5.0) - 1.0) / 2.0
 
-    def keep_best(best: tuple, *trials: tuple) -> tuple:
+    def keep_best(best: _Triple, *trials: _Triple) -> _Triple:
         """(theta, psi, limiting) improved by trial points (psi, theta, limiting) where higher."""
         theta_best, psi_best, limit_best = best
         for candidate, value, limit in trials:

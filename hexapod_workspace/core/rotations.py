@@ -115,7 +115,8 @@ def degrees_to_radians(degrees: ArrayLike) -> NDArray[np.float64]:
     reduced = np.fmod(degrees, 360.0)  # exact
     reduced = np.where(reduced > 180.0, reduced - 360.0, reduced)  # exact (same binade or below)
     reduced = np.where(reduced < -180.0, reduced + 360.0, reduced)
-    return np.radians(np.where(np.abs(degrees) <= 180.0, degrees, reduced))
+    radians: NDArray[np.float64] = np.radians(np.where(np.abs(degrees) <= 180.0, degrees, reduced))
+    return radians
 
 
 def zyz_to_matrix(zyz: ArrayLike) -> NDArray[np.float64]:
@@ -375,7 +376,8 @@ def matrix_to_quaternion(matrix: ArrayLike) -> NDArray[np.float64]:
     )
     quaternion = np.take_along_axis(by_branch, choice[..., None, None], axis=-2)[..., 0, :]
     quaternion = np.where(quaternion[..., 3:4] < 0.0, -quaternion, quaternion)
-    return quaternion / np.linalg.norm(quaternion, axis=-1, keepdims=True)
+    unit: NDArray[np.float64] = quaternion / np.linalg.norm(quaternion, axis=-1, keepdims=True)
+    return unit
 
 
 def quaternion_to_tt(quaternion: ArrayLike) -> NDArray[np.float64]:
@@ -480,7 +482,8 @@ def quaternion_conjugate(quaternion: ArrayLike) -> NDArray[np.float64]:
     ndarray, shape (..., 4)
     """
     quaternion = _last_axis(quaternion, 4, "quaternion")
-    return quaternion * np.array([-1.0, -1.0, -1.0, 1.0])
+    conjugate: NDArray[np.float64] = quaternion * np.array([-1.0, -1.0, -1.0, 1.0])
+    return conjugate
 
 
 def quaternion_multiply(left: ArrayLike, right: ArrayLike) -> NDArray[np.float64]:
@@ -535,7 +538,8 @@ def quaternion_angle(first: ArrayLike, second: ArrayLike) -> NDArray[np.float64]
     second = np.where(dot[..., None] < 0.0, -second, second)
     difference = np.linalg.norm(first - second, axis=-1)
     total = np.linalg.norm(first + second, axis=-1)
-    return 4.0 * np.arctan2(difference, total)
+    angle: NDArray[np.float64] = 4.0 * np.arctan2(difference, total)
+    return angle
 
 
 def quaternion_slerp(first: ArrayLike, second: ArrayLike, s: ArrayLike) -> NDArray[np.float64]:
@@ -570,4 +574,5 @@ def quaternion_slerp(first: ArrayLike, second: ArrayLike, s: ArrayLike) -> NDArr
     weight_first = np.where(small, 1.0 - s, np.sin((1.0 - s) * half) / safe)
     weight_second = np.where(small, s, np.sin(s * half) / safe)
     result = weight_first * first + weight_second * second
-    return result / np.linalg.norm(result, axis=-1, keepdims=True)
+    unit: NDArray[np.float64] = result / np.linalg.norm(result, axis=-1, keepdims=True)
+    return unit

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
@@ -161,7 +161,26 @@ def pose_check_fields(result: CheckResult, index: int) -> dict[str, Any]:
     }
 
 
-def pose_checks_fields(result: CheckResult) -> list[dict[str, Any]]:
+class PoseChecks(Protocol):
+    """What the PoseCheck fields are read from: a :class:`CheckResult` (one position), or the
+    ``WaypointChecks`` of a path (one position per pose). Arrays have shape (N,)."""
+
+    @property
+    def reachable(self) -> NDArray[np.bool_]: ...
+
+    @property
+    def margins(self) -> Mapping[str, NDArray[np.float64]]: ...
+
+    @property
+    def limiting_leg(self) -> NDArray[np.int64]: ...
+
+    @property
+    def violated(self) -> list[list[str]]: ...
+
+    def __len__(self) -> int: ...
+
+
+def pose_checks_fields(result: PoseChecks) -> list[dict[str, Any]]:
     """PoseCheck dicts of every pose of a check result, in order."""
     violated = result.violated
     columns = {
@@ -207,7 +226,7 @@ def check_poses_request_fields(position: ArrayLike, angles: ArrayLike) -> dict[s
 
 
 def check_poses_response_fields(
-    result: CheckResult | None, *, success: bool = True, message: str | None = None
+    result: PoseChecks | None, *, success: bool = True, message: str | None = None
 ) -> dict[str, Any]:
     """hexapod_workspace_msgs/srv/CheckPoses_Response.
 

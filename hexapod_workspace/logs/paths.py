@@ -49,7 +49,9 @@ def pose_fields(position: ArrayLike, quaternion: ArrayLike) -> dict[str, Any]:
     }
 
 
-def _poses_fields(positions: NDArray, quaternions: NDArray) -> list[dict[str, Any]]:
+def _poses_fields(
+    positions: NDArray[np.float64], quaternions: NDArray[np.float64]
+) -> list[dict[str, Any]]:
     return [
         pose_fields(position, quaternion)
         for position, quaternion in zip(positions, quaternions, strict=True)
@@ -135,20 +137,20 @@ def segment_checks_fields(segments: SegmentChecks, *, pairs: bool = True) -> lis
 def segment_check_fields(segments: SegmentChecks, index: int = 0) -> dict[str, Any]:
     """PathSegmentCheck of move ``index`` (e.g. the single move of a commanded motion)."""
     window = slice(index, index + 1)
-    single = SegmentChecks(
-        **{
-            name: value
-            if not isinstance(value, np.ndarray)
-            else (value[:, window] if name == "violation_margins" else value[window])
-            for name, value in vars(segments).items()
-        }
-    )
+    fields: dict[str, Any] = {
+        name: value
+        if not isinstance(value, np.ndarray)
+        else (value[:, window] if name == "violation_margins" else value[window])
+        for name, value in vars(segments).items()
+    }
+    single = SegmentChecks(**fields)
     return segment_checks_fields(single)[0]
 
 
 def _result_parts(result: PathCheck | TorsionPlan) -> tuple[PathCheck, TorsionPlan | None]:
     if isinstance(result, TorsionPlan):
-        return (result.path if result.ok else result.baseline), result
+        # A plan that is ok carries its path; otherwise the ψ = 0 baseline is reported.
+        return (result.path if result.ok and result.path is not None else result.baseline), result
     return result, None
 
 
@@ -203,7 +205,7 @@ def failed_check_path_response_fields(reason: str) -> dict[str, Any]:
 def path_verdict(result: PathCheck | TorsionPlan) -> str:
     """One line: whether the path runs, else where it fails (or where no torsion continues)."""
     path, plan = _result_parts(result)
-    if plan is not None and not plan.ok:
+    if plan is not None and not plan.ok and plan.breakpoint is not None:
         return f"no torsion plan: {plan.breakpoint.reason}"
     count, moves = len(path.waypoints), len(path.segments)
     if path.ok:
@@ -237,7 +239,7 @@ def path_call_fields(
     A request opens a call; a response completes the oldest open call of its service (the
     n-th response answers the n-th request), or stands alone when its request was not recorded.
     """
-    from .recording import message_to_fields
+    from .fields import message_to_fields
 
     fields = message_to_fields(message)
     service = topic.rsplit("/", 1)[0]

@@ -170,8 +170,9 @@ def summarize_log(
             pending_requests.setdefault(_service_of(item.topic), []).append(call)
         elif msgtype == _CHECK_RESPONSE:
             queue = pending_requests.get(_service_of(item.topic), [])
-            call = queue.pop(0) if queue else None
-            if call is None:  # response without its request (log cut before it)
+            if queue:
+                call = queue.pop(0)
+            else:  # response without its request (log cut before it)
                 call = PoseCheckCall(item.log_time_ns, item.topic)
                 summary.checks.append(call)
             call.response = message_to_fields(item.message)

@@ -162,14 +162,13 @@ def _service_types(service_type: str, text: str) -> dict[str, Any]:
     }
     types: dict[str, Any] = {}
     for suffix, part in parts.items():
-        for name, (consts, fields, *rest) in get_types_from_msg(
-            part, f"{service_type}_{suffix}"
-        ).items():
+        for name, definition in get_types_from_msg(part, f"{service_type}_{suffix}").items():
+            consts, fields = definition[0], definition[1]
             if not fields:  # rosidl gives an empty structure one uint8 member on the wire
                 fields = [(_EMPTY_FIELD, (Nodetype.BASE, ("uint8", 0)))]
             own = {store_name(f"{service_type}_{x}") for x in parts}
-            fields = [(fname, _package_relative(desc, own)) for fname, desc in fields]
-            types[name] = (consts, fields, *rest)
+            relative = [(fname, _package_relative(desc, own)) for fname, desc in fields]
+            types[name] = (consts, relative, *definition[2:])
     return types
 
 

@@ -41,8 +41,9 @@ def _message_class(namespaced: tuple[str, ...]) -> type:
 @functools.cache
 def _slots(message_class: type) -> dict[str, Any]:
     """Field name -> rosidl type of a generated message class."""
-    names = message_class.get_fields_and_field_types().keys()
-    return dict(zip(names, message_class.SLOT_TYPES, strict=True))
+    generated: Any = message_class  # rosidl's generated classes carry no type information
+    names = generated.get_fields_and_field_types().keys()
+    return dict(zip(names, generated.SLOT_TYPES, strict=True))
 
 
 def _namespaced_class(definition: NamespacedType) -> type:

@@ -35,6 +35,8 @@ from ..core.paths import (
     DEFAULT_PATH_TOLERANCE,
     DEFAULT_PSI_STEP,
     INTERPOLATIONS,
+    PathCheck,
+    TorsionPlan,
     check_path,
     check_waypoints,
     plan_torsion,
@@ -149,7 +151,7 @@ def check_path_response_fields(manipulator: Manipulator, request: Any) -> dict[s
                 msg = "poses: expected finite quaternions"
                 raise InputError(msg)
             axes = _tool_axes(quaternions)
-            result = plan_torsion(
+            result: PathCheck | TorsionPlan = plan_torsion(
                 manipulator,
                 positions,
                 axes,
