@@ -152,6 +152,7 @@ def commander(rate: float, duration: float) -> dict:
         message.position.z = -1.3
         messages.append(message)
     print(json.dumps({"ready": True}), flush=True)
+    clock = node.get_clock()
     start = time.perf_counter()
     for index, message in enumerate(messages):
         target = start + index / rate
@@ -159,6 +160,7 @@ def commander(rate: float, duration: float) -> dict:
         if pause > 0:
             time.sleep(pause)
         sent[index] = time.perf_counter()
+        message.header.stamp = clock.now().to_msg()  # the node answers stale ones "overloaded"
         publisher.publish(message)
     publish_span = time.perf_counter() - start
     wait_until = time.monotonic() + 10.0

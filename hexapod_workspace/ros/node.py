@@ -86,6 +86,7 @@ from hexapod_workspace.logs import (
 )
 
 from . import health
+from .commands import CommandStream
 from .conversions import angles_from_orientations, position_from_point, to_message, type_name
 from .jobs import JobQueue, Ticket
 from .parameters import (
@@ -110,6 +111,12 @@ COMMAND_QOS = QoSProfile(
 )
 #: ~/reachability keeps 1000 results (1 s at 1 kHz) for a reliable reader that lags.
 REACHABILITY_DEPTH = 1000
+
+
+def _name(key: str) -> str:
+    """The node-relative name (``~/...``) of :data:`messages.TOPICS` entry ``key``, so that a
+    remapped namespace moves every topic, service and action with the node."""
+    return "~/" + messages.TOPICS[key].rsplit("/", 1)[1]
 
 
 def _result_qos(depth: int = 1) -> QoSProfile:
@@ -163,8 +170,13 @@ class WorkspaceNode(Node):
         self.stats = health.Counters()
         self.recorder = Recorder(self.get_logger())
         self._specs = parameter_specs()
-        self._declare_parameters()
-        self._state: State = state_from(self._parameter_values())
+        try:
+            self._declare_parameters()
+            self.state: State = state_from(self._parameter_values())
+        except Exception:
+            self.recorder.shutdown()
+            super().destroy_node()
+            raise
         self._warn_home_pose()
         self.add_on_set_parameters_callback(self._validate_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
@@ -178,43 +190,46 @@ class WorkspaceNode(Node):
 
         self._cloud_publishers = {
             WorkspaceKind.ORIENTATION: self.recorded_publisher(
-                PointCloud2, "~/orientation_workspace"
+                PointCloud2, _name("orientation_workspace")
             ),
             WorkspaceKind.PROJECTED_TORSION_ZERO: self.recorded_publisher(
-                PointCloud2, "~/projected_workspace"
+                PointCloud2, _name("projected_workspace")
             ),
         }
         self._cloud_publishers[WorkspaceKind.PROJECTED_EXACT] = self._cloud_publishers[
             WorkspaceKind.PROJECTED_TORSION_ZERO
         ]
-        self._summary_publisher = self.recorded_publisher(WorkspaceSummary, "~/workspace_summary")
+        self._summary_publisher = self.recorded_publisher(
+            WorkspaceSummary, _name("workspace_summary")
+        )
         self._reachability = self.recorded_publisher(
-            ReachabilityResult, "~/reachability", depth=REACHABILITY_DEPTH
+            ReachabilityResult, _name("reachability"), depth=REACHABILITY_DEPTH
         )
         self._check_service = self.recorded_service(
-            CheckPoses, "~/check_poses", self._on_check_poses, self.check_group
+            CheckPoses, _name("check_poses"), self._on_check_poses, self.check_group
         )
         self._orientation_service = self.recorded_service(
-            Trigger, "~/compute_orientation_workspace", self._on_compute_orientation
+            Trigger, _name("compute_orientation_workspace"), self._on_compute_orientation
         )
         self._projected_service = self.recorded_service(
-            Trigger, "~/compute_projected_workspace", self._on_compute_projected
+            Trigger, _name("compute_projected_workspace"), self._on_compute_projected
         )
         self._commanded = self.recorded_subscription(
-            CommandedPose, "~/commanded_pose", self._on_commanded_pose, self.check_group
+            CommandedPose, _name("commanded_pose"), lambda c: self._commands.on_command(c)
         )
+        self._commands = CommandStream(self, self._commanded, self._reachability)
         self._requests = self.recorded_subscription(
-            WorkspaceRequest, "~/workspace_request", self._on_workspace_request
+            WorkspaceRequest, _name("workspace_request"), self._on_workspace_request
         )
         # The action is recorded in the service's form: its Goal and Result have the fields of
         # ComputeWorkspace.srv's Request and Response (rosbag2 in Jazzy records no actions).
         self._action_topics = self._record_service_channels(
-            ComputeWorkspaceRecord, "~/compute_workspace"
+            ComputeWorkspaceRecord, _name("compute_workspace")
         )
         self._action = ActionServer(
             self,
             ComputeWorkspace,
-            "~/compute_workspace",
+            _name("compute_workspace"),
             execute_callback=self._execute_goal,
             goal_callback=lambda goal: GoalResponse.ACCEPT,
             cancel_callback=self._cancel_goal,
@@ -225,8 +240,8 @@ class WorkspaceNode(Node):
         self.create_timer(1.0, self._publish_diagnostics)
         for attach in extensions:
             attach(self)
-        if self._state.settings.recording_enabled:
-            self.recorder.open(self._state.settings.recording_directory)
+        if self.state.settings.recording_enabled:
+            self.recorder.open(self.state.settings.recording_directory)
         self.worker.start()
         _warm_up()
         self.get_logger().info(
@@ -323,7 +338,7 @@ class WorkspaceNode(Node):
         return super().set_parameters_atomically(parameter_list)
 
     def _warn_home_pose(self) -> None:
-        problems = self._state.manipulator.home_pose_violations()
+        problems = self.state.manipulator.home_pose_violations()
         if problems:
             self.get_logger().warning(
                 f"the home pose (geometry.home_position, identity orientation) is unreachable: "
@@ -344,8 +359,8 @@ class WorkspaceNode(Node):
 
     def _apply_parameters(self, parameters: list[Parameter]) -> None:
         """Swap in the new model and settings after an accepted update."""
-        previous, state = self._state, state_from(self._parameter_values())
-        self._state = state
+        previous, state = self.state, state_from(self._parameter_values())
+        self.state = state
         self.get_logger().info(f"parameters updated: {', '.join(p.name for p in parameters)}")
         if state.manipulator != previous.manipulator:
             self._warn_home_pose()
@@ -361,10 +376,10 @@ class WorkspaceNode(Node):
     ) -> CheckPoses.Response:
         self.stats.check_calls += 1
         try:
-            fields = self._check_fields(self._state, request)
+            fields = self._check_fields(self.state, request)
         except Exception as error:
             fields = messages.check_poses_response_fields(
-                None, success=False, message=self._internal_error(error)
+                None, success=False, message=self.internal_error(error)
             )
         if not fields["success"]:
             self.stats.check_refused += 1
@@ -392,44 +407,10 @@ class WorkspaceNode(Node):
                 reason = str(error)
         return messages.check_poses_response_fields(None, success=False, message=reason)
 
-    def _on_commanded_pose(self, command: CommandedPose) -> None:
-        stats = self.stats
-        stats.commands_received += 1
-        self.recorder.write(self._commanded.topic_name, command)
-        state = self._state
-        now_ns = self._now_ns()
-        common = {
-            "position": position_from_point(command.position),
-            "angles": angles_from_orientations([command.orientation])[0],
-            "stamp_ns": now_ns,
-            "frame_id": state.manipulator.frame_id,
-            "request_id": command.request_id,
-        }
-        sent_ns = command.header.stamp.sec * 1_000_000_000 + command.header.stamp.nanosec
-        age = (now_ns - sent_ns) * 1e-9
-        limit = state.settings.max_command_age
-        if sent_ns > 0 and limit > 0.0 and age > limit:
-            stats.commands_overloaded += 1
-            reason = f"overloaded: command {age:.3f} s old when its turn came (limit {limit:g} s)"
-            fields = messages.reachability_result_fields(None, message=reason, **common)
-        else:
-            try:
-                result = check(state.manipulator, common["angles"][None, :], common["position"])
-                fields = messages.reachability_result_fields(result, **common)
-            except InputError as error:
-                stats.commands_refused += 1
-                fields = messages.reachability_result_fields(None, message=str(error), **common)
-            except Exception as error:
-                stats.commands_refused += 1
-                reason = self._internal_error(error)
-                fields = messages.reachability_result_fields(None, message=reason, **common)
-        self.publish(self._reachability, to_message(ReachabilityResult, fields))
-        stats.commands_answered += 1
-
     # ------------------------------------------------------------------ workspaces
     def _job(self, request: WorkspaceRequest) -> WorkspaceJob | _Failed:
         """The job of a request with the node's parameters filled in, or why it is refused."""
-        settings = self._state.settings
+        settings = self.state.settings
         kind, position = int(request.kind), position_from_point(request.position)
         if WorkspaceKind.of(kind) is None:
             return _Failed(
@@ -448,14 +429,14 @@ class WorkspaceNode(Node):
         if not RAYS_RANGE[0] <= rays <= RAYS_RANGE[1]:
             return _Failed(f"n_rays: expected {RAYS_RANGE[0]}..{RAYS_RANGE[1]}, got {rays}", rays)
         return WorkspaceJob(
-            manipulator=self._state.manipulator,
+            manipulator=self.state.manipulator,
             kind=kind,
             position=position,
             n_rays=rays,
             psi_step=float(request.psi_step) or settings.psi_step,
             tolerance=float(request.tolerance) or settings.tolerance,
             stamp_ns=self._now_ns(),
-            frame_id=self._state.manipulator.frame_id,
+            frame_id=self.state.manipulator.frame_id,
             request_id=request.request_id,
         )
 
@@ -484,7 +465,7 @@ class WorkspaceNode(Node):
         elif isinstance(error, (InputError, UnreachableReferenceError)):
             reason = str(error)
         else:
-            reason = self._internal_error(error)
+            reason = self.internal_error(error)
         return self._publish_failure(
             reason,
             job,
@@ -512,7 +493,7 @@ class WorkspaceNode(Node):
         else:
             position, stamp_ns = position_from_point(origin.position), self._now_ns()
             kind = WorkspaceKind.of(origin.kind) or WorkspaceKind.ORIENTATION
-        frame_id = self._state.manipulator.frame_id
+        frame_id = self.state.manipulator.frame_id
         fields = messages.summary_fields(
             None,
             message=reason,
@@ -540,7 +521,7 @@ class WorkspaceNode(Node):
 
     async def _trigger(self, kind: WorkspaceKind) -> Trigger.Response:
         request = WorkspaceRequest(kind=int(kind))
-        position = self._state.manipulator.position
+        position = self.state.manipulator.position
         request.position.x, request.position.y, request.position.z = map(float, position)
         summary, _ = await self._workspace(request)
         return Trigger.Response(success=summary.success, message=summary.message)
@@ -549,7 +530,7 @@ class WorkspaceNode(Node):
         return await self._trigger(WorkspaceKind.ORIENTATION)
 
     async def _on_compute_projected(self, request: Any, response: Any) -> Trigger.Response:
-        return await self._trigger(WorkspaceKind.projected(self._state.settings.projected_method))
+        return await self._trigger(WorkspaceKind.projected(self.state.settings.projected_method))
 
     async def _workspace(
         self,
@@ -622,7 +603,7 @@ class WorkspaceNode(Node):
     def _publish_diagnostics(self) -> None:
         array = health.diagnostic_array(
             name=self.get_fully_qualified_name(),
-            hardware_id=self._state.manipulator.frame_id or self.get_name(),
+            hardware_id=self.state.manipulator.frame_id or self.get_name(),
             stamp=self.get_clock().now().to_msg(),
             counters=self.stats,
             jobs_depth=self.jobs.depth,
@@ -632,7 +613,7 @@ class WorkspaceNode(Node):
         self._diagnostics.publish(array)
 
     # ------------------------------------------------------------------ lifecycle
-    def _internal_error(self, error: BaseException) -> str:
+    def internal_error(self, error: BaseException) -> str:
         self.get_logger().error(f"internal error: {error!r}")
         reason = f"internal error: {type(error).__name__}: {error}"
         self.stats.last_error = reason
