@@ -46,23 +46,16 @@ from __future__ import annotations
 import inspect
 import sys
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray
-from hexapod_workspace_msgs.action import ComputeWorkspace
 from hexapod_workspace_msgs.msg import (
     CommandedPose,
     ReachabilityResult,
-    WorkspaceRequest,
-    WorkspaceSummary,
 )
 from hexapod_workspace_msgs.srv import CheckPoses
-from hexapod_workspace_msgs.srv import ComputeWorkspace as ComputeWorkspaceRecord
 from rcl_interfaces.msg import SetParametersResult
-from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
 from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
@@ -70,13 +63,9 @@ from rclpy.logging import get_logger
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-from rclpy.task import Future
-from sensor_msgs.msg import PointCloud2
-from std_srvs.srv import Trigger
 
 from hexapod_workspace.core.constraints import check
-from hexapod_workspace.core.resolution import WorkspaceKind
-from hexapod_workspace.errors import ConfigError, InputError, UnreachableReferenceError
+from hexapod_workspace.errors import ConfigError, InputError
 from hexapod_workspace.logs import (
     REQUEST_QOS,
     SERVICE_QOS,
@@ -88,9 +77,7 @@ from hexapod_workspace.logs import (
 from . import health
 from .commands import CommandStream
 from .conversions import angles_from_orientations, position_from_point, to_message, type_name
-from .jobs import JobQueue, Ticket
 from .parameters import (
-    RAYS_RANGE,
     State,
     command_line_override_names,
     parameter_specs,
@@ -98,7 +85,8 @@ from .parameters import (
     state_from,
 )
 from .recorder import Recorder
-from .worker import CanceledError, WorkspaceJob, WorkspaceWorker
+from .worker import WorkspaceWorker
+from .workspaces import WorkspaceServer
 
 __all__ = ["EXTENSIONS", "NODE_NAME", "WorkspaceNode", "main"]
 
@@ -126,14 +114,6 @@ def _result_qos(depth: int = 1) -> QoSProfile:
         reliability=ReliabilityPolicy.RELIABLE,
         durability=DurabilityPolicy.TRANSIENT_LOCAL,
     )
-
-
-@dataclass(frozen=True)
-class _Failed:
-    """A workspace request refused before it reaches the worker."""
-
-    reason: str
-    n_rays: int = 0
 
 
 def _warm_up() -> None:
@@ -186,56 +166,19 @@ class WorkspaceNode(Node):
         self.check_group = ReentrantCallbackGroup()
         self.job_group = MutuallyExclusiveCallbackGroup()
         self.worker = WorkspaceWorker()
-        self.jobs = JobQueue(self.worker, self._finish_job, self._fail_job)
-
-        self._cloud_publishers = {
-            WorkspaceKind.ORIENTATION: self.recorded_publisher(
-                PointCloud2, _name("orientation_workspace")
-            ),
-            WorkspaceKind.PROJECTED_TORSION_ZERO: self.recorded_publisher(
-                PointCloud2, _name("projected_workspace")
-            ),
-        }
-        self._cloud_publishers[WorkspaceKind.PROJECTED_EXACT] = self._cloud_publishers[
-            WorkspaceKind.PROJECTED_TORSION_ZERO
-        ]
-        self._summary_publisher = self.recorded_publisher(
-            WorkspaceSummary, _name("workspace_summary")
-        )
         self._reachability = self.recorded_publisher(
             ReachabilityResult, _name("reachability"), depth=REACHABILITY_DEPTH
         )
-        self._check_service = self.recorded_service(
+        self.recorded_service(
             CheckPoses, _name("check_poses"), self._on_check_poses, self.check_group
-        )
-        self._orientation_service = self.recorded_service(
-            Trigger, _name("compute_orientation_workspace"), self._on_compute_orientation
-        )
-        self._projected_service = self.recorded_service(
-            Trigger, _name("compute_projected_workspace"), self._on_compute_projected
         )
         self._commanded = self.recorded_subscription(
             CommandedPose, _name("commanded_pose"), lambda c: self._commands.on_command(c)
         )
         self._commands = CommandStream(self, self._commanded, self._reachability)
-        self._requests = self.recorded_subscription(
-            WorkspaceRequest, _name("workspace_request"), self._on_workspace_request
-        )
-        # The action is recorded in the service's form: its Goal and Result have the fields of
-        # ComputeWorkspace.srv's Request and Response (rosbag2 in Jazzy records no actions).
-        self._action_topics = self._record_service_channels(
-            ComputeWorkspaceRecord, _name("compute_workspace")
-        )
-        self._action = ActionServer(
-            self,
-            ComputeWorkspace,
-            _name("compute_workspace"),
-            execute_callback=self._execute_goal,
-            goal_callback=lambda goal: GoalResponse.ACCEPT,
-            cancel_callback=self._cancel_goal,
-            callback_group=self.job_group,
-        )
-        self._goal_tickets: dict[bytes, Ticket] = {}
+        self.workspaces = WorkspaceServer(self, _name)
+        #: the one job queue of workspace computations (extensions may submit to it)
+        self.jobs = self.workspaces.jobs
         self._diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self.create_timer(1.0, self._publish_diagnostics)
         for attach in extensions:
@@ -257,7 +200,7 @@ class WorkspaceNode(Node):
         self.recorder.add_channel(publisher.topic_name, type_name(message_class), qos)
         return publisher
 
-    def _record_service_channels(self, service_class: type, name: str) -> tuple[str, str]:
+    def record_service_channels(self, service_class: type, name: str) -> tuple[str, str]:
         """Register ``<service>/request`` and ``/response`` in the logs; return both topics."""
         request_topic, response_topic = service_topics(self.resolve_service_name(name))
         self.recorder.add_channel(request_topic, type_name(service_class.Request), SERVICE_QOS)
@@ -269,7 +212,7 @@ class WorkspaceNode(Node):
     ) -> Any:
         """A service whose requests and responses are recorded (``<name>/request``,
         ``<name>/response``); ``callback(request, response)`` may be a coroutine."""
-        request_topic, response_topic = self._record_service_channels(service_class, name)
+        request_topic, response_topic = self.record_service_channels(service_class, name)
 
         if _is_coroutine(callback):
 
@@ -407,198 +350,6 @@ class WorkspaceNode(Node):
                 reason = str(error)
         return messages.check_poses_response_fields(None, success=False, message=reason)
 
-    # ------------------------------------------------------------------ workspaces
-    def _job(self, request: WorkspaceRequest) -> WorkspaceJob | _Failed:
-        """The job of a request with the node's parameters filled in, or why it is refused."""
-        settings = self.state.settings
-        kind, position = int(request.kind), position_from_point(request.position)
-        if WorkspaceKind.of(kind) is None:
-            return _Failed(
-                f"kind: expected 0 (orientation), 1 (torsion_zero) or 2 (exact), got {kind}"
-            )
-        if not np.all(np.isfinite(position)):
-            return _Failed(f"position: expected finite values, got {position.tolist()}")
-        for name in ("psi_step", "tolerance"):
-            value = float(getattr(request, name))
-            if not np.isfinite(value) or value < 0.0:
-                return _Failed(
-                    f"{name}: expected a finite value >= 0 (0 = node parameter), got {value}"
-                )
-        default_rays = settings.n_rays if kind == WorkspaceKind.ORIENTATION else settings.n_phi
-        rays = int(request.n_rays) or default_rays
-        if not RAYS_RANGE[0] <= rays <= RAYS_RANGE[1]:
-            return _Failed(f"n_rays: expected {RAYS_RANGE[0]}..{RAYS_RANGE[1]}, got {rays}", rays)
-        return WorkspaceJob(
-            manipulator=self.state.manipulator,
-            kind=kind,
-            position=position,
-            n_rays=rays,
-            psi_step=float(request.psi_step) or settings.psi_step,
-            tolerance=float(request.tolerance) or settings.tolerance,
-            stamp_ns=self._now_ns(),
-            frame_id=self.state.manipulator.frame_id,
-            request_id=request.request_id,
-        )
-
-    def _submit(self, request: WorkspaceRequest, **callbacks: Any) -> Ticket | None:
-        """Queue the job of ``request``; a refused request publishes its failure (None)."""
-        job = self._job(request)
-        if isinstance(job, _Failed):
-            self._publish_failure(job.reason, request, n_rays=job.n_rays)
-            return None
-        return self.jobs.submit(Ticket(job, **callbacks))
-
-    def _finish_job(self, job: WorkspaceJob, fields: Any) -> tuple[Any, Any]:
-        """Job thread: the worker's fields -> published (and recorded) summary and cloud."""
-        summary_fields, cloud_fields = fields
-        cloud = to_message(PointCloud2, cloud_fields)
-        summary = to_message(WorkspaceSummary, summary_fields)
-        self.publish(self._cloud_publishers[job.kind], cloud)
-        self.publish(self._summary_publisher, summary)
-        self.get_logger().info(summary.message)
-        return summary, cloud
-
-    def _fail_job(self, job: WorkspaceJob, error: BaseException) -> tuple[Any, Any]:
-        """Job thread: a failed or canceled job -> published failure summary (and cloud)."""
-        if isinstance(error, CanceledError):
-            reason = "canceled"
-        elif isinstance(error, (InputError, UnreachableReferenceError)):
-            reason = str(error)
-        else:
-            reason = self.internal_error(error)
-        return self._publish_failure(
-            reason,
-            job,
-            n_rays=job.n_rays,
-            tolerance=job.tolerance,
-            empty_cloud=isinstance(error, UnreachableReferenceError),
-        )
-
-    def _publish_failure(
-        self,
-        reason: str,
-        origin: WorkspaceRequest | WorkspaceJob,
-        *,
-        n_rays: int = 0,
-        tolerance: float = float("nan"),
-        empty_cloud: bool = False,
-    ) -> tuple[Any, Any]:
-        """Publish (and return) the summary of a failed computation and an empty cloud.
-
-        ``empty_cloud``: the workspace is empty (unreachable reference): the cloud is published
-        too, so that viewers do not keep showing a stale boundary.
-        """
-        if isinstance(origin, WorkspaceJob):
-            position, stamp_ns, kind = origin.position, origin.stamp_ns, origin.kind
-        else:
-            position, stamp_ns = position_from_point(origin.position), self._now_ns()
-            kind = WorkspaceKind.of(origin.kind) or WorkspaceKind.ORIENTATION
-        frame_id = self.state.manipulator.frame_id
-        fields = messages.summary_fields(
-            None,
-            message=reason,
-            reference_reachable=not empty_cloud,
-            n_rays=n_rays,
-            tolerance=tolerance,
-            stamp_ns=stamp_ns,
-            frame_id=frame_id,
-            request_id=origin.request_id,
-            kind=kind,
-            position=np.nan_to_num(position),
-        )
-        summary = to_message(WorkspaceSummary, fields)
-        empty = messages.pointcloud_fields(np.zeros((0, 6)), frame_id=frame_id, stamp_ns=stamp_ns)
-        cloud = to_message(PointCloud2, empty)
-        if empty_cloud:
-            self.publish(self._cloud_publishers[kind], cloud)
-        self.publish(self._summary_publisher, summary)
-        self.get_logger().warning(f"workspace request failed: {reason}")
-        return summary, cloud
-
-    def _on_workspace_request(self, request: WorkspaceRequest) -> None:
-        self.recorder.write(self._requests.topic_name, request)
-        self._submit(request)
-
-    async def _trigger(self, kind: WorkspaceKind) -> Trigger.Response:
-        request = WorkspaceRequest(kind=int(kind))
-        position = self.state.manipulator.position
-        request.position.x, request.position.y, request.position.z = map(float, position)
-        summary, _ = await self._workspace(request)
-        return Trigger.Response(success=summary.success, message=summary.message)
-
-    async def _on_compute_orientation(self, request: Any, response: Any) -> Trigger.Response:
-        return await self._trigger(WorkspaceKind.ORIENTATION)
-
-    async def _on_compute_projected(self, request: Any, response: Any) -> Trigger.Response:
-        return await self._trigger(WorkspaceKind.projected(self.state.settings.projected_method))
-
-    async def _workspace(
-        self,
-        request: WorkspaceRequest,
-        register: Callable[[Ticket], object] | None = None,
-        **callbacks: Any,
-    ) -> tuple[Any, Any]:
-        """Queue ``request``, await its (summary, cloud) without holding the executor; a
-        refused request answers at once. ``register(ticket)`` runs before the first wait."""
-        job = self._job(request)
-        if isinstance(job, _Failed):
-            return self._publish_failure(job.reason, request, n_rays=job.n_rays)
-        future: Future = Future(executor=self.executor)
-        executor = self.executor
-
-        def done(ticket: Ticket) -> None:
-            future.set_result(ticket.outcome)
-            if executor is not None:
-                executor.wake()
-
-        ticket = self.jobs.submit(Ticket(job, on_done=done, **callbacks))
-        if register is not None:
-            register(ticket)
-        return await future
-
-    # ------------------------------------------------------------------ action
-    def _cancel_goal(self, goal_handle: Any) -> CancelResponse:
-        ticket = self._goal_tickets.get(bytes(goal_handle.goal_id.uuid))
-        if ticket is not None:
-            self.jobs.cancel(ticket)
-        return CancelResponse.ACCEPT
-
-    async def _execute_goal(self, goal_handle: Any) -> ComputeWorkspace.Result:
-        request = goal_handle.request.request
-        request_topic, response_topic = self._action_topics
-        self.recorder.write(request_topic, ComputeWorkspaceRecord.Request(request=request))
-        key = bytes(goal_handle.goal_id.uuid)
-
-        def feedback(progress: float, stage: str) -> None:
-            goal_handle.publish_feedback(ComputeWorkspace.Feedback(progress=progress, stage=stage))
-
-        if goal_handle.is_cancel_requested:
-            summary, cloud = self._publish_failure("canceled", request)
-        else:
-            feedback(0.0, "queued")
-            summary, cloud = await self._workspace(
-                request,
-                lambda ticket: self._goal_tickets.__setitem__(key, ticket),
-                on_progress=feedback,
-            )
-        self._goal_tickets.pop(key, None)
-        fields = messages.compute_workspace_response_fields(
-            None,
-            stamp_ns=0,
-            frame_id="",
-            summary=summary,
-            boundary=cloud,
-        )
-        result = to_message(ComputeWorkspace.Result, fields)
-        self.recorder.write(response_topic, to_message(ComputeWorkspaceRecord.Response, fields))
-        if summary.success:
-            goal_handle.succeed()
-        elif goal_handle.is_cancel_requested:
-            goal_handle.canceled()
-        else:
-            goal_handle.abort()
-        return result
-
     # ------------------------------------------------------------------ health
     def _publish_diagnostics(self) -> None:
         array = health.diagnostic_array(
@@ -621,7 +372,7 @@ class WorkspaceNode(Node):
 
     def stop_worker(self) -> None:
         """Cancel the queued and running computations and end the worker process."""
-        self.jobs.stop()
+        self.workspaces.stop()
         self.worker.close()
 
     def destroy_node(self) -> None:

@@ -178,12 +178,12 @@ def workspace_request(**fields) -> WorkspaceRequest:
     ],
 )
 def test_workspace_request_refusals_name_the_field_and_value(node, fields, reason):
-    refused = node._job(workspace_request(**fields))
+    refused = node.workspaces.job(workspace_request(**fields))
     assert reason in refused.reason
 
 
 def test_a_valid_request_gets_the_node_resolution(node):
-    job = node._job(workspace_request(kind=WorkspaceRequest.ORIENTATION))
+    job = node.workspaces.job(workspace_request(kind=WorkspaceRequest.ORIENTATION))
     assert job.n_rays == 36
     assert job.tolerance == node.state.settings.tolerance
 
