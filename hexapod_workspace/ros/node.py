@@ -99,6 +99,9 @@ COMMAND_QOS = QoSProfile(
 )
 #: ~/reachability keeps 1000 results (1 s at 1 kHz) for a reliable reader that lags.
 REACHABILITY_DEPTH = 1000
+#: GIL switch interval of the node process, s: a callback waits at most about this long for the
+#: interpreter while the recorder or job thread runs (Python's default is 5 ms).
+SWITCH_INTERVAL = 2e-4
 
 
 def _name(key: str) -> str:
@@ -242,9 +245,11 @@ class WorkspaceNode(Node):
         return subscription
 
     def publish(self, publisher: Any, message: Any) -> None:
-        """Publish and record ``message`` (any thread)."""
-        publisher.publish(message)
+        """Record and publish ``message`` (any thread). Recorded first: a SIGINT (rclpy raises
+        KeyboardInterrupt in the main thread) between the two cannot leave a published message
+        out of the log."""
         self.recorder.write(publisher.topic_name, message)
+        publisher.publish(message)
 
     def _now_ns(self) -> int:
         return self.get_clock().now().nanoseconds
@@ -394,6 +399,7 @@ def main(args: list[str] | None = None) -> int:
     int
         Process exit status: 0 after a clean shutdown, 1 when the parameters are invalid.
     """
+    sys.setswitchinterval(SWITCH_INTERVAL)
     rclpy.init(args=args)
     node = None
     executor = None
