@@ -483,6 +483,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--node-arg", action="append", default=[], metavar="ARG", help="extra --ros-args"
     )
+    parser.add_argument(
+        "--node-source",
+        type=Path,
+        metavar="DIR",
+        help="run the node of another checkout (e.g. a git worktree of an older commit) "
+        "instead of the install space's, for a before/after comparison in the same conditions",
+    )
     args = parser.parse_args(argv)
     if args.role == "commander":
         print(json.dumps(commander(args.rate, args.duration)), flush=True)
@@ -500,10 +507,19 @@ def main(argv: list[str] | None = None) -> int:
         os.environ["ROS_DOMAIN_ID"] = str(domain)
         os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
         out_dir = Path(tmp)
+        env = dict(os.environ)
+        command = [str(NODE_EXECUTABLE)]
+        if args.node_source is not None:
+            env["PYTHONPATH"] = f"{args.node_source.resolve()}:{env.get('PYTHONPATH', '')}"
+            command = [
+                sys.executable,
+                "-c",
+                "import sys; from hexapod_workspace.ros import main; sys.exit(main(sys.argv))",
+            ]
         with (out_dir / "node.log").open("wb") as out:
             node = subprocess.Popen(
                 [
-                    str(NODE_EXECUTABLE),
+                    *command,
                     "--ros-args",
                     "--params-file",
                     str(REPO / "config" / "example_gpm.yaml"),
@@ -513,6 +529,8 @@ def main(argv: list[str] | None = None) -> int:
                 ],
                 stdout=out,
                 stderr=subprocess.STDOUT,
+                env=env,
+                cwd=tmp,  # not this checkout: "-c" puts the working directory first on sys.path
             )
             floor = subprocess.Popen(
                 [sys.executable, "-c", FLOOR_SERVER], stdout=out, stderr=subprocess.STDOUT
