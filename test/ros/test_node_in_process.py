@@ -214,3 +214,29 @@ def test_commands_in_a_batch_are_answered_one_each_in_order(node):
     model = Manipulator.from_params_file(example_config_path())
     expected = check(model, [[0.0, 0.2, 0.0]], (0.0, 0.0, -1.3))
     assert published[2].check.reachable == bool(expected.reachable[0])
+
+
+def test_an_extension_attaches_with_one_call(ros_context):
+    """What ros/paths.py or ros/atlas_action.py do: ``attach(node)`` wires a recorded service
+    with the node's groups and reads the node's state."""
+    from std_srvs.srv import Trigger
+
+    seen = []
+
+    def attach(node) -> None:
+        def ping(request, response):
+            return Trigger.Response(success=True, message=node.state.manipulator.frame_id)
+
+        seen.append(node.recorded_service(Trigger, "~/ping", ping, node.check_group))
+
+    node = WorkspaceNode(
+        context=ros_context,
+        parameter_overrides=[Parameter("recording.enabled", value=False)],
+        extensions=[attach],
+    )
+    try:
+        (service,) = seen
+        assert node.resolve_service_name(service.srv_name) == "/hexapod_workspace/ping"
+        assert node.jobs is node.workspaces.jobs and node.recorder is not None
+    finally:
+        node.destroy_node()
