@@ -16,8 +16,6 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
-from hexapod_workspace.errors import HexapodWorkspaceError
-
 from .worker import CanceledError, WorkspaceJob, WorkspaceWorker
 
 __all__ = ["JobQueue", "Ticket"]
@@ -121,7 +119,8 @@ class JobQueue:
                 return  # running (the worker sees the event) or done
             self._pending.remove(ticket)
         self.canceled += 1
-        ticket._finish(self._on_error(ticket.job, CanceledError("canceled")), CanceledError())
+        error = CanceledError("canceled")
+        ticket._finish(self._failure(ticket.job, error), error)
 
     def stop(self, timeout: float = 10.0) -> None:
         """Cancel everything and end the thread."""
@@ -135,6 +134,14 @@ class JobQueue:
         if running is not None:
             running.canceled.set()
         self._thread.join(timeout)
+
+    def _failure(self, job: WorkspaceJob, error: BaseException) -> Any:
+        """The outcome of a failed job (``on_error``), or None when even that fails (the node
+        is shutting down: its publishers are gone)."""
+        try:
+            return self._on_error(job, error)
+        except Exception:
+            return None
 
     def _run(self) -> None:
         while True:
@@ -161,13 +168,10 @@ class JobQueue:
             )
             ticket.report(0.95, PUBLISHING)
             outcome = self._finish_job(job, fields)
-        except (HexapodWorkspaceError, RuntimeError) as error:
+        except Exception as error:  # a bad request, a cancel, a dead worker, a bug: answered
             if isinstance(error, CanceledError):
                 self.canceled += 1
-            ticket._finish(self._on_error(job, error), error)
-            return
-        except Exception as error:  # a bug: the ticket still gets an answer
-            ticket._finish(self._on_error(job, error), error)
+            ticket._finish(self._failure(job, error), error)
             return
         self.completed += 1
         ticket.report(1.0)
