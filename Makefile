@@ -1,7 +1,8 @@
 # Entry points for humans and CI. Everything runs in .venv (tools/venv.sh), created on demand.
 #   make demo   CLI demo (no ROS needed): venv with base requirements + the package
 #   make ros    colcon build of hexapod_workspace_msgs and hexapod_workspace (full venv)
-#   make test   full venv + colcon build + ruff + the whole pytest suite over real DDS
+#   make test   full venv + colcon build + ruff + Foxglove's npm libraries (npm ci, pinned by
+#               test/foxglove/package-lock.json) + the whole pytest suite over real DDS
 #   make clean  remove build/ install/ log/ demo_out/ (keeps .venv)
 SHELL := /usr/bin/env bash
 .SHELLFLAGS := -euo pipefail -c
@@ -15,8 +16,11 @@ ROS_DOMAIN_ID ?= $(shell echo $$(( 1 + $$$$ % 100 )))
 export ROS_DOMAIN_ID
 # The ROS tests fail (instead of skipping) when the install space cannot be used.
 export HEXAPOD_REQUIRE_ROS := 1
+# The log checks with Foxglove's own libraries fail (instead of skipping) without them.
+export HEXAPOD_REQUIRE_FOXGLOVE := 1
+FOXGLOVE := test/foxglove
 
-.PHONY: demo ros test lint venv-base venv-full clean
+.PHONY: demo ros test lint venv-base venv-full foxglove clean
 
 venv-base:
 	tools/venv.sh base
@@ -34,8 +38,18 @@ lint: venv-full
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
 
-test: ros lint
+# npm ci only when the lock file changed; its output goes to log/npm_ci.out (shown on failure).
+$(FOXGLOVE)/node_modules/.package-lock.json: $(FOXGLOVE)/package.json $(FOXGLOVE)/package-lock.json
+	@mkdir -p log
+	@echo "[tools] npm ci in $(FOXGLOVE) (Foxglove's libraries for the log checks)" >&2
+	@cd $(FOXGLOVE) && npm ci --no-audit --no-fund >$(CURDIR)/log/npm_ci.out 2>&1 \
+	  || { tail -n 30 $(CURDIR)/log/npm_ci.out >&2; exit 1; }
+	@touch $@
+
+foxglove: $(FOXGLOVE)/node_modules/.package-lock.json
+
+test: ros lint foxglove
 	tools/with_ros_env.sh python -m pytest test
 
 clean:
-	rm -rf build install log demo_out
+	rm -rf build install log demo_out $(FOXGLOVE)/node_modules

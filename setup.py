@@ -42,6 +42,7 @@ setup(
     license="Apache-2.0",
     python_requires=">=3.10",
     packages=find_packages(exclude=["test", "test.*", "benchmarks"]),
+    package_data={PACKAGE: ["py.typed"]},
     cmdclass={"build_py": BuildPyWithData},
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
@@ -50,12 +51,18 @@ setup(
         (f"share/{PACKAGE}/launch", glob("launch/*.py")),
     ],
     install_requires=[
-        "numpy>=1.24",
+        # Tested with 1.26.4 (Ubuntu 24.04's python3-numpy, next to ROS 2 Jazzy from apt) and
+        # the pinned 2.2.6 (requirements/base.txt).
+        "numpy>=1.26",
         "PyYAML>=5.4",
         "matplotlib>=3.6",
         "mcap>=1.6",
         "rosbags>=0.11",
     ],
+    extras_require={
+        # The workspace atlas engine (hexapod_workspace.atlas): pip install .[atlas]
+        "atlas": ["dask[distributed]>=2024.12", "xarray>=2025.1", "zarr>=3.0"],
+    },
     zip_safe=False,
     entry_points={
         "console_scripts": [

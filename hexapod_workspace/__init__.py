@@ -7,6 +7,8 @@ Units are SI (m, rad). Orientations are Tilt-and-Torsion angles (φ, θ, ψ) wit
 ``R = Rz(φ) Ry(θ) Rz(−φ) Rz(ψ)``; see :mod:`hexapod_workspace.core.rotations`.
 """
 
+from .atlas import workspace_atlas
+from .core.atlas import AtlasGrid, AtlasOptions
 from .core.constraints import CONSTRAINT_NAMES, CheckResult, check
 from .core.manipulator import HomePoseWarning, Manipulator
 from .core.orientation import (
@@ -18,11 +20,13 @@ from .core.orientation import (
 )
 from .core.projected import ProjectedWorkspace, projected_workspace
 from .errors import (
+    AtlasError,
     ConfigError,
     GeometryError,
     HexapodWorkspaceError,
     InputError,
     LogReadError,
+    MissingExtraError,
     RecordingError,
     ResolutionError,
     UnreachableReferenceError,
@@ -32,6 +36,9 @@ __version__ = "0.1.0"
 
 __all__ = [
     "CONSTRAINT_NAMES",
+    "AtlasError",
+    "AtlasGrid",
+    "AtlasOptions",
     "CheckResult",
     "ConfigError",
     "GeometryError",
@@ -40,6 +47,7 @@ __all__ = [
     "InputError",
     "LogReadError",
     "Manipulator",
+    "MissingExtraError",
     "OrientationSlice",
     "OrientationWorkspace",
     "ProjectedWorkspace",
@@ -51,4 +59,5 @@ __all__ = [
     "orientation_workspace",
     "projected_workspace",
     "torsion_range",
+    "workspace_atlas",
 ]

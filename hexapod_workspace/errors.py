@@ -7,11 +7,13 @@ An unreachable *pose* is a result, never an exception.
 from __future__ import annotations
 
 __all__ = [
+    "AtlasError",
     "ConfigError",
     "GeometryError",
     "HexapodWorkspaceError",
     "InputError",
     "LogReadError",
+    "MissingExtraError",
     "RecordingError",
     "ResolutionError",
     "UnreachableReferenceError",
@@ -48,3 +50,11 @@ class RecordingError(HexapodWorkspaceError):
 
 class LogReadError(HexapodWorkspaceError):
     """An MCAP log could not be read (missing, truncated beyond use, or not a log)."""
+
+
+class MissingExtraError(HexapodWorkspaceError, ImportError):
+    """An optional extra (e.g. ``atlas``: Dask, xarray, Zarr) is not installed."""
+
+
+class AtlasError(HexapodWorkspaceError):
+    """An atlas run cannot start or go on: store conflict, unreachable scheduler, no workers."""

@@ -58,9 +58,77 @@ def _is_field(name: str) -> bool:
     return not name.startswith("_") and not name.isupper() and name != EMPTY_MEMBER
 
 
+def read_with_rosbags_documented(path: Path) -> list[tuple[str, str, Any]]:
+    """(topic, type, decoded) as rosbags' documentation reads a bag: ``AnyReader`` with the
+    default typestore (ROS 2 Jazzy) plus the log's own definitions, then
+    ``reader.deserialize(raw, connection.msgtype)``, nothing else."""
+    from rosbags.typesys import Stores, get_typestore
+
+    out = []
+    with AnyReader([Path(path)], default_typestore=get_typestore(Stores.ROS2_JAZZY)) as reader:
+        for connection, _, raw in reader.messages():
+            out.append(
+                (connection.topic, connection.msgtype, reader.deserialize(raw, connection.msgtype))
+            )
+    return out
+
+
+FOXGLOVE = Path(__file__).resolve().parent / "foxglove"
+
+
+def read_with_foxglove(path: Path, tmp_path: Path) -> dict[str, Any]:
+    """{topic: {schema, count, messages}} as Foxglove's own libraries read the log
+    (``test/foxglove/check_log.mjs``: @mcap/core, @foxglove/rosmsg,
+    @foxglove/rosmsg2-serialization, pinned by test/foxglove/package-lock.json).
+
+    Fails the test when a channel is refused or a message does not decode. Skips when the
+    npm packages are not installed, unless ``HEXAPOD_REQUIRE_FOXGLOVE`` is set (``make test``
+    sets it after ``npm ci``).
+    """
+    import json
+    import os
+    import shutil
+    import subprocess
+
+    import pytest
+
+    node = shutil.which("node")
+    if node is None or not (FOXGLOVE / "node_modules" / "@mcap" / "core").is_dir():
+        if os.environ.get("HEXAPOD_REQUIRE_FOXGLOVE"):
+            pytest.fail("node or test/foxglove/node_modules missing (run npm ci in test/foxglove)")
+        pytest.skip("Foxglove's libraries not installed (npm ci in test/foxglove)")
+    out = tmp_path / "foxglove.json"
+    done = subprocess.run(
+        [node, str(FOXGLOVE / "check_log.mjs"), str(path), str(out)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    return json.loads(out.read_text())
+
+
+def foxglove_form(value: Any) -> Any:
+    """What :func:`plain` gives, in the JSON form check_log.mjs writes: bytes as lists of ints,
+    non-finite floats as strings."""
+    if isinstance(value, dict):
+        return {k: foxglove_form(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [foxglove_form(v) for v in value]
+    if isinstance(value, bytes):
+        return list(value)
+    if isinstance(value, float) and math.isinf(value):
+        return "infinity" if value > 0 else "-infinity"
+    return value
+
+
 def read_with_rosbags(path: Path) -> list[tuple[str, str, Any]]:
     """(topic, type, decoded) of a finished log with rosbags' AnyReader and the log's own
-    schemas (an independent typestore)."""
+    schemas (an independent typestore). Channels of the old form (``pkg/srv/X_Request``,
+    which rosbags files under ``pkg/srv/msg/X_Request``) are looked up under rosbags' name;
+    :func:`read_with_rosbags_documented` is what a user following rosbags' documentation
+    does."""
     out = []
     with AnyReader([Path(path)]) as reader:
         for connection, _, raw in reader.messages():

@@ -1,4 +1,4 @@
-"""projected, orientation, torsion-range and demo through a real subprocess."""
+"""projected, orientation, torsion-range, demo and the help, in-process (``main(argv, out=)``)."""
 
 from __future__ import annotations
 
@@ -6,16 +6,16 @@ import json
 import math
 
 import pytest
-from cli_support import run_cli
+from cli_support import one_error_line, run_main
 
-from hexapod_workspace import check
+from hexapod_workspace import check, torsion_range
 
 
 def test_projected_json_fields_and_plot(tmp_path):
     plot = tmp_path / "projected.png"
-    done = run_cli("--json", "projected", "--n-phi", "36", "--plot", str(plot))
-    assert done.returncode == 0, done.stderr
-    document = json.loads(done.stdout)
+    code, out, err = run_main("--json", "projected", "--n-phi", "36", "--plot", str(plot))
+    assert code == 0, err
+    document = json.loads(out)
     for key in (
         "phi_deg",
         "theta_deg",
@@ -33,10 +33,11 @@ def test_projected_json_fields_and_plot(tmp_path):
     assert document["phi_deg"][1] == pytest.approx(10.0)
     assert document["tilt_min_deg"] == pytest.approx(min(document["theta_deg"]))
     assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert err == f"plot: {plot}\n"  # JSON mode: nothing else on stdout
 
 
 def test_projected_exact_reports_the_gap(example):
-    done = run_cli(
+    code, out, err = run_main(
         "--json",
         "projected",
         "--method",
@@ -48,8 +49,8 @@ def test_projected_exact_reports_the_gap(example):
         "0.2",
         "-0.95",
     )
-    assert done.returncode == 0, done.stderr
-    document = json.loads(done.stdout)
+    assert code == 0, err
+    document = json.loads(out)
     assert document["method"] == "exact"
     assert len(document["torsion_zero_gap_deg"]) == 24
     assert min(document["torsion_zero_gap_deg"]) >= 0.0
@@ -64,20 +65,54 @@ def test_projected_exact_reports_the_gap(example):
     assert check(example, angles, [0.2, 0.2, -0.95]).reachable.all()
 
 
-def test_projected_text_output():
-    done = run_cli("projected", "--n-phi", "24")
-    assert done.returncode == 0
-    assert "tilt range:" in done.stdout
-    assert "solid angle" in done.stdout
+def test_projected_text_says_the_table_is_thinned():
+    code, out, _ = run_main("projected", "--n-phi", "360")
+    assert code == 0
+    assert "tilt range:" in out and "solid angle" in out
+    assert "boundary, every 30th of the 360 azimuths (12 rows; --json gives all):" in out
+    lines = out.splitlines()
+    table = lines[lines.index(next(r for r in lines if r.endswith("limiting"))) + 1 :]
+    assert len(table) == 12
+    assert len({r.index(".") for r in table}) == 1  # phi column aligned
+    code, out, _ = run_main("projected", "--n-phi", "8")
+    assert "boundary (8 azimuths):" in out
+
+
+@pytest.mark.parametrize("name", ["plot.txt", "plot"])
+def test_plot_name_must_say_the_format_before_any_work(tmp_path, name):
+    """Item 3/9: no result, then a traceback; a refused name costs nothing."""
+    code, out, err = run_main("projected", "--plot", str(tmp_path / name))
+    assert (code, out) == (2, "")
+    assert "--plot: expected a file name ending in .png or .pdf or .svg" in one_error_line(err)
+
+
+def test_plot_into_a_folder_or_a_missing_folder_is_refused(tmp_path):
+    code, _, err = run_main("orientation", "--plot", str(tmp_path))
+    assert code == 2 and "is a folder; give a file name such as" in one_error_line(err)
+    code, _, err = run_main("orientation", "--plot", str(tmp_path / "new" / "o.png"))
+    assert code == 2 and "does not exist" in one_error_line(err)
+    other = tmp_path / "notes.png"
+    other.write_text("my notes")
+    code, _, err = run_main("projected", "--n-phi", "12", "--plot", str(other))
+    assert code == 2 and "not replaced (use --force)" in one_error_line(err)
+
+
+def test_plot_formats_and_the_printed_path_is_the_file_written(tmp_path):
+    for name in ("p.svg", "p.pdf"):
+        plot = tmp_path / name
+        code, out, err = run_main("projected", "--n-phi", "12", "--plot", str(plot))
+        assert code == 0, err
+        assert f"plot: {plot}\n" in out
+        assert plot.stat().st_size > 1000
 
 
 def test_orientation_json_fields(tmp_path):
     plot = tmp_path / "orientation.png"
-    done = run_cli(
+    code, out, err = run_main(
         "--json", "orientation", "--n-rays", "24", "--psi-step-deg", "10", "--plot", str(plot)
     )
-    assert done.returncode == 0, done.stderr
-    document = json.loads(done.stdout)
+    assert code == 0, err
+    document = json.loads(out)
     for key in ("psi_min_deg", "psi_max_deg", "volume", "slices", "position", "elapsed_s"):
         assert key in document
     assert document["psi_min_deg"] < 0 < document["psi_max_deg"]
@@ -90,62 +125,117 @@ def test_orientation_json_fields(tmp_path):
     assert plot.stat().st_size > 10_000
 
 
+def test_orientation_text_says_what_the_zero_slice_numbers_are():
+    """Item 12: the psi = 0 slice's tilts come from rays from the slice centre, not from
+    theta = 0 as in `projected`; the text says so and gives the centre."""
+    code, out, _ = run_main("--position", "0.2", "0.2", "-0.95", "orientation", "--n-rays", "36")
+    assert code == 0
+    assert "boundary points\n    (rays from the slice centre (" in out
+    assert "`projected` samples the same boundary along\n    azimuths from theta = 0" in out
+
+
 def test_torsion_range_json_is_exact_shape():
-    done = run_cli("--json", "torsion-range", "--direction", "30", "20")
-    assert done.returncode == 0, done.stderr
-    document = json.loads(done.stdout)
+    code, out, err = run_main("--json", "torsion-range", "--direction", "30", "20")
+    assert code == 0, err
+    document = json.loads(out)
     assert set(document) == {"direction_deg", "intervals_deg"}
     assert document["direction_deg"] == [30.0, 20.0]
     ((low, high),) = document["intervals_deg"]
     assert low < 0 < high
 
 
-def test_torsion_range_none_feasible_exit_1():
-    done = run_cli("--json", "torsion-range", "--direction", "0", "80")
-    assert done.returncode == 1
-    assert json.loads(done.stdout)["intervals_deg"] == []
+def test_torsion_range_of_a_huge_azimuth_is_that_of_its_principal_value(example):
+    """Item 1: phi = 1e20 deg denotes 280 deg; 1e20 rad in the API denotes its own value."""
+    _, out, _ = run_main("--json", "torsion-range", "--direction", "1e20", "10")
+    _, reference, _ = run_main("--json", "torsion-range", "--direction", "280", "10")
+    assert json.loads(out)["direction_deg"] == [1e20, 10.0]
+    ((low, high),) = json.loads(out)["intervals_deg"]
+    assert [low, high] == pytest.approx(json.loads(reference)["intervals_deg"][0], abs=1e-6)
+    huge = torsion_range(example, 1e20, 0.3).intervals
+    principal = torsion_range(example, math.atan2(math.sin(1e20), math.cos(1e20)), 0.3).intervals
+    assert huge.shape == principal.shape and huge.ravel() == pytest.approx(
+        principal.ravel(), abs=1e-5
+    )
+
+
+def test_torsion_range_none_feasible_exit_1_reason_on_stderr():
+    code, out, err = run_main("--json", "torsion-range", "--direction", "0", "80")
+    assert code == 1
+    assert json.loads(out)["intervals_deg"] == []
+    assert (
+        err == "hexapod-workspace: no torsion is feasible for direction phi 0 deg, theta 80 deg\n"
+    )
 
 
 def test_unreachable_reference_exit_1_with_reason():
-    done = run_cli("--json", "--position", "0", "0", "-0.5", "orientation")
-    assert done.returncode == 1
-    document = json.loads(done.stdout)
+    code, out, err = run_main("--json", "--position", "0", "0", "-0.5", "orientation")
+    assert code == 1
+    document = json.loads(out)
     assert document["reference_reachable"] is False
     assert "unreachable" in document["reason"]
-    assert "workspace is empty" in done.stderr
+    assert "workspace is empty" in err
 
 
 @pytest.mark.parametrize(
     ("args", "reason"),
     [
-        (["projected", "--n-phi", "1000000"], "n_phi: expected 3 to 7200 rays"),
-        (["projected", "--n-phi", "2"], "n_phi: expected 3 to 7200 rays"),
-        (["projected", "--tol-deg", "0"], "tolerance: expected"),
-        (["projected", "--tol-deg", "nan"], "--tol-deg: expected finite"),
-        (["orientation", "--psi-step-deg", "0"], "psi_step: expected"),
+        # Item 5: the flag's own words and units.
+        (["projected", "--n-phi", "1000000"], "--n-phi: expected 3 to 7200, got 1000000"),
+        (["projected", "--n-phi", "2"], "--n-phi: expected 3 to 7200, got 2"),
+        (["projected", "--tol-deg", "0"], "--tol-deg: expected 5.73e-11 to 5.73 degrees, got 0"),
+        (["projected", "--tol-deg", "10"], "--tol-deg: expected 5.73e-11 to 5.73 degrees, got 10"),
+        (["projected", "--tol-deg", "nan"], "--tol-deg: expected finite numbers (degrees)"),
+        (["orientation", "--psi-step-deg", "0"], "--psi-step-deg: expected 0.00573 to 28.6 deg"),
         (["orientation", "--n-rays", "7200", "--psi-step-deg", "0.01"], "boundary points"),
-        (["torsion-range", "--direction", "0", "200"], "theta in [0, pi]"),
+        (["torsion-range", "--direction", "0", "200"], "--direction: expected THETA in [0, 180]"),
+        (["torsion-range", "--direction", "0", "10", "--tol-deg", "-1e-3"], "--tol-deg"),
         (["projected", "--method", "paper"], "invalid choice"),
+        # Item 13: options that would be ignored are refused.
+        (["--position", "0", "0", "-1.3", "demo"], "demo: --position does not apply"),
+        (["replay", "x.mcap", "--config", "c.yaml"], "unrecognized arguments: --config"),
+        (["--config", "c.yaml", "replay", "x.mcap"], "replay: --config does not apply"),
     ],
 )
 def test_absurd_requests_exit_2(args, reason):
-    done = run_cli(*args)
-    assert done.returncode == 2
-    assert reason in done.stderr
-    assert len(done.stderr.strip().splitlines()) == 1
-    assert done.stdout == ""
+    code, out, err = run_main(*args)
+    assert (code, out) == (2, "")
+    assert reason in one_error_line(err)
+    if any(arg.endswith("-deg") for arg in args):
+        assert " rad" not in err and "tolerance:" not in err and "psi_step:" not in err
+
+
+def test_help_describes_every_option_and_shows_defaults():
+    import contextlib
+    import io
+
+    from hexapod_workspace.cli.main import COMMANDS, build_parser
+
+    parser = build_parser()
+    for name in COMMANDS:
+        text = io.StringIO()
+        with contextlib.redirect_stdout(text), pytest.raises(SystemExit):
+            parser.parse_args([name, "--help"])
+        assert "--json" in text.getvalue()
+    for name, options in {
+        "projected": ["--method", "--n-phi", "--tol-deg"],
+        "orientation": ["--n-rays", "--psi-step-deg", "--tol-deg"],
+    }.items():
+        sub = next(a for a in parser._actions if a.dest == "command").choices[name]
+        for action in sub._actions:
+            if set(action.option_strings) & set(options):
+                assert action.help and "default" in action.help, action.option_strings
 
 
 def test_no_progress_bar_when_stderr_is_not_a_terminal():
-    done = run_cli("projected", "--n-phi", "12")
-    assert "[#" not in done.stderr
+    _, _, err = run_main("projected", "--n-phi", "12")
+    assert "[#" not in err
 
 
-def test_demo_writes_table_plots_and_log(tmp_path):
-    out = tmp_path / "demo"
-    done = run_cli("demo", "--out", str(out), timeout=600)
-    assert done.returncode == 0, done.stderr
-    names = {path.name for path in out.iterdir()}
+def test_demo_writes_table_plots_and_a_log_with_real_times(tmp_path):
+    out_dir = tmp_path / "deep" / "demo"  # --out is created with its parents
+    code, out, err = run_main("demo", "--out", str(out_dir))
+    assert code == 0, err
+    names = {path.name for path in out_dir.iterdir()}
     assert {
         "results.md",
         "results.json",
@@ -155,11 +245,22 @@ def test_demo_writes_table_plots_and_log(tmp_path):
         "orientation_on_axis.png",
         "orientation_off_axis.png",
     } <= names
-    rows = json.loads((out / "results.json").read_text())
+    rows = json.loads((out_dir / "results.json").read_text())
     assert [row["case"] for row in rows] == ["on_axis", "off_axis"]
     for row in rows:
         assert row["tilt_min_deg"] <= row["exact_tilt_min_deg"]
         assert row["psi_min_deg"] < 0 < row["psi_max_deg"]
-    assert "| on_axis |" in done.stdout
-    replay = run_cli("--json", "replay", str(out / "demo.mcap"))
-    assert replay.returncode == 0, replay.stderr
+    assert "| on_axis |" in out
+    code, out, err = run_main("--json", "replay", str(out_dir / "demo.mcap"))
+    assert code == 0, err
+    report = json.loads(out)
+    # Item 14: each result at the time it was computed, not one timestamp for all.
+    times = [w["time_s"] for w in report["workspaces"]]
+    assert len(times) == 6 and times == sorted(times)
+    total = sum(sum(row["elapsed_s"].values()) for row in rows)
+    assert report["duration_s"] >= 0.9 * total > 0.0
+    # A second run replaces the demo's own files; a foreign file is kept without --force.
+    (out_dir / "results.md").write_text("my notes")
+    code, _, err = run_main("demo", "--out", str(out_dir))
+    assert code == 2 and "results.md exists and is not the demo's" in one_error_line(err)
+    assert (out_dir / "results.md").read_text() == "my notes"

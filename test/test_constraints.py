@@ -240,8 +240,8 @@ def test_large_batches_cross_chunk_boundaries(example, rng):
         ([[0.0, math.nan, 0.0]], None, "angles: expected finite values, pose 0"),
         ([[0.0, 0.0, math.inf]], None, "angles: expected finite values"),
         ([[0.0, 0.0]], None, r"angles: expected shape \(N, 3\)"),
-        ([0.0, 0.0, 0.0], [0.0, 0.0], r"position: expected 3 values"),
-        ([0.0, 0.0, 0.0], [0.0, math.nan, -1.0], "position: expected finite values"),
+        ([0.0, 0.0, 0.0], [0.0, 0.0], r"position: expected 3 finite values"),
+        ([0.0, 0.0, 0.0], [0.0, math.nan, -1.0], "position: expected 3 finite values"),
     ],
 )
 def test_bad_input_is_refused(example, angles, position, message):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 import textwrap
 import warnings
 
@@ -23,7 +24,7 @@ def test_example_loads_with_defaults_from_the_home_pose(example):
     assert example.base_joints.shape == (6, 3)
     assert example.platform_joints.shape == (6, 3)
     np.testing.assert_allclose(np.linalg.norm(example.base_joint_axes, axis=1), 1.0)
-    # Default axes: the leg directions at the home pose (DESIGN.md section 2).
+    # Default axes: the leg directions at the home pose (README, Conventions).
     legs = example.home_position + example.platform_joints - example.base_joints
     directions = legs / np.linalg.norm(legs, axis=1, keepdims=True)
     np.testing.assert_allclose(example.base_joint_axes, directions)
@@ -244,3 +245,82 @@ def test_yaml_example_is_commented():
                 "limits:",
                 "pose:",
             }, textwrap.shorten(line, 60)
+
+
+# ---------------------------------------------------------------------------- unknown names
+def _write(tmp_path, parameters: dict, extra: str = "") -> object:
+    lines = ["hexapod_workspace:", "  ros__parameters:"]
+    lines += [f"    {name}: {value!r}" for name, value in parameters.items()]
+    path = tmp_path / "params.yaml"
+    path.write_text("\n".join(lines) + "\n" + extra)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("name", "reason"),
+    [
+        ("limitz.leg_length_min", "limitz: unknown section (expected one of check, frame_id, "),
+        ("limits.leg_lenght_min", "limits.leg_lenght_min: unknown parameter (expected one of "),
+        ("resolution.n_phy", "resolution.n_phy: unknown parameter (expected one of resolution."),
+        ("frame_id.x", "frame_id: expected a value, got a section"),
+        ("recordings.enabled", "recordings: unknown section"),
+    ],
+)
+def test_unknown_names_in_a_file_are_named_at_their_level(tmp_path, example, name, reason):
+    """Item 7: every level of the file is checked; a misspelt section is named."""
+    parameters = {**example.to_parameters(), name: 1.0}
+    with pytest.raises(ConfigError, match=re.escape(reason)):
+        Manipulator.from_params_file(_write(tmp_path, parameters))
+
+
+def test_node_and_ros_parameters_are_known_in_a_file(tmp_path, example):
+    parameters = {
+        **example.to_parameters(),
+        "resolution.n_phi": 90,
+        "recording.enabled": False,
+        "use_sim_time": False,
+        "qos_overrides./hexapod_workspace/reachability.publisher.depth": 5,
+    }
+    assert Manipulator.from_params_file(_write(tmp_path, parameters)) == example
+
+
+def test_unknown_key_next_to_ros__parameters(tmp_path, example):
+    path = _write(tmp_path, example.to_parameters(), "  ros_parameters:\n    frame_id: x\n")
+    with pytest.raises(ConfigError, match="unknown key 'ros_parameters' in section"):
+        Manipulator.from_params_file(path)
+
+
+@pytest.mark.parametrize("name", ["geometry.base_joints", "limits.leg_length_max", "pose.position"])
+def test_lengths_beyond_a_million_metres_are_refused(example_parameters, name):
+    """Item 2: margins must stay finite numbers; absurd geometry is refused with its name."""
+    parameters = dict(example_parameters)
+    value = np.array(parameters.get(name, [1.0]), dtype=float)
+    parameters[name] = (value * 1e300).tolist()
+    with pytest.raises(GeometryError, match=re.escape(f"{name}: expected values within")):
+        Manipulator.from_mapping(parameters)
+
+
+def test_example_from_any_working_directory(tmp_path, monkeypatch, example):
+    """Item 20: the README's API snippet uses the packaged example, not a relative path."""
+    monkeypatch.chdir(tmp_path)
+    assert Manipulator.example() == example
+
+
+def test_a_clone_named_like_the_package_does_not_shadow_it(tmp_path):
+    """Item 20: Python started in the folder above a clone named hexapod_workspace imports the
+    package (editable install in compat mode), not the clone as an empty namespace package."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    (tmp_path / "hexapod_workspace").symlink_to(root, target_is_directory=True)
+    done = subprocess.run(
+        [sys.executable, "-c", "from hexapod_workspace import Manipulator; print(Manipulator)"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -13,6 +12,8 @@ from hexapod_workspace import logs
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import constraints
 from hexapod_workspace.core.manipulator import Manipulator
+from hexapod_workspace.core.orientation import OrientationSlice, OrientationWorkspace
+from hexapod_workspace.core.projected import ProjectedWorkspace
 from hexapod_workspace.core.resolution import WorkspaceKind
 from hexapod_workspace.logs import messages
 
@@ -28,11 +29,11 @@ def check_result(manipulator: Manipulator) -> constraints.CheckResult:
     return constraints.check(manipulator, angles)
 
 
-def projected_stub(method: str = "torsion_zero", n: int = 36) -> SimpleNamespace:
-    """A projected workspace with the attributes of API.md (no algorithm needed)."""
+def projected_stub(method: str = "torsion_zero", n: int = 36) -> ProjectedWorkspace:
+    """A projected workspace built by hand (no algorithm needed): a real result dataclass."""
     phi = np.linspace(-math.pi, math.pi, n, endpoint=False)
     theta = 0.5 + 0.1 * np.cos(3 * phi)
-    return SimpleNamespace(
+    return ProjectedWorkspace(
         method=method,
         position=np.array([0.0, 0.0, 1.2]),
         phi=phi,
@@ -47,26 +48,16 @@ def projected_stub(method: str = "torsion_zero", n: int = 36) -> SimpleNamespace
     )
 
 
-def orientation_stub() -> SimpleNamespace:
-    rows = []
-    for psi in (-0.1, 0.0, 0.1):
-        phi = np.linspace(-math.pi, math.pi, 8, endpoint=False)
-        theta = np.full(8, 0.4)
-        rows.append(
-            np.column_stack(
-                (
-                    theta * np.cos(phi),
-                    theta * np.sin(phi),
-                    np.full(8, psi),
-                    phi,
-                    theta,
-                    np.full(8, psi),
-                )
-            )
-        )
-    points = np.vstack(rows)
-    return SimpleNamespace(
+def orientation_stub() -> OrientationWorkspace:
+    """An orientation workspace of three circular slices built by hand: a real dataclass."""
+    phi = np.linspace(-math.pi, math.pi, 8, endpoint=False)
+    slices = [
+        OrientationSlice(psi=psi, center=np.zeros(2), phi=phi, theta=np.full(8, 0.4))
+        for psi in (-0.1, 0.0, 0.1)
+    ]
+    return OrientationWorkspace(
         position=np.array([0.0, 0.0, 1.2]),
+        slices=slices,
         psi_min=-0.1,
         psi_max=0.1,
         volume=0.05,
@@ -74,7 +65,6 @@ def orientation_stub() -> SimpleNamespace:
         psi_step=0.1,
         tolerance=1e-5,
         elapsed=0.2,
-        boundary_points=lambda: points,
     )
 
 

@@ -6,24 +6,35 @@ own schemas, and mcap + mcap_ros2) and compared with what was written, after dec
 
 from __future__ import annotations
 
+import io
 import signal
 import subprocess
 import sys
 import textwrap
 import threading
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 import yaml
 from mcap.reader import make_reader
-from recording_support import plain, read_with_mcap_ros2, read_with_rosbags, write_foreign_log
+from recording_support import (
+    foxglove_form,
+    plain,
+    read_with_foxglove,
+    read_with_mcap_ros2,
+    read_with_rosbags,
+    read_with_rosbags_documented,
+    write_foreign_log,
+)
 from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Rosbag2Writer
 from rosbags.rosbag2.metadata import parse_qos
 
 from hexapod_workspace import logs
 from hexapod_workspace._resources import data_dir, example_config_path
+from hexapod_workspace.cli.replay import run_replay
 from hexapod_workspace.core import constraints
 from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.errors import LogReadError, RecordingError
@@ -34,7 +45,8 @@ CLOUD = "sensor_msgs/msg/PointCloud2"
 
 
 def sample_messages() -> list[tuple[str, str, str, dict]]:
-    """(topic, type, qos, fields) of every kind the node records, from real check results."""
+    """(topic, type, qos, fields) of every topic and every service the node records, in the
+    recorded form (service parts as their message twins), from real check results."""
     manipulator = Manipulator.from_params_file(example_config_path())
     angles = np.radians([[0.0, 0.0, 0.0], [30.0, 20.0, 5.0], [45.0, 80.0, 10.0]])
     result = constraints.check(manipulator, angles)
@@ -51,7 +63,6 @@ def sample_messages() -> list[tuple[str, str, str, dict]]:
     )
     topics, types = messages.TOPICS, messages.TYPES
     check_req, check_resp = logs.service_topics(topics["check_poses"])
-    trig_req, trig_resp = logs.service_topics(topics["compute_projected_workspace"])
     cw_req, cw_resp = logs.service_topics(topics["compute_workspace"])
     return [
         (
@@ -88,33 +99,50 @@ def sample_messages() -> list[tuple[str, str, str, dict]]:
             messages.pointcloud_fields(points, frame_id="base", stamp_ns=10),
         ),
         (
+            topics["orientation_workspace"],
+            types["orientation_workspace"],
+            logs.RESULT_QOS,
+            messages.pointcloud_fields(points[:20], frame_id="base", stamp_ns=12),
+        ),
+        (
             check_req,
-            types["check_poses"] + "_Request",
+            logs.recorded_type(types["check_poses"] + "_Request"),
             logs.SERVICE_QOS,
             messages.check_poses_request_fields(result.position, angles),
         ),
         (
             check_resp,
-            types["check_poses"] + "_Response",
+            logs.recorded_type(types["check_poses"] + "_Response"),
             logs.SERVICE_QOS,
             messages.check_poses_response_fields(result),
         ),
-        (trig_req, "std_srvs/srv/Trigger_Request", logs.SERVICE_QOS, {}),
-        (
-            trig_resp,
-            "std_srvs/srv/Trigger_Response",
-            logs.SERVICE_QOS,
-            {"success": True, "message": "projected workspace: tilt 0..30 deg"},
+        *(
+            item
+            for service in ("compute_projected_workspace", "compute_orientation_workspace")
+            for item in (
+                (
+                    logs.service_topics(topics[service])[0],
+                    logs.recorded_type("std_srvs/srv/Trigger_Request"),
+                    logs.SERVICE_QOS,
+                    {},
+                ),
+                (
+                    logs.service_topics(topics[service])[1],
+                    logs.recorded_type("std_srvs/srv/Trigger_Response"),
+                    logs.SERVICE_QOS,
+                    {"success": True, "message": f"{service}: done"},
+                ),
+            )
         ),
         (
             cw_req,
-            types["compute_workspace"] + "_Request",
+            logs.recorded_type(types["compute_workspace"] + "_Request"),
             logs.SERVICE_QOS,
             {"request": messages.workspace_request_fields(2, [0, 0, 1])},
         ),
         (
             cw_resp,
-            types["compute_workspace"] + "_Response",
+            logs.recorded_type(types["compute_workspace"] + "_Response"),
             logs.SERVICE_QOS,
             messages.compute_workspace_response_fields(
                 None, stamp_ns=10, frame_id="base", summary=summary
@@ -417,6 +445,12 @@ def test_corrupt_chunk_is_skipped_and_reported(tmp_path: Path) -> None:
     contents = logs.read_log(path)
     assert [m.message.request_id for m in contents.messages] == ["request-0", "request-2"]
     assert any("corrupt" in p for p in contents.problems)
+    # Item 15: finished (it has its footer), but damaged, and replay says so with exit 1.
+    assert contents.finished and contents.damaged
+    out, err = io.StringIO(), io.StringIO()
+    assert run_replay(path, stdout=out, stderr=err) == 1
+    assert out.getvalue().startswith(f"log: {path} (finished, but damaged: read as far as intact)")
+    assert "is damaged; everything intact was read" in err.getvalue()
 
 
 def test_unknown_types_are_skipped_with_a_note(tmp_path: Path) -> None:
@@ -441,3 +475,57 @@ def test_not_a_log(tmp_path: Path) -> None:
     empty_dir.mkdir()
     with pytest.raises(LogReadError, match="without metadata.yaml"):
         logs.read_log(empty_dir)
+
+
+def test_every_channel_decodes_as_rosbags_documents_it(finished_log) -> None:
+    """Item 18: AnyReader with the default store plus the log's definitions, then
+    ``reader.deserialize(raw, connection.msgtype)``: every channel, services included."""
+    path, written = finished_log
+    decoded = [(t, m, plain(msg)) for t, m, msg in read_with_rosbags_documented(path)]
+    assert decoded == written
+    assert not any("/srv/" in msgtype for _, msgtype, _ in decoded)
+
+
+def test_every_channel_opens_in_foxglove(finished_log, tmp_path) -> None:
+    """Item 19: Foxglove's own libraries open every channel (no empty schema but
+    std_msgs/Empty) and decode every message to what was written."""
+    path, written = finished_log
+    opened = read_with_foxglove(path, tmp_path)
+    assert set(opened) == {topic for topic, _, _ in written}
+    for topic, msgtype, _ in written:
+        assert opened[topic]["schema"] == msgtype
+    for topic in opened:
+        expected = [foxglove_form(f) for t, _, f in written if t == topic]
+        got = opened[topic]["messages"]
+        assert len(got) == len(expected), topic
+        for message, want in zip(got, expected, strict=True):
+            message.pop("structure_needs_at_least_one_member", None)
+            assert _close(message, want), (topic, message, want)
+
+
+def _close(got: Any, want: Any) -> bool:
+    """Equal, floats to 1e-6 relative (float32 fields come back as float32 in JS)."""
+    if isinstance(want, dict):
+        return set(got) == set(want) and all(_close(got[k], want[k]) for k in want)
+    if isinstance(want, list):
+        return len(got) == len(want) and all(_close(g, w) for g, w in zip(got, want, strict=True))
+    if isinstance(want, float) and isinstance(got, (int, float)):
+        return got == pytest.approx(want, rel=1e-6, abs=1e-12)
+    return got == want
+
+
+def test_service_parts_and_their_recorded_twins_have_the_same_bytes() -> None:
+    """The node records the service's own CDR bytes under the message twin: same fields, same
+    bytes, so recording needs no re-serialisation."""
+    for part, twin in logs.typestore.RECORDED_TYPES.items():
+        assert logs.service_part(twin) in (part, twin)
+    for _, msgtype, _, fields in sample_messages():
+        part = logs.service_part(msgtype)
+        if part != msgtype:
+            assert bytes(logs.serialize(part, fields)) == bytes(logs.serialize(msgtype, fields))
+    empty = logs.serialize("std_srvs/srv/Trigger_Request", {})
+    assert bytes(empty) == bytes(logs.serialize("std_msgs/msg/Empty", {}))
+    # An empty structure other than std_msgs/Empty says what it is on the wire.
+    assert logs.message_definition("std_srvs/srv/Trigger_Request") == (
+        "uint8 structure_needs_at_least_one_member\n"
+    )

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import importlib.util
 import io
 import json
@@ -20,6 +21,7 @@ from test_messages import orientation_stub, projected_stub
 from hexapod_workspace import logs
 from hexapod_workspace.cli.replay import run_replay
 from hexapod_workspace.core import constraints
+from hexapod_workspace.core.orientation import OrientationSlice
 from hexapod_workspace.logs import messages
 from hexapod_workspace.logs.record import record_results
 from hexapod_workspace.logs.summary import summarize_log
@@ -80,16 +82,17 @@ def test_recorded_cli_messages_equal_what_was_built(tmp_path: Path, check_result
     """The --record log decodes with rosbags and mcap_ros2 to the dicts messages.py built."""
     path = tmp_path / "cli.mcap"
     workspace = projected_stub()
-    record_results(path, [check_result, workspace], frame_id="base", stamp_ns=5_000)
+    record_results(path, [check_result, workspace], frame_id="base", stamps_ns=[5_000, 7_000])
     points = messages.boundary_points(workspace)
+    answered = 7_000 + round(workspace.elapsed * 1e9)  # the response, elapsed after the request
     expected = [
         messages.check_poses_request_fields(check_result.position, check_result.angles),
         messages.check_poses_response_fields(check_result),
         messages.compute_workspace_request_fields(workspace, stamp_ns=7_000, frame_id="base")[
             "request"
         ],
-        messages.summary_fields(workspace, stamp_ns=8_000, frame_id="base", n_points=36),
-        messages.pointcloud_fields(points, frame_id="base", stamp_ns=8_000),
+        messages.summary_fields(workspace, stamp_ns=answered, frame_id="base", n_points=36),
+        messages.pointcloud_fields(points, frame_id="base", stamp_ns=answered),
     ]
     for reader in (read_with_rosbags, read_with_mcap_ros2):
         assert [plain(message) for _, _, message in reader(path)] == plain(expected)
@@ -170,8 +173,8 @@ def test_cli_record_then_replay(tmp_path: Path) -> None:
 
 
 def test_plot_redraws_overlaid_methods_and_degenerate_workspaces(tmp_path: Path) -> None:
-    single_point = orientation_stub()
-    single_point.boundary_points = lambda: np.array([[0.1, 0.0, 0.0, 0.0, 0.1, 0.0]])
+    one = OrientationSlice(psi=0.0, center=np.zeros(2), phi=np.zeros(1), theta=np.full(1, 0.1))
+    single_point = dataclasses.replace(orientation_stub(), slices=[one])
     path = record_results(
         tmp_path / "stubs.mcap",
         [projected_stub("exact"), projected_stub(), orientation_stub(), single_point],
@@ -213,9 +216,13 @@ def test_truncated_logs(tmp_path: Path, check_result) -> None:
     half = tmp_path / "half.mcap"
     half.write_bytes(data[: len(data) // 2])
     code, out, err = replay(half, as_json=True)
-    assert code == 0 and err.startswith("note: half.mcap: unreadable from about byte")
+    # Item 15: a damaged log is reported as damaged, exit 1, after everything intact.
+    assert code == 1 and err.startswith("note: half.mcap: unreadable from about byte")
+    assert err.splitlines()[-1].endswith(
+        "is damaged; everything intact was read (see the notes above)"
+    )
     report = json.loads(out)
-    assert not report["finished"] and report["problems"]
+    assert not report["finished"] and report["damaged"] and report["problems"]
     assert report["message_count"] >= 2
 
 
@@ -302,6 +309,7 @@ def test_publish_without_rclpy_says_so(tmp_path: Path, monkeypatch) -> None:
     assert code == 2 and "needs rclpy" in err.splitlines()[-1]
 
 
+@pytest.mark.skipif(not HAVE_RCLPY, reason="the refusal is the ROS layer's; needs rclpy")
 def test_publish_refuses_network_discovery(tmp_path: Path, monkeypatch) -> None:
     monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "SUBNET")
     path = tmp_path / "a.mcap"
@@ -371,3 +379,77 @@ def test_publish_republishes_recorded_clouds(tmp_path: Path, monkeypatch) -> Non
         assert [plain(m) for m in received] == plain(clouds)
     finally:
         rclpy.try_shutdown(context=context)
+
+
+@pytest.mark.skipif(
+    not HAVE_RCLPY,
+    reason="rclpy not importable: run under the ROS venv (make test) to exercise replay --publish",
+)
+def test_publish_counts_only_what_went_out(tmp_path: Path, monkeypatch) -> None:
+    """Item 16: messages of a type this ROS environment lacks are named and not counted as
+    republished (before: "12 not republished", then "republished 18 messages")."""
+    import importlib
+
+    with pytest.raises(ImportError):
+        importlib.import_module("visualization_msgs.msg")  # in rosbags' Jazzy store, not here
+    monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+    assert os.environ.get("ROS_DOMAIN_ID"), "tests that start rclpy need a test ROS_DOMAIN_ID"
+    path = tmp_path / "mixed.mcap"
+    cloud = messages.pointcloud_fields(np.zeros((3, 6)), frame_id="base", stamp_ns=1)
+    status = {"u": 0.5, "v": 0.25}
+    with logs.LogWriter(path) as writer:
+        for i in range(3):
+            writer.write_fields("/mixed/cloud", "sensor_msgs/msg/PointCloud2", cloud, 10 + i)
+        for i in range(2):
+            writer.write_fields(
+                "/mixed/status", "visualization_msgs/msg/UVCoordinate", status, 20 + i
+            )
+    code, _, err = replay(path, publish=True, rate=0.0)
+    assert code == 0, err
+    assert (
+        "note: /mixed/status: type visualization_msgs/msg/UVCoordinate is not available in this "
+        "ROS environment; its 2 message(s) are not republished" in err
+    )
+    assert err.splitlines()[-1] == (
+        "republished 3 of 5 messages on 1 topics (2 not republished, see the notes above)"
+    )
+
+
+def test_plotting_leaves_matplotlib_global_state_alone(tmp_path: Path) -> None:
+    """Finding 8: no backend switch and no pyplot on import or use; axis beyond the curves."""
+    import subprocess
+    import sys
+
+    script = f"""
+import sys
+import matplotlib
+matplotlib.use("svg")
+sys.path.insert(0, {str(Path(__file__).parent)!r})
+from test_messages import orientation_stub, projected_stub
+from hexapod_workspace.cli import plotting
+plotting.plot_projected([projected_stub(), projected_stub("exact")], {str(tmp_path / "p.png")!r})
+plotting.plot_orientation(orientation_stub(), {str(tmp_path / "o.png")!r})
+print(matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules)
+"""
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=120, check=False
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["svg", "False"]
+    assert (tmp_path / "p.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_projected_plot_radial_axis_clears_the_largest_tilt(tmp_path: Path) -> None:
+    """Item 17: the curves never lie on the frame, and no radial label sits on a curve."""
+    from hexapod_workspace.cli import plotting
+
+    workspaces = [projected_stub(), projected_stub("exact")]
+    largest = max(np.degrees(w.theta).max() for w in workspaces)
+    step = plotting._nice_step(largest, 5)
+    top = step * math.ceil(largest * 1.1 / step)
+    assert top >= 1.1 * largest
+    ticks = np.arange(step, top - step / 2, step)
+    curves = [(np.mod(np.degrees(w.phi), 360.0), np.degrees(w.theta)) for w in workspaces]
+    angle = plotting._label_angle(curves, ticks)
+    assert angle % 45.0 == 22.5
+    assert plotting.plot_projected(workspaces, tmp_path / "p.png").stat().st_size > 10_000

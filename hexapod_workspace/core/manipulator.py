@@ -17,7 +17,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import ConfigError, GeometryError
-from .params import flatten, load_params_file
+from .constraints import check
+from .params import NODE_PARAMETERS, ROS_PARAMETERS, flatten, load_params_file, unknown_parameter
+from .resolution import MAX_POSITION_NORM
 
 __all__ = ["PARAMETER_DEFAULTS", "HomePoseWarning", "Manipulator"]
 
@@ -65,8 +67,17 @@ def _numbers(name: str, value: Any) -> NDArray[np.float64]:
     return array
 
 
+def _length(name: str, array: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Refuse lengths (m) beyond MAX_POSITION_NORM, where margins would stop being finite."""
+    if array.size and float(np.max(np.abs(array))) > MAX_POSITION_NORM:
+        shown = _describe(array.tolist())
+        msg = f"{name}: expected values within ±{MAX_POSITION_NORM:g} m, got {shown}"
+        raise GeometryError(msg)
+    return array
+
+
 def _joint_array(name: str, value: Any) -> NDArray[np.float64]:
-    array = _numbers(name, value)
+    array = _length(name, _numbers(name, value))
     if array.size != 18:
         msg = f"{name}: expected 18 numbers (6 joints × x, y, z), got {array.size}"
         raise GeometryError(msg)
@@ -74,7 +85,7 @@ def _joint_array(name: str, value: Any) -> NDArray[np.float64]:
 
 
 def _vector3(name: str, value: Any) -> NDArray[np.float64]:
-    array = _numbers(name, value)
+    array = _length(name, _numbers(name, value))
     if array.size != 3:
         msg = f"{name}: expected 3 numbers (x, y, z), got {array.size}"
         raise GeometryError(msg)
@@ -211,8 +222,14 @@ class Manipulator:
         )
         home = _vector3("geometry.home_position", values["geometry.home_position"])
         position = _vector3("pose.position", values["pose.position"])
-        length_min = _per_leg("limits.leg_length_min", values["limits.leg_length_min"])
-        length_max = _per_leg("limits.leg_length_max", values["limits.leg_length_max"])
+        length_min = _length(
+            "limits.leg_length_min",
+            _per_leg("limits.leg_length_min", values["limits.leg_length_min"]),
+        )
+        length_max = _length(
+            "limits.leg_length_max",
+            _per_leg("limits.leg_length_max", values["limits.leg_length_max"]),
+        )
         if np.any(length_min < 0.0):
             msg = f"limits.leg_length_min: expected values >= 0 m, got {length_min.min():g}"
             raise GeometryError(msg)
@@ -235,7 +252,9 @@ class Manipulator:
                 )
                 raise GeometryError(msg)
             angles[name] = angle
-        diameter = _numbers("limits.leg_diameter", values["limits.leg_diameter"])
+        diameter = _length(
+            "limits.leg_diameter", _numbers("limits.leg_diameter", values["limits.leg_diameter"])
+        )
         if diameter.size != 1:
             msg = f"limits.leg_diameter: expected one number, got {diameter.size}"
             raise GeometryError(msg)
@@ -290,18 +309,46 @@ class Manipulator:
         """Build a manipulator from a ROS 2 parameters file (root key ``hexapod_workspace``
         or ``/**``).
 
+        Every name in the file must be known: the model's, the node's (``resolution.*``,
+        ``check.*``, ``recording.*``, read by the node only) or ROS's own (``use_sim_time``,
+        ...). A misspelt name is reported at its own level (``limitz: unknown section``).
+
         Parameters
         ----------
         path : str or pathlib.Path
-            YAML parameters file, as in DESIGN.md section 4.
+            YAML parameters file, as in the README's section *ROS 2 node*, *Parameters*.
         warn : bool
             See :meth:`from_mapping`.
 
         Returns
         -------
         Manipulator
+
+        Raises
+        ------
+        ConfigError
+            Unreadable file, unknown names, or a model :meth:`from_mapping` refuses.
         """
-        return cls.from_mapping(load_params_file(path), warn=warn)
+        parameters = load_params_file(path)
+        unknown = unknown_parameter(
+            parameters, (*PARAMETER_DEFAULTS, *NODE_PARAMETERS, *ROS_PARAMETERS)
+        )
+        if unknown is not None:
+            msg = f"parameters file {path}: {unknown}"
+            raise ConfigError(msg)
+        return cls.from_mapping(parameters, warn=warn)
+
+    @classmethod
+    def example(cls, *, warn: bool = True) -> Manipulator:
+        """The packaged example GPM (``config/example_gpm.yaml``), from any working directory.
+
+        Returns
+        -------
+        Manipulator
+        """
+        from .._resources import example_config_path
+
+        return cls.from_params_file(example_config_path(), warn=warn)
 
     # ------------------------------------------------------------------ views
     def to_parameters(self) -> dict[str, Any]:
@@ -347,8 +394,6 @@ class Manipulator:
 
     def home_pose_violations(self) -> list[str]:
         """Names of the constraints violated at the home pose (home position, identity)."""
-        from .constraints import check
-
         result = check(self, np.zeros((1, 3)), self.home_position)
         return result.violated[0]
 

@@ -1,6 +1,6 @@
 """3-D orientation workspace (ψ slices in the cylindrical picture) and torsion ranges.
 
-Cylindrical picture (DESIGN.md section 1): x = θ cos φ, y = θ sin φ, z = ψ. The orientation
+Cylindrical picture (README, *Conventions*): x = θ cos φ, y = θ sin φ, z = ψ. The orientation
 workspace at a position is the set of reachable (x, y, ψ) connected to the reference
 orientation (0, 0, 0). It is computed as in Bonev & Ryu, with every boundary located to a
 tolerance by the certified search of :mod:`hexapod_workspace.core.search`:
@@ -46,6 +46,9 @@ from .resolution import (
     validate_tolerance,
 )
 from .search import RaySearch
+
+#: numpy >= 2 names it trapezoid; numpy 1.x (Ubuntu 24.04's python3-numpy 1.26) trapz.
+_trapezoid = getattr(np, "trapezoid", None) or np.trapz  # noqa: NPY201
 
 __all__ = [
     "OrientationSlice",
@@ -383,7 +386,7 @@ def orientation_workspace(
     slices = lower[:0:-1] + upper
     areas = np.array([piece.area() for piece in slices])
     psis = np.array([piece.psi for piece in slices])
-    volume = float(np.trapezoid(areas, psis)) if len(slices) > 1 else 0.0
+    volume = float(_trapezoid(areas, psis)) if len(slices) > 1 else 0.0
     # Cones from the end slices to the extreme torsions (area shrinking to zero).
     volume += 0.5 * areas[-1] * (psi_max - psis[-1]) + 0.5 * areas[0] * (psis[0] - psi_min)
     if progress:

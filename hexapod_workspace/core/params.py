@@ -8,17 +8,42 @@ to the node's dotted parameter names (``geometry.base_joints``, ...);
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
 
-__all__ = ["NODE_NAME", "flatten", "load_params_file"]
+__all__ = [
+    "NODE_NAME",
+    "NODE_PARAMETERS",
+    "ROS_PARAMETERS",
+    "flatten",
+    "load_params_file",
+    "unknown_parameter",
+]
 
 #: The node name, and the root key the CLI looks for in a parameters file.
 NODE_NAME = "hexapod_workspace"
 _ROOT_KEYS = (NODE_NAME, f"/{NODE_NAME}", "/**")
+
+#: Parameters the node declares besides the manipulator model (``Manipulator.PARAMETER_DEFAULTS``).
+#: A parameters file may carry them; the CLI ignores them, but refuses any name it does not know
+#: so that a misspelt section (``limitz:``) is named instead of reported as a missing parameter.
+#: ``test/ros`` checks that the node declares exactly these.
+NODE_PARAMETERS = (
+    "resolution.n_phi",
+    "resolution.n_rays",
+    "resolution.psi_step",
+    "resolution.tolerance",
+    "resolution.projected_method",
+    "check.max_poses",
+    "check.max_command_age",
+    "recording.enabled",
+    "recording.directory",
+)
+#: Parameters every ROS 2 node has (prefixes end with a dot).
+ROS_PARAMETERS = ("use_sim_time", "start_type_description_service", "qos_overrides.")
 
 
 def load_params_file(path: str | Path) -> dict[str, Any]:
@@ -70,6 +95,13 @@ def load_params_file(path: str | Path) -> dict[str, Any]:
         ):
             msg = f"parameters file {path}: section {key!r} has no 'ros__parameters' mapping"
             raise ConfigError(msg)
+        extra = sorted(str(name) for name in section if name != "ros__parameters")
+        if extra:
+            msg = (
+                f"parameters file {path}: unknown key {extra[0]!r} in section {key!r} "
+                "(expected only 'ros__parameters')"
+            )
+            raise ConfigError(msg)
         found = True
         merged.update(flatten(section["ros__parameters"]))
     if not found:
@@ -105,3 +137,47 @@ def flatten(parameters: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
         else:
             flat[name] = value
     return flat
+
+
+def unknown_parameter(names: Iterable[str], known: Iterable[str]) -> str | None:
+    """Describe the first name of ``names`` that is not a known parameter, at its own level.
+
+    Parameters
+    ----------
+    names : iterable of str
+        Dotted parameter names, as :func:`flatten` gives them.
+    known : iterable of str
+        Every accepted dotted name; a name ending with ``.`` accepts everything under it.
+
+    Returns
+    -------
+    str or None
+        ``"limitz: unknown section (expected one of ...)"`` when the first level is unknown,
+        ``"limits.leg_lenght_min: unknown parameter (expected one of limits.leg_length_min,
+        ...)"`` when a deeper one is; None when every name is known.
+    """
+    known = tuple(known)
+    exact = {name for name in known if not name.endswith(".")}
+    prefixes = tuple(name for name in known if name.endswith("."))
+    for name in sorted(names):
+        if name in exact or name.startswith(prefixes):
+            continue
+        parts = name.split(".")
+        for depth in range(1, len(parts) + 1):
+            stem = ".".join(parts[:depth])
+            if stem in exact:
+                return f"{stem}: expected a value, got a section (holding {name})"
+            below = [k for k in known if k == stem or k.startswith(stem + ".")]
+            if below:
+                continue
+            level = ".".join(parts[: depth - 1])
+            siblings = sorted(
+                {
+                    ".".join(k.rstrip(".").split(".")[:depth])
+                    for k in known
+                    if not level or k.startswith(level + ".")
+                }
+            )
+            what = "section" if depth < len(parts) else "parameter"
+            return f"{stem}: unknown {what} (expected one of {', '.join(siblings)})"
+    return None

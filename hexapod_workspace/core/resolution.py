@@ -28,6 +28,7 @@ __all__ = [
     "DEFAULT_PSI_STEP",
     "DEFAULT_TOLERANCE",
     "MAX_POINTS",
+    "MAX_POSITION_NORM",
     "MAX_PSI_STEP",
     "MAX_RAYS",
     "MAX_SLICES",
@@ -100,6 +101,11 @@ MAX_SLICES = 20_000
 #: Largest number of boundary points (slices × rays) one orientation workspace may produce.
 MAX_POINTS = 5_000_000
 
+#: Largest accepted distance |OC| of a position from the base origin, m. Far beyond any
+#: machine (legs are metres long), and small enough that every squared length, leg direction and
+#: margin computed from it stays a finite number.
+MAX_POSITION_NORM = 1e6
+
 #: Default azimuths of the projected workspace.
 DEFAULT_N_PHI = 360
 #: Default rays per slice of the orientation workspace.
@@ -124,30 +130,48 @@ def validate_rays(count: int, name: str) -> int:
     return int(count)
 
 
+def _bounded(value: float, low: float, high: float, name: str) -> float:
+    """``value`` as a float when finite and within [low, high] rad, else ResolutionError."""
+    number = float(value)
+    if not (math.isfinite(number) and low <= number <= high):
+        msg = f"{name}: expected {low:g} to {high:g} rad, got {value!r}"
+        raise ResolutionError(msg)
+    return number
+
+
 def validate_tolerance(tolerance: float, name: str = "tolerance") -> float:
     """Check a boundary tolerance (rad) against [:data:`MIN_TOLERANCE`, :data:`MAX_TOLERANCE`]."""
-    value = float(tolerance)
-    if not (math.isfinite(value) and MIN_TOLERANCE <= value <= MAX_TOLERANCE):
-        msg = f"{name}: expected {MIN_TOLERANCE:g} to {MAX_TOLERANCE:g} rad, got {tolerance!r}"
-        raise ResolutionError(msg)
-    return value
+    return _bounded(tolerance, MIN_TOLERANCE, MAX_TOLERANCE, name)
 
 
 def validate_psi_step(psi_step: float, name: str = "psi_step") -> float:
     """Check a slice step Δψ (rad) against [:data:`MIN_PSI_STEP`, :data:`MAX_PSI_STEP`]."""
-    value = float(psi_step)
-    if not (math.isfinite(value) and MIN_PSI_STEP <= value <= MAX_PSI_STEP):
-        msg = f"{name}: expected {MIN_PSI_STEP:g} to {MAX_PSI_STEP:g} rad, got {psi_step!r}"
-        raise ResolutionError(msg)
-    return value
+    return _bounded(psi_step, MIN_PSI_STEP, MAX_PSI_STEP, name)
 
 
 def validate_position(manipulator: Manipulator, position: ArrayLike | None) -> NDArray[np.float64]:
-    """The position to use (default ``manipulator.position``), checked: shape (3,), finite, m."""
+    """The position to use (default ``manipulator.position``), checked: shape (3,), finite, m.
+
+    Raises
+    ------
+    InputError
+        Not 3 values, NaN or infinite values, or farther than :data:`MAX_POSITION_NORM` from
+        the base origin (where margins would stop being finite numbers).
+    """
     if position is None:
         return np.array(manipulator.position)
-    array = np.asarray(position, dtype=np.float64)
+    try:
+        array = np.asarray(position, dtype=np.float64)
+    except (TypeError, ValueError) as error:
+        msg = f"position: expected 3 numbers (x, y, z) in m, got {position!r}"
+        raise InputError(msg) from error
     if array.shape != (3,) or not np.all(np.isfinite(array)):
         msg = f"position: expected 3 finite values (x, y, z) in m, got {np.ravel(array).tolist()}"
+        raise InputError(msg)
+    if not float(np.linalg.norm(array)) <= MAX_POSITION_NORM:
+        msg = (
+            f"position: expected a distance from the base origin of at most "
+            f"{MAX_POSITION_NORM:g} m, got {array.tolist()}"
+        )
         raise InputError(msg)
     return array

@@ -1,6 +1,6 @@
 """Tilt-and-Torsion angles and the other orientation representations, batch-first.
 
-Conventions (DESIGN.md section 1): the Tilt-and-Torsion (T&T) angles (φ, θ, ψ) of Bonev & Ryu
+Conventions (README, "Conventions"): the Tilt-and-Torsion (T&T) angles (φ, θ, ψ) of Bonev & Ryu
 define ``R(φ, θ, ψ) = Rz(φ) · Ry(θ) · Rz(−φ) · Rz(ψ)``, the orientation of the mobile frame
 relative to the base frame, with φ ∈ (−π, π] (azimuth of the tilt axis), θ ∈ [0, π] (tilt) and
 ψ ∈ [−π, π] (torsion). The same rotation in ZYZ Euler angles is (φ, θ, ψ − φ). The *approach
@@ -10,6 +10,10 @@ At θ = 0 the T&T representation is singular: φ and ψ merge and ``R = Rz(ψ)``
 here is defined there: the forward maps need no special case and the inverse maps return φ = 0
 and the whole rotation in ψ. At θ = π (tool pointing straight down) the approach vector has no
 azimuth either; the inverse maps return φ = 0 there too.
+
+Any finite angle denotes one orientation, however large: every function here takes the sine and
+cosine of each input angle (numpy reduces the argument exactly) before angles are combined, so
+``φ = 1e20`` rad is the orientation of ``1e20 mod 2π``, never a rounding of ``ψ − φ``.
 
 Quaternions are ``(x, y, z, w)``, scalar last, as in ROS ``geometry_msgs/Quaternion``.
 All functions take arrays of any leading shape ``(...)`` and broadcast like numpy.
@@ -24,6 +28,7 @@ from ..errors import InputError
 
 __all__ = [
     "approach_vector",
+    "degrees_to_radians",
     "matrix_to_quaternion",
     "matrix_to_tt",
     "quaternion_to_matrix",
@@ -57,12 +62,16 @@ def _matrices(matrix: ArrayLike) -> NDArray[np.float64]:
 
 
 def wrap_angle(angle: ArrayLike) -> NDArray[np.float64]:
-    """Wrap angles into (−π, π].
+    """Wrap angles into (−π, π] (their principal values).
+
+    Angles already in [−π, π] are returned unchanged (bit for bit, except −π -> π); larger ones
+    are reduced through their sine and cosine, which numpy evaluates with exact argument
+    reduction, so even ``1e300`` rad gives the principal value of the angle it denotes.
 
     Parameters
     ----------
     angle : array_like, shape (...)
-        Angles in rad.
+        Angles in rad, any finite values.
 
     Returns
     -------
@@ -70,8 +79,37 @@ def wrap_angle(angle: ArrayLike) -> NDArray[np.float64]:
         The same angles in (−π, π], rad.
     """
     angle = np.asarray(angle, dtype=np.float64)
-    wrapped = np.remainder(angle + np.pi, 2.0 * np.pi) - np.pi
+    inside = np.abs(angle) <= np.pi
+    if np.all(inside):
+        wrapped = angle
+    else:
+        wrapped = np.where(inside, angle, np.arctan2(np.sin(angle), np.cos(angle)))
     return np.where(wrapped == -np.pi, np.pi, wrapped)
+
+
+def degrees_to_radians(degrees: ArrayLike) -> NDArray[np.float64]:
+    """Angles in degrees to their principal values in rad, exactly for any finite value.
+
+    ``np.radians(1e20)`` is 1.745e18 rad with a rounding error of hundreds of radians: it no
+    longer denotes the orientation the user typed. Reducing modulo 360 first is exact in
+    floating point (``fmod`` by an exactly representable 360), so the result is the principal
+    value of the typed angle to the last bit of the conversion.
+
+    Parameters
+    ----------
+    degrees : array_like, shape (...)
+        Angles in degrees, any finite values.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Angles in rad; values in [−180°, 180°] convert unchanged, others land in (−π, π].
+    """
+    degrees = np.asarray(degrees, dtype=np.float64)
+    reduced = np.fmod(degrees, 360.0)  # exact
+    reduced = np.where(reduced > 180.0, reduced - 360.0, reduced)  # exact (same binade or below)
+    reduced = np.where(reduced < -180.0, reduced + 360.0, reduced)
+    return np.radians(np.where(np.abs(degrees) <= 180.0, degrees, reduced))
 
 
 def zyz_to_matrix(zyz: ArrayLike) -> NDArray[np.float64]:
@@ -125,7 +163,7 @@ def tt_to_zyz(angles: ArrayLike) -> NDArray[np.float64]:
     """
     angles = _last_axis(angles, 3, "angles")
     zyz = angles.copy()
-    zyz[..., 2] = wrap_angle(angles[..., 2] - angles[..., 0])
+    zyz[..., 2] = wrap_angle(wrap_angle(angles[..., 2]) - wrap_angle(angles[..., 0]))
     return zyz
 
 
@@ -162,8 +200,25 @@ def tt_to_matrix(angles: ArrayLike) -> NDArray[np.float64]:
         vector.
     """
     angles = _last_axis(angles, 3, "angles")
-    phi = angles[..., 0]
-    return _zyz_matrix(phi, angles[..., 1], angles[..., 2] - phi)
+    phi, theta, psi = angles[..., 0], angles[..., 1], angles[..., 2]
+    # ZYZ (φ, θ, ψ − φ) with cos/sin of ψ − φ from those of φ and ψ: no angle is combined
+    # before its sine and cosine are taken (exact for any finite φ, ψ).
+    cp, sp = np.cos(phi), np.sin(phi)
+    cs, ss = np.cos(psi), np.sin(psi)
+    cb, sb = np.cos(theta), np.sin(theta)
+    cg = cs * cp + ss * sp
+    sg = ss * cp - cs * sp
+    matrix = np.empty((*np.shape(phi), 3, 3))
+    matrix[..., 0, 0] = cp * cb * cg - sp * sg
+    matrix[..., 0, 1] = -cp * cb * sg - sp * cg
+    matrix[..., 0, 2] = cp * sb
+    matrix[..., 1, 0] = sp * cb * cg + cp * sg
+    matrix[..., 1, 1] = -sp * cb * sg + cp * cg
+    matrix[..., 1, 2] = sp * sb
+    matrix[..., 2, 0] = -sb * cg
+    matrix[..., 2, 1] = sb * sg
+    matrix[..., 2, 2] = cb
+    return matrix
 
 
 def matrix_to_tt(matrix: ArrayLike) -> NDArray[np.float64]:
@@ -213,7 +268,11 @@ def tt_to_quaternion(angles: ArrayLike) -> NDArray[np.float64]:
         Quaternions (x, y, z, w), unit norm.
     """
     angles = _last_axis(angles, 3, "angles")
-    phi, theta, psi = angles[..., 0], angles[..., 1], angles[..., 2]
+    phi, theta, psi = (
+        wrap_angle(angles[..., 0]),
+        wrap_angle(angles[..., 1]),
+        wrap_angle(angles[..., 2]),
+    )
     half_tilt_sin, half_tilt_cos = np.sin(theta / 2.0), np.cos(theta / 2.0)
     azimuth = phi - psi / 2.0
     return np.stack(

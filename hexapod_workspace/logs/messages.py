@@ -17,6 +17,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..core.orientation import OrientationWorkspace
+from ..core.projected import ProjectedWorkspace
 from ..core.resolution import WorkspaceKind
 from ..core.rotations import approach_vector
 
@@ -24,8 +26,6 @@ if TYPE_CHECKING:
     from numpy.typing import ArrayLike, NDArray
 
     from hexapod_workspace.core.constraints import CheckResult
-    from hexapod_workspace.core.orientation import OrientationWorkspace
-    from hexapod_workspace.core.projected import ProjectedWorkspace
 
 __all__ = [
     "POINT_FIELD_NAMES",
@@ -255,10 +255,9 @@ def reachability_result_fields(
 
 def workspace_kind(workspace: ProjectedWorkspace | OrientationWorkspace) -> int:
     """The WorkspaceKind of a result (orientation, projected torsion_zero or exact)."""
-    method = getattr(workspace, "method", None)
-    if method is None:
+    if isinstance(workspace, OrientationWorkspace):
         return WorkspaceKind.ORIENTATION
-    return WorkspaceKind.projected(method)
+    return WorkspaceKind.projected(workspace.method)
 
 
 def workspace_request_fields(
@@ -292,7 +291,7 @@ def _request_for(
     frame_id: str,
 ) -> dict[str, Any]:
     kind = workspace_kind(workspace)
-    if kind == WorkspaceKind.ORIENTATION:
+    if isinstance(workspace, OrientationWorkspace):
         n_rays, psi_step = int(workspace.n_rays), float(workspace.psi_step)
     else:
         n_rays, psi_step = int(np.asarray(workspace.phi).shape[0]), 0.0
@@ -333,7 +332,7 @@ def boundary_points(workspace: ProjectedWorkspace | OrientationWorkspace) -> NDA
         Orientation workspace: x, y, z = θ cos φ, θ sin φ, ψ (the cylindrical picture).
         Projected workspace: x, y, z = the unit approach vector of each boundary direction.
     """
-    if workspace_kind(workspace) == WorkspaceKind.ORIENTATION:
+    if isinstance(workspace, OrientationWorkspace):
         return np.asarray(workspace.boundary_points(), dtype=float).reshape(-1, 6)
     phi = np.asarray(workspace.phi, dtype=float)
     theta = np.asarray(workspace.theta, dtype=float)
@@ -395,7 +394,7 @@ def summary_fields(
         )
         return fields
     kind = workspace_kind(workspace) if kind is None else int(kind)
-    if kind == WorkspaceKind.ORIENTATION:
+    if isinstance(workspace, OrientationWorkspace):
         fields.update(
             psi_min=float(workspace.psi_min),
             psi_max=float(workspace.psi_max),
@@ -511,6 +510,7 @@ def pointcloud_to_array(cloud: Any) -> NDArray[np.float64]:
     step = int(_get(cloud, "point_step"))
     order = ">" if bool(_get(cloud, "is_bigendian")) else "<"
     data = _get(cloud, "data")
+    buffer: NDArray[np.uint8]
     if isinstance(data, np.ndarray):
         buffer = np.ascontiguousarray(data).view(np.uint8).reshape(-1)
     else:  # bytes, bytearray, memoryview, array.array("B") of an rclpy message

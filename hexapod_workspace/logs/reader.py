@@ -74,6 +74,10 @@ class LogContents:
         One line per thing that could not be read (truncation, corruption, unknown types).
     finished : bool
         True when every file ended with a valid footer (a cleanly closed log).
+    damaged : bool
+        True when something recorded could not be read: a truncated or corrupt stretch, a
+        chunk failing its CRC, a message that does not decode. (A topic of a type unknown here
+        is skipped with a note but is not damage.)
     start_ns, end_ns : int or None
         Span of the messages read.
     """
@@ -83,6 +87,7 @@ class LogContents:
     topics: dict[str, TopicInfo] = field(default_factory=dict)
     problems: list[str] = field(default_factory=list)
     finished: bool = True
+    damaged: bool = False
     start_ns: int | None = None
     end_ns: int | None = None
     messages: list[LogMessage] = field(default_factory=list)
@@ -143,6 +148,7 @@ def _records(path: Path, contents: LogContents) -> Iterator[Any]:
                 break
             except Exception as err:  # any failure to frame or parse a record is damage
                 contents.finished = False
+                contents.damaged = True
                 reason = str(err) or type(err).__name__
                 contents.problems.append(
                     f"{path.name}: unreadable from about byte {offset} on ({reason}); "
@@ -153,6 +159,7 @@ def _records(path: Path, contents: LogContents) -> Iterator[Any]:
                 try:
                     yield from breakup_chunk(record, validate_crc=True)
                 except Exception as err:  # any failure to frame or parse a record is damage
+                    contents.damaged = True
                     contents.problems.append(
                         f"{path.name}: a chunk of {record.uncompressed_size} bytes near byte "
                         f"{offset} is corrupt ({err}); its messages are skipped"
@@ -163,6 +170,7 @@ def _records(path: Path, contents: LogContents) -> Iterator[Any]:
             yield record
         if not saw_footer:
             contents.finished = False
+            contents.damaged = True
 
 
 def iter_log(
@@ -255,6 +263,7 @@ def iter_log(
                 f"{count} message(s) skipped"
             )
         for topic, count in broken.items():
+            contents.damaged = True
             contents.problems.append(f"{topic}: {count} message(s) could not be decoded")
 
 

@@ -19,6 +19,7 @@ from hexapod_workspace.logs import (
     iter_log,
     message_to_fields,
     messages,
+    service_part,
 )
 
 if TYPE_CHECKING:
@@ -122,7 +123,7 @@ def summarize_log(
         if item.message is None:
             continue
         summary.decoded += 1
-        msgtype = item.msgtype
+        msgtype = service_part(item.msgtype)  # a recorded service part, or a log of old form
         if msgtype in (_SUMMARY, _WORKSPACE_RESPONSE):
             fields = message_to_fields(item.message)
             points = None

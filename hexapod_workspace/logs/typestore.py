@@ -1,7 +1,35 @@
 """The type store of the logs: rosbags' Jazzy store plus hexapod_workspace_msgs and std_srvs.
 
 Schema text (``ros2msg``, full concatenated definitions), RIHS01 type hashes, the rosbag2 QoS
-profile text of each channel, and the topics a recorded service call uses.
+profile text of each channel, and how a service call is recorded.
+
+How service calls are recorded
+------------------------------
+A call of service ``S`` is two messages: its request on ``S/request`` and its response on
+``S/response`` (:func:`service_topics`), in the order they happened. Their channel types are
+*message* types (``pkg/msg/...``) with exactly the fields, and so the very CDR bytes, of the
+service's ``_Request`` and ``_Response`` (:func:`recorded_type`):
+
+(``pkg`` = ``hexapod_workspace_msgs``)
+
+=================================  ==================================
+service part                       recorded as
+=================================  ==================================
+``pkg/srv/CheckPoses_Request``     ``pkg/msg/CheckPosesRequest``
+``pkg/srv/CheckPoses_Response``    ``pkg/msg/CheckPosesResponse``
+``pkg/srv/ComputeWorkspace_...``   ``pkg/msg/ComputeWorkspace...`` (same suffix)
+``std_srvs/srv/Trigger_Request``   ``std_msgs/msg/Empty``
+``std_srvs/srv/Trigger_Response``  ``pkg/msg/TriggerResponse``
+=================================  ==================================
+
+Why message types: rosbags files a type ``pkg/srv/X_Request`` under ``pkg/srv/msg/X_Request``,
+so its documented ``reader.deserialize(raw, connection.msgtype)`` cannot find any ``srv``-named
+channel (rosbag2's own service events, ``pkg/srv/X_Event``, included). Foxglove refuses an empty
+``ros2msg`` schema unless it is ``std_msgs/Empty``, which is what ``Trigger_Request`` (an empty
+structure) is on the wire. With message types every tool decodes every channel: rosbags with its
+documented API, mcap_ros2, Foxglove (``@mcap/core``, ``@foxglove/rosmsg2-serialization``), and
+``ros2 bag play`` can republish them, because the types exist in the interface package.
+Logs written before this choice (``srv``-named channels) are still read here.
 """
 
 from __future__ import annotations
@@ -39,6 +67,8 @@ ROS_DISTRO = "jazzy"
 # std_srvs ships no .msg/.srv files in the pip wheels and rosbags' stores hold no services.
 _EXTRA_SERVICES = {"std_srvs/srv/Trigger": "---\nbool success\nstring message\n"}
 _EMPTY_FIELD = "structure_needs_at_least_one_member"
+#: The only types whose ros2msg schema may be empty (what Foxglove accepts as empty).
+_EMPTY_SCHEMA_NAMES = ("std_msgs/msg/Empty", "std_msgs/Empty")
 _DTYPES = {
     "bool": np.bool_,
     "byte": np.uint8,
@@ -59,6 +89,46 @@ _DTYPES = {
 # --------------------------------------------------------------------------- type store
 
 
+#: The message type each service part is recorded as (see the module docstring).
+RECORDED_TYPES = {
+    f"{INTERFACE_PACKAGE}/srv/CheckPoses_Request": f"{INTERFACE_PACKAGE}/msg/CheckPosesRequest",
+    f"{INTERFACE_PACKAGE}/srv/CheckPoses_Response": f"{INTERFACE_PACKAGE}/msg/CheckPosesResponse",
+    f"{INTERFACE_PACKAGE}/srv/ComputeWorkspace_Request": (
+        f"{INTERFACE_PACKAGE}/msg/ComputeWorkspaceRequest"
+    ),
+    f"{INTERFACE_PACKAGE}/srv/ComputeWorkspace_Response": (
+        f"{INTERFACE_PACKAGE}/msg/ComputeWorkspaceResponse"
+    ),
+    "std_srvs/srv/Trigger_Request": "std_msgs/msg/Empty",
+    "std_srvs/srv/Trigger_Response": f"{INTERFACE_PACKAGE}/msg/TriggerResponse",
+}
+
+
+def recorded_type(msgtype: str) -> str:
+    """Return the type a log records ``msgtype`` as: a service part's message twin, else itself.
+
+    Parameters
+    ----------
+    msgtype : str
+        A ROS type name, e.g. ``"std_srvs/srv/Trigger_Response"`` or
+        ``"sensor_msgs/msg/PointCloud2"``.
+
+    Returns
+    -------
+    str
+        ``"hexapod_workspace_msgs/msg/TriggerResponse"``, or ``msgtype`` unchanged.
+    """
+    return RECORDED_TYPES.get(msgtype, msgtype)
+
+
+def service_part(msgtype: str) -> str:
+    """Return the service part (``pkg/srv/X_Request``) a recorded type stands for, else itself."""
+    for part, recorded in RECORDED_TYPES.items():
+        if recorded == msgtype and not recorded.startswith("std_msgs/"):
+            return part
+    return msgtype
+
+
 def service_topics(service_name: str) -> tuple[str, str]:
     """Return the topics a service's requests and responses are recorded on.
 
@@ -70,8 +140,8 @@ def service_topics(service_name: str) -> tuple[str, str]:
     Returns
     -------
     (str, str)
-        ``("<service>/request", "<service>/response")``; their types are the generated
-        ``<pkg>/srv/<Name>_Request`` and ``<pkg>/srv/<Name>_Response``.
+        ``("<service>/request", "<service>/response")``; their types are
+        ``recorded_type("<pkg>/srv/<Name>_Request")`` and ``..._Response``.
     """
     return f"{service_name}/request", f"{service_name}/response"
 
@@ -163,7 +233,12 @@ def message_definition(msgtype: str) -> str:
     if store_name(msgtype) not in store.fielddefs:
         msg = f"unknown ROS type {msgtype!r}"
         raise KeyError(msg)
-    return store.generate_msgdef(store_name(msgtype), ros_version=2)[0]
+    text = store.generate_msgdef(store_name(msgtype), ros_version=2)[0]
+    if not text and msgtype not in _EMPTY_SCHEMA_NAMES:
+        # An empty structure is one uint8 on the wire (rosidl's filler); say so, as Foxglove
+        # refuses an empty schema for any type but std_msgs/Empty.
+        text = f"uint8 {_EMPTY_FIELD}\n"
+    return text
 
 
 @functools.cache

@@ -16,9 +16,11 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
+from rclpy.task import Future
+
 from .worker import CanceledError, WorkspaceJob, WorkspaceWorker
 
-__all__ = ["JobQueue", "Ticket"]
+__all__ = ["JobQueue", "Ticket", "completion", "in_thread"]
 
 #: The stages a ticket goes through (the action's feedback ``stage``).
 QUEUED, COMPUTING, PUBLISHING, DONE = "queued", "computing", "publishing", "done"
@@ -176,3 +178,45 @@ class JobQueue:
         self.completed += 1
         ticket.report(1.0)
         ticket._finish(outcome)
+
+
+def completion(node: Any) -> tuple[Future, Callable[..., None]]:
+    """A future a coroutine callback of ``node`` can await, and the function another thread
+    calls to complete it: ``complete(value)`` or ``complete(error=exception)``. Completing wakes
+    the node's executor, which then resumes the coroutine."""
+    executor = node.executor
+    future: Future = Future(executor=executor)
+
+    def complete(value: Any = None, error: BaseException | None = None) -> None:
+        if error is None:
+            future.set_result(value)
+        else:
+            future.set_exception(error)
+        if executor is not None:
+            executor.wake()
+
+    return future, complete
+
+
+def in_thread(node: Any, callback: Callable[..., Any]) -> Callable[..., Any]:
+    """A coroutine version of a blocking callback of ``node`` (an action's execute callback, a
+    slow service): each call runs ``callback`` in a thread of its own while the node's
+    single-threaded executor keeps serving, and resumes when it returns. For extensions whose
+    callbacks block, e.g. ``execute_callback=in_thread(node, execute)``."""
+
+    async def run(*args: Any, **kwargs: Any) -> Any:
+        future, complete = completion(node)
+
+        def target() -> None:
+            try:
+                value = callback(*args, **kwargs)
+            except BaseException as error:  # handed to the awaiting coroutine
+                complete(error=error)
+            else:
+                complete(value)
+
+        name = f"hexapod_workspace_{getattr(callback, '__name__', 'callback')}"
+        threading.Thread(target=target, name=name, daemon=True).start()
+        return await future
+
+    return run

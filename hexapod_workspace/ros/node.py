@@ -71,6 +71,7 @@ from hexapod_workspace.logs import (
     SERVICE_QOS,
     messages,
     qos_profile_text,
+    recorded_type,
     service_topics,
 )
 
@@ -206,8 +207,12 @@ class WorkspaceNode(Node):
     def record_service_channels(self, service_class: type, name: str) -> tuple[str, str]:
         """Register ``<service>/request`` and ``/response`` in the logs; return both topics."""
         request_topic, response_topic = service_topics(self.resolve_service_name(name))
-        self.recorder.add_channel(request_topic, type_name(service_class.Request), SERVICE_QOS)
-        self.recorder.add_channel(response_topic, type_name(service_class.Response), SERVICE_QOS)
+        for topic, part in (
+            (request_topic, service_class.Request),
+            (response_topic, service_class.Response),
+        ):
+            # recorded as the message twin of the service part (same CDR bytes)
+            self.recorder.add_channel(topic, recorded_type(type_name(part)), SERVICE_QOS)
         return request_topic, response_topic
 
     def recorded_service(

@@ -16,13 +16,12 @@ from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
-from hexapod_workspace.logs import (
-    LogMessage,
-)
+from hexapod_workspace.logs.summary import LogSummary
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
-from hexapod_workspace.logs.summary import LogSummary
+
+    from hexapod_workspace.logs import LogMessage
 
 from .conversions import message_class
 
@@ -86,10 +85,12 @@ def publish_log(
         try:
             classes[info.topic] = message_class(info.msgtype)
         except (ImportError, AttributeError, ValueError):
+            count = sum(1 for m in usable if m.topic == info.topic)
             err.write(
-                f"note: {info.topic}: type {info.msgtype} not available in this ROS "
-                "environment; not republished\n"
+                f"note: {info.topic}: type {info.msgtype} is not available in this ROS "
+                f"environment; its {count} message(s) are not republished\n"
             )
+    published = 0
     context = rclpy.Context()
     rclpy.init(context=context)
     try:
@@ -115,10 +116,14 @@ def publish_log(
                 if delay > 0:
                     time.sleep(delay)
             publisher.publish(item.data)  # serialized bytes go out unchanged
+            published += 1
         for publisher in publishers.values():  # let reliable subscribers receive everything
             publisher.wait_for_all_acked(Duration(seconds=5))
         node.destroy_node()
     finally:
         rclpy.try_shutdown(context=context)
-    err.write(f"republished {len(usable)} messages on {len(classes)} topics\n")
+    topics = len({m.topic for m in usable if m.topic in classes})
+    skipped = len(usable) - published
+    note = f" ({skipped} not republished, see the notes above)" if skipped else ""
+    err.write(f"republished {published} of {len(usable)} messages on {topics} topics{note}\n")
     return 0

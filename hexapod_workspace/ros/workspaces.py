@@ -24,7 +24,6 @@ from hexapod_workspace_msgs.action import ComputeWorkspace
 from hexapod_workspace_msgs.msg import WorkspaceRequest, WorkspaceSummary
 from hexapod_workspace_msgs.srv import ComputeWorkspace as ComputeWorkspaceRecord
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
-from rclpy.task import Future
 from sensor_msgs.msg import PointCloud2
 from std_srvs.srv import Trigger
 
@@ -33,7 +32,7 @@ from hexapod_workspace.errors import InputError, UnreachableReferenceError
 from hexapod_workspace.logs import messages
 
 from .conversions import position_from_point, to_message
-from .jobs import JobQueue, Ticket
+from .jobs import JobQueue, Ticket, completion
 from .parameters import RAYS_RANGE
 from .worker import CanceledError, WorkspaceJob
 
@@ -230,15 +229,10 @@ class WorkspaceServer:
         job = self.job(request)
         if isinstance(job, _Failed):
             return self._publish_failure(job.reason, request, n_rays=job.n_rays)
-        future: Future = Future(executor=self._node.executor)
-        executor = self._node.executor
-
-        def done(ticket: Ticket) -> None:
-            future.set_result(ticket.outcome)
-            if executor is not None:
-                executor.wake()
-
-        ticket = self.jobs.submit(Ticket(job, on_done=done, **callbacks))
+        future, complete = completion(self._node)
+        ticket = self.jobs.submit(
+            Ticket(job, on_done=lambda done: complete(done.outcome), **callbacks)
+        )
         if register is not None:
             register(ticket)
         return await future

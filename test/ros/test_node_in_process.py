@@ -240,3 +240,41 @@ def test_an_extension_attaches_with_one_call(ros_context):
         assert node.jobs is node.workspaces.jobs and node.recorder is not None
     finally:
         node.destroy_node()
+
+
+def test_a_blocking_extension_callback_runs_in_a_thread_while_the_executor_serves(ros_context):
+    """in_thread: a blocking callback (the atlas action's execute) does not stop the
+    single-threaded executor; its coroutine resumes with the callback's value (or error)."""
+    import threading
+
+    from rclpy.executors import SingleThreadedExecutor
+
+    from hexapod_workspace.ros.jobs import in_thread
+
+    node = make_node(ros_context)
+    executor = SingleThreadedExecutor(context=ros_context)
+    executor.add_node(node)
+    release = threading.Event()
+    ticks: list[int] = []
+    node.create_timer(0.01, lambda: ticks.append(1))
+
+    def blocking(value):
+        release.wait(10)
+        if value == "bad":
+            raise ValueError("bad value")
+        return value * 2
+
+    try:
+        good = executor.create_task(in_thread(node, blocking), 21)
+        bad = executor.create_task(in_thread(node, blocking), "bad")
+        for _ in range(30):  # the timer keeps firing while both callbacks block
+            executor.spin_once(timeout_sec=0.05)
+        assert len(ticks) >= 5 and not good.done()
+        release.set()
+        with pytest.raises(ValueError, match="bad value"):  # rclpy re-raises a task's error
+            executor.spin_until_future_complete(bad, timeout_sec=10)
+        executor.spin_until_future_complete(good, timeout_sec=10)
+        assert good.result() == 42
+    finally:
+        executor.shutdown()
+        node.destroy_node()

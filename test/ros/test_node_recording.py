@@ -23,20 +23,31 @@ from ros_support import DISCOVERY_TIMEOUT, require_ros, running_node, write_para
 require_ros()
 
 from hexapod_workspace_msgs.msg import (  # noqa: E402
+    CheckPosesRequest,
+    CheckPosesResponse,
     CommandedPose,
+    ComputeWorkspaceRequest,
+    ComputeWorkspaceResponse,
     ReachabilityResult,
     TiltTorsion,
+    TriggerResponse,
     WorkspaceSummary,
 )
 from hexapod_workspace_msgs.srv import CheckPoses, ComputeWorkspace  # noqa: E402
 from sensor_msgs.msg import PointCloud2  # noqa: E402
+from std_msgs.msg import Empty  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 
 from hexapod_workspace import logs  # noqa: E402
 from hexapod_workspace.core.resolution import WorkspaceKind  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # test/recording_support.py
-from recording_support import plain, read_with_mcap_ros2, read_with_rosbags  # noqa: E402
+from recording_support import (  # noqa: E402
+    plain,
+    read_with_foxglove,
+    read_with_mcap_ros2,
+    read_with_rosbags,
+)
 
 #: Every test runs its node in its own namespace: fresh service names, so no client of an earlier
 #: node (already stopped or killed) can swallow a request.
@@ -155,6 +166,13 @@ def test_sigint_log_holds_exactly_what_the_node_did(ros_domain, ros_client, tmp_
     entries = [(m.topic, m.msgtype, m.message) for m in ours.messages]
     for reader_entries in (read_with_rosbags(path), read_with_mcap_ros2(path)):
         assert by_topic(reader_entries) == by_topic(entries)
+    # Every channel of the node's log opens in Foxglove (its own libraries, test/foxglove).
+    # (read_with_foxglove fails on any refused channel, those without messages included.)
+    opened = read_with_foxglove(path, tmp_path)
+    assert set(opened) == set(ours.topics)
+    assert {topic: channel["count"] for topic, channel in opened.items() if channel["count"]} == {
+        topic: len(items) for topic, items in by_topic(entries).items()
+    }
 
     recorded = by_topic(entries)
     assert recorded[f"{node_name}/check_poses/request"] == [plain(check)]
@@ -207,7 +225,7 @@ def test_sigkill_under_a_stream_loses_nothing_older_than_the_flush_bound(
 ) -> None:
     """A 200 Hz CommandedPose stream; SIGKILL at a random point: every result this process
     received more than FLUSH_BOUND s before the kill is in the log, with its command."""
-    from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
     from hexapod_workspace.ros.recorder import FLUSH_BOUND
 
@@ -218,11 +236,15 @@ def test_sigkill_under_a_stream_loses_nothing_older_than_the_flush_bound(
     qos = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE)
     received: dict[str, float] = {}
     with running_node(tmp_path, NODE_PARAMS, args) as node:
-        ros_client.node.create_subscription(
+        ros_client.node.create_subscription(  # transient local: no result lost to discovery
             ReachabilityResult,
             f"{node_name}/reachability",
             lambda m: received.setdefault(m.request_id, time.monotonic()),
-            qos,
+            QoSProfile(
+                history=HistoryPolicy.KEEP_ALL,
+                reliability=ReliabilityPolicy.RELIABLE,
+                durability=DurabilityPolicy.TRANSIENT_LOCAL,
+            ),
         )
         publisher = ros_client.node.create_publisher(
             CommandedPose, f"{node_name}/commanded_pose", qos
@@ -233,6 +255,10 @@ def test_sigkill_under_a_stream_loses_nothing_older_than_the_flush_bound(
             what="the node's command topics",
             timeout=DISCOVERY_TIMEOUT,
         )
+        warm = CommandedPose(request_id=f"k{kill}-warm-up")
+        warm.position.z = -1.3
+        publisher.publish(warm)
+        ros_client.spin_until(lambda: warm.request_id in received, what="the warm-up result")
         kill_after = rng.uniform(1.5, 4.0)  # s of stream before the kill
         start = time.monotonic()
         index = 0
@@ -302,6 +328,13 @@ def test_recorded_type_hashes_are_the_ones_rclpy_announces(ros_client) -> None:
         "std_srvs/srv/Trigger_Request": Trigger.Request,
         "std_srvs/srv/Trigger_Response": Trigger.Response,
         "sensor_msgs/msg/PointCloud2": PointCloud2,
+        # The message twins service calls are recorded as (logs.recorded_type).
+        "hexapod_workspace_msgs/msg/CheckPosesRequest": CheckPosesRequest,
+        "hexapod_workspace_msgs/msg/CheckPosesResponse": CheckPosesResponse,
+        "hexapod_workspace_msgs/msg/ComputeWorkspaceRequest": ComputeWorkspaceRequest,
+        "hexapod_workspace_msgs/msg/ComputeWorkspaceResponse": ComputeWorkspaceResponse,
+        "hexapod_workspace_msgs/msg/TriggerResponse": TriggerResponse,
+        "std_msgs/msg/Empty": Empty,
     }
     for index, (msgtype, message_class) in enumerate(classes.items()):
         topic = f"/type_hash_check/t{index}"

@@ -72,8 +72,11 @@ def node_topics(ros_client, tmp_path_factory):
             }
 
         service = messages.TOPICS["compute_projected_workspace"]
+        action = messages.TOPICS["compute_workspace"] + "/_action/send_goal"
         ros_client.spin_until(
-            lambda: {wanted, service} <= set(offered()), what="the node's interfaces", timeout=60.0
+            lambda: {wanted, service, action, "/diagnostics"} <= set(offered()),
+            what="the node's interfaces",
+            timeout=60.0,
         )
         topics = offered()
         node.stop()

@@ -20,6 +20,7 @@ from rcl_interfaces.msg import Parameter as ParameterMsg  # noqa: E402
 from rcl_interfaces.msg import ParameterType, ParameterValue  # noqa: E402
 from rcl_interfaces.srv import (  # noqa: E402
     DescribeParameters,
+    ListParameters,
     SetParameters,
     SetParametersAtomically,
 )
@@ -88,6 +89,28 @@ def test_check_poses_matches_core(client, model):
     assert 0 < np.count_nonzero(expected.reachable) < len(expected), "need both verdicts"
     response = client.call(CheckPoses, f"{NODE}/check_poses", check_request(angles))
     assert_matches_core(response, expected)
+
+
+def test_check_poses_huge_angles_get_the_verdict_of_their_principal_values(client, model):
+    """Item 1 at the node: phi = 1e300 rad is the orientation of its principal value."""
+    huge = np.array([[1e300, 0.17, 2.6], [0.3, 0.2, -1e20], [1e20, 0.6, 1e20]])
+    principal = np.arctan2(np.sin(huge), np.cos(huge))
+    expected = check(model, principal, model.position)
+    response = client.call(CheckPoses, f"{NODE}/check_poses", check_request(huge))
+    assert response.success, response.message
+    for name in CONSTRAINT_NAMES:
+        got = np.array([getattr(r, f"{name}_margin") for r in response.results])
+        np.testing.assert_allclose(got, expected.margins[name], atol=1e-12)
+    assert [r.reachable for r in response.results] == expected.reachable.tolist()
+
+
+def test_check_poses_huge_position_is_refused_not_answered(client):
+    """Item 2 at the node: no NaN margins with success=true; a refusal with the reason."""
+    request = check_request(np.zeros((1, 3)), (1e300, 0.0, 0.0))
+    response = client.call(CheckPoses, f"{NODE}/check_poses", request)
+    assert not response.success
+    assert "at most 1e+06 m" in response.message
+    assert list(response.results) == []
 
 
 def test_check_poses_at_another_position(client, model):
@@ -267,6 +290,19 @@ def test_parameters_have_descriptors(client):
     assert by_name["resolution.n_rays"].integer_range[0].to_value == 7200
     assert by_name["check.max_poses"].read_only
     assert by_name["frame_id"].read_only
+
+
+def test_a_parameters_file_check_knows_every_parameter_of_the_node(client):
+    """Item 7: the CLI refuses unknown names in a parameters file, so it must know every name
+    the node declares (core.params.NODE_PARAMETERS + the model's + ROS's own), and no more."""
+    from hexapod_workspace.core.manipulator import PARAMETER_DEFAULTS
+    from hexapod_workspace.core.params import NODE_PARAMETERS, ROS_PARAMETERS, unknown_parameter
+
+    listed = client.call(ListParameters, f"{NODE}/list_parameters", ListParameters.Request())
+    names = set(listed.result.names)
+    known = (*PARAMETER_DEFAULTS, *NODE_PARAMETERS, *ROS_PARAMETERS)
+    assert unknown_parameter(names, known) is None
+    assert set(NODE_PARAMETERS) <= names
 
 
 # ---------------------------------------------------------------------------- recording

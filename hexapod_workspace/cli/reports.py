@@ -1,0 +1,507 @@
+"""Everything the CLI prints: tables and JSON documents of results, logs and the demo.
+
+One module for the rendering, so that every command speaks the same units and words: angles in
+degrees (JSON keys carry the unit, ``theta_deg``), lengths in m (tables: mm for margins), and
+margins always called margins (signed distance to the limit: >= 0 holds, < 0 violated).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Sequence
+from typing import IO, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..core.constraints import CONSTRAINT_NAMES, CheckResult
+from ..core.orientation import OrientationWorkspace, TorsionRange
+from ..core.projected import ProjectedWorkspace
+from ..core.resolution import WorkspaceKind
+from ..logs.summary import LogSummary, PoseCheckCall, WorkspaceRecord
+
+__all__ = [
+    "check_json",
+    "check_table",
+    "demo_table",
+    "log_report",
+    "log_report_text",
+    "orientation_json",
+    "orientation_text",
+    "projected_json",
+    "projected_text",
+    "torsion_range_json",
+    "torsion_range_text",
+    "unreachable_json",
+    "write_json",
+]
+
+
+def _degrees(values: Any) -> Any:
+    """Radians to degrees as plain Python floats (lists for arrays)."""
+    converted = np.degrees(values)
+    return converted.tolist() if isinstance(converted, np.ndarray) else float(converted)
+
+
+def _number(value: float, width: int, decimals: int) -> str:
+    """A number in a fixed-width column: fixed-point when it fits, else scientific."""
+    text = f"{value:{width}.{decimals}f}"
+    return (
+        text if len(text) <= width else f"{value:{width}.{max(decimals, 3)}e}"[:width].rjust(width)
+    )
+
+
+def write_json(document: Any, out: IO[str]) -> None:
+    """One JSON document on a line (NaN and infinities refused: callers map them to null)."""
+    out.write(json.dumps(document, allow_nan=False) + "\n")
+
+
+# ---------------------------------------------------------------------------- check
+def _write_rows(out: IO[str], template: str, columns: Sequence[Sequence[Any]], sep: str) -> None:
+    """Write ``template % row`` for the rows of ``columns`` joined by ``sep``, in blocks."""
+    block = 65536
+    count = len(columns[0])
+    for start in range(0, count, block):
+        rows = zip(*(column[start : start + block] for column in columns), strict=True)
+        text = sep.join([template % row for row in rows])
+        out.write(text if start + block >= count else text + sep)
+
+
+def check_json(result: CheckResult, out: IO[str], degrees: NDArray[np.float64]) -> None:
+    """Write ``{"position": [...], "poses": [...]}`` for a check result, streaming.
+
+    One object per pose in input order with ``phi_deg, theta_deg, psi_deg`` (as the user gave
+    them), ``reachable, violated, margins{...}`` (signed, SI: m, rad; null when a check is
+    disabled) and ``limiting_leg``. Numbers carry 12 significant digits.
+
+    Parameters
+    ----------
+    result : CheckResult
+    out : text stream
+    degrees : ndarray, shape (N, 3)
+        The poses as the user gave them, degrees.
+    """
+    texts: dict[tuple[str, ...], str] = {}
+    violated = [texts.setdefault(tuple(v), json.dumps(v)) for v in result.violated]
+    finite = {name: bool(np.all(np.isfinite(result.margins[name]))) for name in CONSTRAINT_NAMES}
+    margins = [
+        result.margins[name].tolist()
+        if finite[name]
+        else ["null" if not math.isfinite(v) else repr(v) for v in result.margins[name].tolist()]
+        for name in CONSTRAINT_NAMES
+    ]
+    # 12 significant digits: exact to 1e-12 relative, and twice as fast to format as repr().
+    margin_fields = ", ".join(
+        f'"{name}": {"%.12g" if finite[name] else "%s"}' for name in CONSTRAINT_NAMES
+    )
+    template = (
+        '{"phi_deg": %.12g, "theta_deg": %.12g, "psi_deg": %.12g, "reachable": %s, "violated": %s, '
+        f'"margins": {{{margin_fields}}}, "limiting_leg": %d}}'
+    )
+    columns = [
+        *np.asarray(degrees).T.tolist(),
+        np.where(result.reachable, "true", "false").tolist(),
+        violated,
+        *margins,
+        result.limiting_leg.tolist(),
+    ]
+    out.write(f'{{"position": {json.dumps(result.position.tolist())}, "poses": [\n')
+    _write_rows(out, template, columns, ",\n")
+    out.write("]}\n")
+
+
+def check_table(result: CheckResult, out: IO[str], degrees: NDArray[np.float64]) -> None:
+    """Write a readable table: angles in degrees, margins (distance to each limit) in mm and
+    degrees, the limiting leg and the violated constraints.
+
+    Parameters are those of :func:`check_json`.
+    """
+    x, y, z = result.position
+    out.write(f"position: ({x:.4f}, {y:.4f}, {z:.4f}) m\n")
+    header = (
+        f"{'':>9} {'':>9} {'':>9}  {'':<9}  {'margin to each limit (>= 0 holds, < 0 violated)'}",
+        f"{'phi':>9} {'theta':>9} {'psi':>9}  {'reachable':<9}  {'leg_length':>11} "
+        f"{'base_joint':>11} {'platform_j':>11} {'interfer.':>11}  {'limiting':>8}  violated",
+        f"{'[deg]':>9} {'[deg]':>9} {'[deg]':>9}  {'':<9}  {'[mm]':>11} {'[deg]':>11} "
+        f"{'[deg]':>11} {'[mm]':>11}  {'leg':>8}",
+    )
+    out.write("".join(line.rstrip() + "\n" for line in header))
+    degrees = np.asarray(degrees)
+    wide = bool(np.any(np.abs(degrees) >= 1e5))
+    angle_columns = (
+        [[_number(v, 9, 3) for v in column] for column in degrees.T.tolist()]
+        if wide
+        else degrees.T.tolist()
+    )
+    angle_format = "%s %s %s" if wide else "%9.3f %9.3f %9.3f"
+    columns = [
+        *angle_columns,
+        np.where(result.reachable, "yes", "NO").tolist(),
+        (result.margins["leg_length"] * 1e3).tolist(),
+        np.degrees(result.margins["base_joint"]).tolist(),
+        np.degrees(result.margins["platform_joint"]).tolist(),
+        (result.margins["leg_interference"] * 1e3).tolist(),
+        result.limiting_leg.tolist(),
+        [",".join(v) or "-" for v in result.violated],
+    ]
+    template = angle_format + "  %-9s  %11.3f %11.3f %11.3f %11.3f  %8d  %s"
+    _write_rows(out, template, columns, "\n")
+    reachable = int(np.count_nonzero(result.reachable))
+    out.write(f"\n{reachable}/{len(result)} poses reachable\n")
+
+
+# ---------------------------------------------------------------------------- workspaces
+def unreachable_json(position: Any, reason: str) -> dict[str, Any]:
+    """The JSON document of an empty workspace (reference orientation unreachable)."""
+    return {
+        "position": np.asarray(position, dtype=float).tolist(),
+        "reference_reachable": False,
+        "reason": reason,
+    }
+
+
+def projected_json(workspace: ProjectedWorkspace) -> dict[str, Any]:
+    """The JSON document of a projected workspace (angles in degrees)."""
+    document: dict[str, Any] = {
+        "method": workspace.method,
+        "position": workspace.position.tolist(),
+        "reference_reachable": True,
+        "phi_deg": _degrees(workspace.phi),
+        "theta_deg": _degrees(workspace.theta),
+        "psi_deg": _degrees(workspace.psi),
+        "limiting": workspace.limiting,
+        "tilt_min_deg": _degrees(workspace.tilt_min),
+        "tilt_max_deg": _degrees(workspace.tilt_max),
+        "solid_angle_sr": workspace.solid_angle,
+        "tolerance_deg": _degrees(workspace.tolerance),
+        "elapsed_s": workspace.elapsed,
+    }
+    if workspace.gap is not None:
+        document["torsion_zero_gap_deg"] = _degrees(workspace.gap)
+        document["torsion_zero_gap_max_deg"] = _degrees(float(workspace.gap.max()))
+        document["torsion_zero_gap_mean_deg"] = _degrees(float(workspace.gap.mean()))
+    return document
+
+
+#: Rows of the projected table (every k-th azimuth); ``--json`` gives all of them.
+PROJECTED_TABLE_ROWS = 12
+
+
+def projected_text(workspace: ProjectedWorkspace, out: IO[str]) -> None:
+    """A readable summary of a projected workspace and a thinned table of its boundary."""
+    x, y, z = workspace.position
+    out.write(
+        f"projected orientation workspace ({workspace.method}) at ({x:.4f}, {y:.4f}, {z:.4f}) m\n"
+        f"  azimuths: {workspace.n_phi} rays from theta = 0, "
+        f"tolerance {math.degrees(workspace.tolerance):.2e} deg, "
+        f"{workspace.elapsed * 1e3:.1f} ms\n"
+        f"  tilt range: {math.degrees(workspace.tilt_min):.4f} .. "
+        f"{math.degrees(workspace.tilt_max):.4f} deg (least and largest boundary tilt over "
+        "the azimuths)\n"
+        f"  solid angle of attainable directions: {workspace.solid_angle:.5f} sr\n"
+    )
+    if workspace.gap is not None:
+        worst = int(np.argmax(workspace.gap))
+        out.write(
+            f"  torsion_zero lies inside by up to {math.degrees(workspace.gap[worst]):.4f} deg "
+            f"(phi {math.degrees(workspace.phi[worst]):.1f} deg, "
+            f"mean {math.degrees(float(workspace.gap.mean())):.4f} deg)\n"
+        )
+    step = max(1, math.ceil(workspace.n_phi / PROJECTED_TABLE_ROWS))
+    shown = range(0, workspace.n_phi, step)
+    if step > 1:
+        out.write(
+            f"  boundary, every {step}th of the {workspace.n_phi} azimuths "
+            f"({len(shown)} rows; --json gives all):\n"
+        )
+    else:
+        out.write(f"  boundary ({workspace.n_phi} azimuths):\n")
+    out.write(f"  {'phi [deg]':>10} {'theta [deg]':>12} {'psi [deg]':>10}  limiting\n")
+    for k in shown:
+        out.write(
+            f"  {_number(math.degrees(workspace.phi[k]), 10, 2)} "
+            f"{_number(math.degrees(workspace.theta[k]), 12, 4)} "
+            f"{_number(math.degrees(workspace.psi[k]), 10, 3)}  {workspace.limiting[k] or '-'}\n"
+        )
+
+
+def orientation_json(workspace: OrientationWorkspace) -> dict[str, Any]:
+    """The JSON document of a 3-D orientation workspace (angles in degrees)."""
+    return {
+        "position": workspace.position.tolist(),
+        "reference_reachable": True,
+        "psi_min_deg": _degrees(workspace.psi_min),
+        "psi_max_deg": _degrees(workspace.psi_max),
+        "volume": workspace.volume,
+        "volume_unit": "rad^3",
+        "n_rays": workspace.n_rays,
+        "psi_step_deg": _degrees(workspace.psi_step),
+        "tolerance_deg": _degrees(workspace.tolerance),
+        "slices": [
+            {
+                "psi_deg": _degrees(piece.psi),
+                "center_deg": _degrees(piece.center),
+                "phi_deg": _degrees(piece.phi),
+                "theta_deg": _degrees(piece.theta),
+            }
+            for piece in workspace.slices
+        ],
+        "elapsed_s": workspace.elapsed,
+    }
+
+
+def orientation_text(workspace: OrientationWorkspace, out: IO[str]) -> None:
+    """A readable summary of an orientation workspace, saying what each number is."""
+    x, y, z = workspace.position
+    areas = [piece.area() for piece in workspace.slices]
+    middle = min(range(len(workspace.slices)), key=lambda k: abs(workspace.slices[k].psi))
+    zero = workspace.slices[middle]
+    cx, cy = np.degrees(zero.center)
+    out.write(
+        f"orientation workspace at ({x:.4f}, {y:.4f}, {z:.4f}) m\n"
+        f"  {len(workspace.slices)} slices of {workspace.n_rays} rays, "
+        f"step {math.degrees(workspace.psi_step):g} deg, "
+        f"tolerance {math.degrees(workspace.tolerance):.2e} deg, {workspace.elapsed:.2f} s\n"
+        f"  torsion range: {math.degrees(workspace.psi_min):.4f} .. "
+        f"{math.degrees(workspace.psi_max):.4f} deg\n"
+        f"  volume (cylindrical coordinates): {workspace.volume:.5f} rad^3\n"
+        f"  psi = {math.degrees(zero.psi):g} slice: area {areas[middle]:.5f} rad^2, tilt "
+        f"{math.degrees(zero.theta.min()):.3f} .. {math.degrees(zero.theta.max()):.3f} deg over "
+        f"its {zero.phi.size} boundary points\n"
+        f"    (rays from the slice centre ({cx:.3f}, {cy:.3f}) deg; `projected` samples the same "
+        "boundary along\n"
+        "    azimuths from theta = 0, so its tilt range differs by the sampling)\n"
+    )
+
+
+def torsion_range_json(found: TorsionRange, direction_deg: Sequence[float]) -> dict[str, Any]:
+    """The JSON document of a torsion range: the direction as typed, intervals in degrees."""
+    return {
+        "direction_deg": [float(v) for v in direction_deg],
+        "intervals_deg": np.degrees(found.intervals).tolist(),
+    }
+
+
+def torsion_range_text(found: TorsionRange, direction_deg: Sequence[float], out: IO[str]) -> None:
+    """A readable list of the feasible torsion intervals."""
+    x, y, z = found.position
+    phi, theta = direction_deg
+    out.write(
+        f"torsion range for direction phi {phi:g} deg, theta {theta:g} deg "
+        f"at ({x:.4f}, {y:.4f}, {z:.4f}) m\n"
+    )
+    if not len(found.intervals):
+        out.write("  no feasible torsion\n")
+    for low, high in np.degrees(found.intervals).tolist():
+        out.write(f"  psi in [{low:.4f}, {high:.4f}] deg\n")
+
+
+# ---------------------------------------------------------------------------- logs (replay)
+def _kind_label(kind: int) -> str:
+    known = WorkspaceKind.of(kind)
+    return known.label if known is not None else str(kind)
+
+
+def _iso(ns: int | None) -> str:
+    if ns is None:
+        return "-"
+    seconds, rest = divmod(ns, 1_000_000_000)
+    return time.strftime("%Y-%m-%dT%H:%M:%S", time.gmtime(seconds)) + f".{rest // 1_000_000:03d}Z"
+
+
+def _deg(value: float) -> float | None:
+    return None if not math.isfinite(value) else math.degrees(value)
+
+
+def _finite(value: float) -> float | None:
+    return float(value) if math.isfinite(value) else None
+
+
+def _workspace_json(index: int, record: WorkspaceRecord, start_ns: int) -> dict[str, Any]:
+    summary = record.summary
+    position = summary["position"]
+    return {
+        "index": index,
+        "time_s": (record.log_time_ns - start_ns) / 1e9,
+        "sources": record.sources,
+        "request_id": summary["request_id"],
+        "kind": _kind_label(int(summary["kind"])),
+        "success": bool(summary["success"]),
+        "message": summary["message"],
+        "position": [position["x"], position["y"], position["z"]],
+        "reference_reachable": bool(summary["reference_reachable"]),
+        "n_rays": int(summary["n_rays"]),
+        "tolerance_deg": _deg(summary["tolerance"]),
+        "tilt_min_deg": _deg(summary["tilt_min"]),
+        "tilt_max_deg": _deg(summary["tilt_max"]),
+        "solid_angle_sr": _finite(summary["solid_angle"]),
+        "psi_min_deg": _deg(summary["psi_min"]),
+        "psi_max_deg": _deg(summary["psi_max"]),
+        "volume": _finite(summary["volume"]),
+        "n_points": int(summary["n_points"]),
+        "boundary_recorded": record.points is not None,
+        "elapsed_s": float(summary["elapsed"]),
+    }
+
+
+def _check_json(index: int, call: PoseCheckCall, start_ns: int) -> dict[str, Any]:
+    response = call.response or {}
+    results = response.get("results", [])
+    return {
+        "index": index,
+        "time_s": (call.log_time_ns - start_ns) / 1e9,
+        "topic": call.topic,
+        "position": call.position,
+        "n_poses": None if call.angles is None else len(call.angles),
+        "answered": call.response is not None,
+        "success": response.get("success"),
+        "message": response.get("message"),
+        "n_reachable": sum(bool(r["reachable"]) for r in results),
+    }
+
+
+def log_report(summary: LogSummary) -> dict[str, Any]:
+    contents = summary.contents
+    start = contents.start_ns or 0
+    reach = summary.reachability
+    return {
+        "log": str(contents.path),
+        "files": [str(f) for f in contents.files],
+        "finished": contents.finished,
+        "damaged": contents.damaged,
+        "start": _iso(contents.start_ns),
+        "end": _iso(contents.end_ns),
+        "duration_s": ((contents.end_ns or 0) - start) / 1e9,
+        "message_count": contents.message_count,
+        "topics": [
+            {"topic": t.topic, "type": t.msgtype, "count": t.count, "decoded": t.decoded}
+            for t in contents.topics.values()
+        ],
+        "workspaces": [_workspace_json(i + 1, r, start) for i, r in enumerate(summary.workspaces)],
+        "pose_checks": [_check_json(i + 1, c, start) for i, c in enumerate(summary.checks)],
+        "reachability": {
+            "count": len(reach),
+            "reachable": sum(bool(r["success"] and r["check"]["reachable"]) for r in reach),
+            "unreachable": sum(bool(r["success"] and not r["check"]["reachable"]) for r in reach),
+            "invalid": sum(not r["success"] for r in reach),
+        },
+        "trigger_calls": [
+            {
+                "topic": t["topic"],
+                "time_s": (t["log_time_ns"] - start) / 1e9,
+                "success": bool(t["success"]),
+                "message": t["message"],
+            }
+            for t in summary.triggers
+        ],
+        "problems": list(contents.problems),
+    }
+
+
+def jsonable(value: Any) -> Any:
+    """NaN and infinities (a rejected request's position, a disabled margin) become null."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {key: jsonable(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [jsonable(item) for item in value]
+    return value
+
+
+def log_report_text(report: dict[str, Any], out: IO[str]) -> None:
+    if report["damaged"]:
+        state = (
+            "finished, but damaged: read as far as intact"
+            if report["finished"]
+            else "not finished cleanly: read as far as intact"
+        )
+    else:
+        state = "finished" if report["finished"] else "not finished"
+    out.write(f"log: {report['log']} ({state})\n")
+    out.write(
+        f"span: {report['start']} .. {report['end']} ({report['duration_s']:.3f} s), "
+        f"{report['message_count']} messages\n"
+    )
+    out.write("topics:\n")
+    width = max([len(t["topic"]) for t in report["topics"]] + [5])
+    type_width = max([len(t["type"]) for t in report["topics"]] + [4])
+    for topic in report["topics"]:
+        out.write(f"  {topic['topic']:<{width}}  {topic['type']:<{type_width}}  {topic['count']}\n")
+    out.write(f"workspace results: {len(report['workspaces'])}\n")
+    for ws in report["workspaces"]:
+        position = ", ".join(f"{v:.4g}" for v in ws["position"])
+        request = f" request_id={ws['request_id']!r}" if ws["request_id"] else ""
+        out.write(
+            f"  [{ws['index']}] +{ws['time_s']:.3f} s{request} at ({position}) m: {_line(ws)}\n"
+        )
+    if report["pose_checks"]:
+        out.write(f"pose checks: {len(report['pose_checks'])}\n")
+        for check in report["pose_checks"]:
+            if not check["answered"]:
+                verdict = "no response recorded"
+            elif check["success"]:
+                verdict = f"{check['n_reachable']}/{check['n_poses'] or 0} reachable"
+            else:
+                verdict = f"failed: {check['message']}"
+            out.write(
+                f"  [{check['index']}] +{check['time_s']:.3f} s {check['topic']}: {verdict}\n"
+            )
+    reach = report["reachability"]
+    if reach["count"]:
+        out.write(
+            f"reachability results: {reach['count']} ({reach['reachable']} reachable, "
+            f"{reach['unreachable']} unreachable, {reach['invalid']} invalid)\n"
+        )
+    for call in report["trigger_calls"]:
+        out.write(
+            f"  trigger {call['topic']} +{call['time_s']:.3f} s: "
+            f"{'ok' if call['success'] else 'failed'}: {call['message']}\n"
+        )
+
+
+def _line(ws: dict[str, Any]) -> str:
+    if not ws["success"]:
+        return f"{ws['kind']}: failed: {ws['message']}"
+    if ws["kind"] == "orientation":
+        text = (
+            f"orientation: psi {ws['psi_min_deg']:.3f}..{ws['psi_max_deg']:.3f} deg, "
+            f"volume {ws['volume']:.6g} rad^3"
+        )
+    else:
+        text = (
+            f"{ws['kind']}: tilt {ws['tilt_min_deg']:.3f}..{ws['tilt_max_deg']:.3f} deg, "
+            f"solid angle {ws['solid_angle_sr']:.6g} sr"
+        )
+    boundary = "" if ws["boundary_recorded"] else " (not recorded)"
+    return f"{text}, {ws['n_points']} boundary points{boundary}"
+
+
+# ---------------------------------------------------------------------------- demo
+def demo_table(rows: list[dict[str, Any]], log_name: str) -> str:
+    lines = [
+        "| case | position [m] | tilt θ (ψ = 0) [deg] | tilt θ (exact) [deg] "
+        "| max gap [deg] | ψ range [deg] | volume [rad³] | time tz / exact / 3-D [s] |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for row in rows:
+        position = "({:g}, {:g}, {:g})".format(*row["position"])
+        if "error" in row:
+            lines.append(f"| {row['case']} | {position} | {row['error']} | | | | | |")
+            continue
+        elapsed = row["elapsed_s"]
+        lines.append(
+            f"| {row['case']} | {position} "
+            f"| {row['tilt_min_deg']:.2f} – {row['tilt_max_deg']:.2f} "
+            f"| {row['exact_tilt_min_deg']:.2f} – {row['exact_tilt_max_deg']:.2f} "
+            f"| {row['torsion_zero_gap_max_deg']:.2f} "
+            f"| {row['psi_min_deg']:.2f} – {row['psi_max_deg']:.2f} "
+            f"| {row['volume_rad3']:.4f} "
+            f"| {elapsed['torsion_zero']:.3f} / {elapsed['exact']:.3f} / "
+            f"{elapsed['orientation']:.2f} |"
+        )
+    lines.append("")
+    lines.append(f"Log of every result: `{log_name}` (`hexapod-workspace replay {log_name}`).")
+    return "\n".join(lines) + "\n"
