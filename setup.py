@@ -51,9 +51,10 @@ setup(
         (f"share/{PACKAGE}/launch", glob("launch/*.py")),
     ],
     install_requires=[
-        # Tested with 1.26.4 (Ubuntu 24.04's python3-numpy, next to ROS 2 Jazzy from apt) and
-        # the pinned 2.2.6 (requirements/base.txt).
+        # Lower bounds a ROS 2 Jazzy user on Ubuntu 24.04 meets with apt (python3-numpy 1.26,
+        # python3-numba 0.59); tested against those in a venv, and the pins of requirements/.
         "numpy>=1.26",
+        "numba>=0.59",
         "PyYAML>=5.4",
         "matplotlib>=3.6",
         "mcap>=1.6",

@@ -7,6 +7,14 @@ import pytest
 
 from hexapod_workspace import Manipulator
 from hexapod_workspace._resources import example_config_path
+from hexapod_workspace.core import kernels
+
+
+@pytest.fixture(scope="session", autouse=True)
+def compiled_kernels() -> float:
+    """Compile (or load) the kernels once before any test: the CLI subprocesses of the tests
+    share this source tree's cache, so none of them prints the first-run notice."""
+    return kernels.warm_up()
 
 
 @pytest.fixture(scope="session")

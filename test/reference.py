@@ -5,6 +5,9 @@ segment distance computed by a different method than :mod:`hexapod_workspace.cor
 (interior critical point plus the four edge cases). Tests use them as independent evidence
 for the batched code; the benchmarks use them as the "straightforward per-pose loop" and the
 paper's literal projected-workspace procedure.
+
+:class:`BatchedMargins` is the numpy batch evaluation the package used before its compiled
+kernels: the kernels must reproduce its margins to 1e-12 and its verdicts exactly.
 """
 
 from __future__ import annotations
@@ -14,9 +17,13 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from hexapod_workspace.core.constraints import PAIRS_I, PAIRS_J, _segment_distance_squared
 from hexapod_workspace.core.manipulator import Manipulator
+from hexapod_workspace.core.rotations import tt_to_matrix
 
 __all__ = [
+    "BatchedMargins",
+    "batched_margins",
     "paper_projected_workspace",
     "point_segment_distance",
     "pose_margins_literal",
@@ -171,3 +178,144 @@ def paper_projected_workspace(
             index = max(0, index - 1)
         boundary[k] = min(first_violated * step, math.pi)
     return boundary
+
+
+#: Poses per chunk of the numpy batch reference (keeps its temporaries in the CPU cache).
+CHUNK = 2048
+
+
+class BatchedMargins:
+    """The numpy batch evaluation of the four margins, as the package computed them before the
+    compiled kernels (commit 0b9ef59): the reference the kernels are compared with.
+
+    Arrays are laid out component-first, ``(3, 6)``, so each chunk's temporaries are
+    ``(n, 6)`` or ``(n, 15)`` planes of contiguous memory.
+    """
+
+    def __init__(self, manipulator: Manipulator, interference: bool) -> None:
+        self.b_t = np.ascontiguousarray(manipulator.platform_joints.T)  # (3, 6), mobile frame
+        self.a_t = np.ascontiguousarray(manipulator.base_joints.T)  # (3, 6), base frame
+        self.ja_t = np.ascontiguousarray(manipulator.base_joint_axes.T)  # (3, 6)
+        self.jb_t = np.ascontiguousarray(manipulator.platform_joint_axes.T)  # (3, 6)
+        self.b_jb_t = np.ascontiguousarray(np.hstack([self.b_t, self.jb_t]))  # (3, 12)
+        self.length_min = manipulator.leg_length_min
+        self.length_max = manipulator.leg_length_max
+        self.alpha = manipulator.base_joint_max_angle
+        self.beta = manipulator.platform_joint_max_angle
+        self.diameter = manipulator.leg_diameter
+        self.interference = interference and manipulator.leg_diameter > 0.0
+        # Interference: r_ij = A_i − A_j is constant (the base joints do not move).
+        r = manipulator.base_joints[PAIRS_I] - manipulator.base_joints[PAIRS_J]  # (15, 3)
+        self.r = r
+        self.rr = np.einsum("pk,pk->p", r, r)
+        self.alpha_equal = bool(np.all(self.alpha == self.alpha[0]))
+        self.beta_equal = bool(np.all(self.beta == self.beta[0]))
+
+    def evaluate(
+        self,
+        rotations: NDArray[np.float64],
+        positions: NDArray[np.float64],
+        margins_out: NDArray[np.float64],
+        legs_out: NDArray[np.int64],
+        pairs_out: NDArray[np.int64],
+    ) -> None:
+        """Margins of one chunk of n poses, written into the ``*_out`` views."""
+        n = rotations.shape[0]
+        rows = np.arange(n)
+        # One batched product gives R·b_i and R·jB_i: (n, 3, 12), component planes of (n, 6).
+        rotated = rotations @ self.b_jb_t
+        lx = rotated[:, 0, :6] + (positions[:, 0:1] - self.a_t[0])
+        ly = rotated[:, 1, :6] + (positions[:, 1:2] - self.a_t[1])
+        lz = rotated[:, 2, :6] + (positions[:, 2:3] - self.a_t[2])
+        squared = lx * lx + ly * ly + lz * lz
+        lengths = np.sqrt(squared)
+        inverse = 1.0 / lengths
+
+        per_leg = np.minimum(lengths - self.length_min, self.length_max - lengths)
+        leg = per_leg.argmin(axis=1)
+        legs_out[0] = leg
+        margins_out[0] = per_leg[rows, leg]
+
+        # Base joint: angle between jA_i (base frame) and n_i.
+        cos_a = (self.ja_t[0] * lx + self.ja_t[1] * ly + self.ja_t[2] * lz) * inverse
+        self._angle_margin(cos_a, self.alpha, self.alpha_equal, rows, margins_out[1], legs_out[1])
+
+        # Platform joint: angle between R·jB_i and −n_i.
+        cos_b = (
+            rotated[:, 0, 6:] * lx + rotated[:, 1, 6:] * ly + rotated[:, 2, 6:] * lz
+        ) * -inverse
+        self._angle_margin(cos_b, self.beta, self.beta_equal, rows, margins_out[2], legs_out[2])
+
+        if not self.interference:
+            margins_out[3] = np.inf
+            legs_out[3] = 0
+            pairs_out[:] = 0
+            return
+        # Segment i: A_i + s·L_i, segment j: A_j + t·L_j, r = A_i − A_j.
+        xi, yi, zi = lx[:, PAIRS_I], ly[:, PAIRS_I], lz[:, PAIRS_I]
+        xj, yj, zj = lx[:, PAIRS_J], ly[:, PAIRS_J], lz[:, PAIRS_J]
+        b = xi * xj + yi * yj + zi * zj
+        c = xi * self.r[:, 0] + yi * self.r[:, 1] + zi * self.r[:, 2]
+        f = xj * self.r[:, 0] + yj * self.r[:, 1] + zj * self.r[:, 2]
+        distance = np.sqrt(
+            _segment_distance_squared(squared[:, PAIRS_I], b, c, squared[:, PAIRS_J], f, self.rr)
+        )
+        pair = distance.argmin(axis=1)
+        margins_out[3] = distance[rows, pair] - self.diameter
+        legs_out[3] = PAIRS_I[pair]
+        pairs_out[:, 0] = PAIRS_I[pair]
+        pairs_out[:, 1] = PAIRS_J[pair]
+
+    @staticmethod
+    def _angle_margin(
+        cosine: NDArray[np.float64],
+        limit: NDArray[np.float64],
+        equal: bool,
+        rows: NDArray[np.int64],
+        margin_out: NDArray[np.float64],
+        leg_out: NDArray[np.int64],
+    ) -> None:
+        """min_i (limit_i − arccos(cos_i)) and its leg; one arccos per pose when limits are equal
+        (the margin is then decreasing in the angle, so the smallest cosine is the limiting leg).
+        """
+        if equal:
+            leg = cosine.argmin(axis=1)
+            smallest = np.minimum(np.maximum(cosine[rows, leg], -1.0), 1.0)
+            margin_out[:] = limit[0] - np.arccos(smallest)
+        else:
+            per_leg = limit - np.arccos(np.minimum(np.maximum(cosine, -1.0), 1.0))
+            leg = per_leg.argmin(axis=1)
+            margin_out[:] = per_leg[rows, leg]
+        leg_out[:] = leg
+
+
+def batched_margins(
+    manipulator: Manipulator, angles: ArrayLike, position: ArrayLike
+) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int64]]:
+    """The numpy batch reference for poses (N, 3) of T&T angles (rad) at one position (3,), m.
+
+    Returns
+    -------
+    margins : ndarray, shape (4, N)
+    legs : ndarray, shape (4, N), int
+        0-based limiting leg of each constraint.
+    pairs : ndarray, shape (N, 2), int
+        0-based closest pair.
+    """
+    angles = np.asarray(angles, dtype=np.float64)
+    count = angles.shape[0]
+    model = BatchedMargins(manipulator, interference=True)
+    margins = np.empty((4, count))
+    legs = np.zeros((4, count), dtype=np.int64)
+    pairs = np.zeros((count, 2), dtype=np.int64)
+    positions = np.broadcast_to(np.asarray(position, dtype=np.float64), (CHUNK, 3))
+    for start in range(0, count, CHUNK):
+        stop = min(start + CHUNK, count)
+        model.evaluate(
+            tt_to_matrix(angles[start:stop]),
+            positions[: stop - start],
+            margins[:, start:stop],
+            legs[:, start:stop],
+            pairs[start:stop],
+        )
+    return margins, legs, pairs

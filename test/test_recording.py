@@ -1,4 +1,4 @@
-"""Tests of logs.recording: rosbag2-form MCAP writing, durability, tolerant reading.
+"""Tests of hexapod_workspace.logs: rosbag2-form MCAP writing, durability, tolerant reading.
 
 Every recorded message is decoded by two independent readers (rosbags' AnyReader with the log's
 own schemas, and mcap + mcap_ros2) and compared with what was written, after decoding.

@@ -17,7 +17,6 @@ from typing import Any
 import numpy as np
 
 from ..core.atlas import AtlasGrid
-from .plotting import _pyplot
 
 __all__ = ["plot_atlas", "plot_dexterous_3d", "plot_tilt_slices"]
 
@@ -36,23 +35,17 @@ def plot_tilt_slices(
     dataset: Any, grid: AtlasGrid, tilts_deg: Sequence[float], path: str | Path
 ) -> Path:
     """Heat maps of ``tilt_capability`` per z slice with the θ_req contours; returns the PNG."""
-    plt = _pyplot()
-    from matplotlib.patches import Patch
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch, Rectangle
 
     capability = np.degrees(dataset["tilt_capability"].values)  # (nx, ny, nz)
     x, y, z = grid.x, grid.y, grid.z
     chosen = _slices(z.size)[::-1]  # top slice first (z up)
     columns = min(4, len(chosen))
     rows = -(-len(chosen) // columns)
-    figure, axes = plt.subplots(
-        rows,
-        columns,
-        figsize=(3.3 * columns + 1.2, 3.1 * rows + 0.9),
-        squeeze=False,
-        sharex=True,
-        sharey=True,
-        layout="constrained",
-    )
+    figure = Figure(figsize=(3.3 * columns + 1.2, 3.1 * rows + 0.9), layout="constrained")
+    axes = figure.subplots(rows, columns, squeeze=False, sharex=True, sharey=True)
     known = capability[np.isfinite(capability)]
     vmax = float(known.max()) if known.size else 1.0
     half = 0.5 * (grid.step or 1.0)
@@ -62,7 +55,7 @@ def plot_tilt_slices(
         values = capability[:, :, k].T  # rows y, columns x
         axis.set_facecolor("0.85")
         axis.add_patch(
-            plt.Rectangle(
+            Rectangle(
                 (extent[0], extent[2]),
                 extent[1] - extent[0],
                 extent[3] - extent[2],
@@ -104,14 +97,13 @@ def plot_tilt_slices(
         bar.set_label("tilt capability [deg]")
     handles = [Patch(facecolor="0.85", hatch="//", edgecolor="0.6", label="reference unreachable")]
     handles += [
-        plt.Line2D([], [], color=color, linewidth=1.6, label=f"θ_req = {level:g}°")
+        Line2D([], [], color=color, linewidth=1.6, label=f"θ_req = {level:g}°")
         for level, color in zip(tilts_deg, _LEVEL_COLORS, strict=False)
     ]
     figure.legend(handles=handles, loc="outside lower center", ncols=len(handles), fontsize=8)
     figure.suptitle("Tilt capability (largest cone of tool directions all attainable) per z slice")
     path = Path(path)
     figure.savefig(path, dpi=110, facecolor="white")
-    plt.close(figure)
     return path
 
 
@@ -119,7 +111,8 @@ def plot_dexterous_3d(
     dataset: Any, grid: AtlasGrid, tilts_deg: Sequence[float], path: str | Path
 ) -> Path:
     """3-D view of the dexterous workspace per θ_req (grid cells as voxels); returns the PNG."""
-    plt = _pyplot()
+    import matplotlib as mpl
+    from matplotlib.figure import Figure
     from matplotlib.patches import Patch
 
     capability = np.degrees(dataset["tilt_capability"].values)
@@ -129,9 +122,9 @@ def plot_dexterous_3d(
         np.append(axis - 0.5 * step, axis[-1] + 0.5 * step) for axis in (grid.x, grid.y, grid.z)
     ]
     xe, ye, ze = np.meshgrid(*edges, indexing="ij")
-    figure = plt.figure(figsize=(7.5, 6.8))
+    figure = Figure(figsize=(7.5, 6.8))
     axis = figure.add_subplot(projection="3d")
-    colors = plt.get_cmap("plasma")(np.linspace(0.15, 0.85, max(1, len(tilts_deg))))
+    colors = mpl.colormaps["plasma"](np.linspace(0.15, 0.85, max(1, len(tilts_deg))))
     handles = []
     levels = sorted(tilts_deg)
     # Cut away the quadrant facing the viewer (x > 0, y < 0) so that inner shells show.
@@ -184,7 +177,6 @@ def plot_dexterous_3d(
     )
     path = Path(path)
     figure.savefig(path, dpi=110, facecolor="white")
-    plt.close(figure)
     return path
 
 

@@ -25,7 +25,7 @@ from typing import IO, Any
 import numpy as np
 
 from .. import __version__
-from ..core import resolution
+from ..core import kernels, resolution
 from ..errors import HexapodWorkspaceError
 from . import atlas, commands
 from .inputs import (
@@ -501,7 +501,9 @@ def main(
         options = build_parser().parse_args(argv)
         command = COMMANDS[options.command]
         _refuse_unused_globals(options, command)
-        return command.run(options, out, err)
+        # The first run after an install compiles the kernels: say so in one line.
+        with kernels.compile_notice(lambda message: err.write(f"{PROG}: {message}\n")):
+            return command.run(options, out, err)
     except (CliError, HexapodWorkspaceError) as error:
         reason = " ".join(str(error).split())
         err.write(f"{PROG}: error: {reason}\n")

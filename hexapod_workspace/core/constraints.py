@@ -14,21 +14,26 @@ name                 margin                                           unit
 ``leg_interference`` min_{i<j} (dist(A_iB_i, A_jB_j) − D)              m
 ==================== ================================================ =======
 
-``leg_interference`` is +inf when D = 0 (check disabled). Everything is vectorised over poses
-and processed in cache-sized chunks; there is no Python loop per pose.
+``leg_interference`` is +inf when D = 0 (check disabled). The margins are evaluated by the
+compiled kernels of :mod:`hexapod_workspace.core.kernels` (one pass per pose, no Python loop);
+large batches of :func:`check` are split over the available cores.
 """
 
 from __future__ import annotations
 
+import itertools
+import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
-from .resolution import validate_position
-from .rotations import tt_to_matrix
+from . import kernels
+from .resolution import MAX_POSITION_NORM, validate_position
 
 if TYPE_CHECKING:
     from .manipulator import Manipulator
@@ -37,8 +42,10 @@ __all__ = [
     "CONSTRAINT_NAMES",
     "CheckResult",
     "LegKinematics",
+    "PoseCheck",
     "PoseMargins",
     "check",
+    "check_pose",
     "inverse_kinematics",
     "pose_margins",
     "relative_margins",
@@ -54,10 +61,10 @@ CONSTRAINT_NAMES: tuple[str, ...] = (
 )
 #: Leg pairs (i < j, 0-based) checked for interference, in a fixed order.
 PAIRS_I, PAIRS_J = np.triu_indices(6, k=1)
-#: Poses evaluated per chunk: keeps every temporary array in the CPU cache.
-CHUNK = 2048
 #: Largest batch :func:`check` accepts in one call.
 MAX_POSES = 50_000_000
+#: Batches of :func:`check` at least this large are split over the available cores.
+PARALLEL_POSES = 32_768
 
 
 def _positions(position: ArrayLike, count: int) -> NDArray[np.float64]:
@@ -270,137 +277,19 @@ def pose_margins(
     -------
     PoseMargins
     """
-    rotations = _rotation_batch(rotations)
+    rotations = np.ascontiguousarray(_rotation_batch(rotations))
     count = rotations.shape[0]
     positions = _positions(position, count)
+    if positions.strides[0] == 0:  # one position for every pose
+        positions = positions[:1]
+    positions = np.ascontiguousarray(positions)
     margins = np.empty((4, count))
-    legs = np.zeros((4, count), dtype=np.int64)
-    pairs = np.zeros((count, 2), dtype=np.int64)
-    model = _chunk_model(manipulator, interference)
-    for start in range(0, count, CHUNK):
-        stop = min(start + CHUNK, count)
-        model.evaluate(
-            rotations[start:stop],
-            positions[start:stop],
-            margins[:, start:stop],
-            legs[:, start:stop],
-            pairs[start:stop],
-        )
+    legs = np.empty((4, count), dtype=np.int64)
+    pairs = np.empty((count, 2), dtype=np.int64)
+    kernels.margins_rotations(
+        kernels.model_vector(manipulator), rotations, positions, interference, margins, legs, pairs
+    )
     return PoseMargins(margins, legs, pairs)
-
-
-def _chunk_model(manipulator: Manipulator, interference: bool) -> _ChunkModel:
-    """The chunk model of a manipulator, cached on the (immutable) manipulator object."""
-    cache = manipulator.__dict__.setdefault("_chunk_models", {})
-    model = cache.get(interference)
-    if model is None:
-        model = cache[interference] = _ChunkModel(manipulator, interference)
-    return model
-
-
-class _ChunkModel:
-    """Precomputed constants of a manipulator for the chunked margin evaluation.
-
-    Arrays are laid out component-first, ``(3, 6)``, so each chunk's temporaries are
-    ``(n, 6)`` or ``(n, 15)`` planes of contiguous memory.
-    """
-
-    def __init__(self, manipulator: Manipulator, interference: bool) -> None:
-        self.b_t = np.ascontiguousarray(manipulator.platform_joints.T)  # (3, 6), mobile frame
-        self.a_t = np.ascontiguousarray(manipulator.base_joints.T)  # (3, 6), base frame
-        self.ja_t = np.ascontiguousarray(manipulator.base_joint_axes.T)  # (3, 6)
-        self.jb_t = np.ascontiguousarray(manipulator.platform_joint_axes.T)  # (3, 6)
-        self.b_jb_t = np.ascontiguousarray(np.hstack([self.b_t, self.jb_t]))  # (3, 12)
-        self.length_min = manipulator.leg_length_min
-        self.length_max = manipulator.leg_length_max
-        self.alpha = manipulator.base_joint_max_angle
-        self.beta = manipulator.platform_joint_max_angle
-        self.diameter = manipulator.leg_diameter
-        self.interference = interference and manipulator.leg_diameter > 0.0
-        # Interference: r_ij = A_i − A_j is constant (the base joints do not move).
-        r = manipulator.base_joints[PAIRS_I] - manipulator.base_joints[PAIRS_J]  # (15, 3)
-        self.r = r
-        self.rr = np.einsum("pk,pk->p", r, r)
-        self.alpha_equal = bool(np.all(self.alpha == self.alpha[0]))
-        self.beta_equal = bool(np.all(self.beta == self.beta[0]))
-        self.relative_scale = _relative_scale(manipulator)
-
-    def evaluate(
-        self,
-        rotations: NDArray[np.float64],
-        positions: NDArray[np.float64],
-        margins_out: NDArray[np.float64],
-        legs_out: NDArray[np.int64],
-        pairs_out: NDArray[np.int64],
-    ) -> None:
-        """Margins of one chunk of n poses, written into the ``*_out`` views."""
-        n = rotations.shape[0]
-        rows = np.arange(n)
-        # One batched product gives R·b_i and R·jB_i: (n, 3, 12), component planes of (n, 6).
-        rotated = rotations @ self.b_jb_t
-        lx = rotated[:, 0, :6] + (positions[:, 0:1] - self.a_t[0])
-        ly = rotated[:, 1, :6] + (positions[:, 1:2] - self.a_t[1])
-        lz = rotated[:, 2, :6] + (positions[:, 2:3] - self.a_t[2])
-        squared = lx * lx + ly * ly + lz * lz
-        lengths = np.sqrt(squared)
-        inverse = 1.0 / lengths
-
-        per_leg = np.minimum(lengths - self.length_min, self.length_max - lengths)
-        leg = per_leg.argmin(axis=1)
-        legs_out[0] = leg
-        margins_out[0] = per_leg[rows, leg]
-
-        # Base joint: angle between jA_i (base frame) and n_i.
-        cos_a = (self.ja_t[0] * lx + self.ja_t[1] * ly + self.ja_t[2] * lz) * inverse
-        self._angle_margin(cos_a, self.alpha, self.alpha_equal, rows, margins_out[1], legs_out[1])
-
-        # Platform joint: angle between R·jB_i and −n_i.
-        cos_b = (
-            rotated[:, 0, 6:] * lx + rotated[:, 1, 6:] * ly + rotated[:, 2, 6:] * lz
-        ) * -inverse
-        self._angle_margin(cos_b, self.beta, self.beta_equal, rows, margins_out[2], legs_out[2])
-
-        if not self.interference:
-            margins_out[3] = np.inf
-            legs_out[3] = 0
-            pairs_out[:] = 0
-            return
-        # Segment i: A_i + s·L_i, segment j: A_j + t·L_j, r = A_i − A_j.
-        xi, yi, zi = lx[:, PAIRS_I], ly[:, PAIRS_I], lz[:, PAIRS_I]
-        xj, yj, zj = lx[:, PAIRS_J], ly[:, PAIRS_J], lz[:, PAIRS_J]
-        b = xi * xj + yi * yj + zi * zj
-        c = xi * self.r[:, 0] + yi * self.r[:, 1] + zi * self.r[:, 2]
-        f = xj * self.r[:, 0] + yj * self.r[:, 1] + zj * self.r[:, 2]
-        distance = np.sqrt(
-            _segment_distance_squared(squared[:, PAIRS_I], b, c, squared[:, PAIRS_J], f, self.rr)
-        )
-        pair = distance.argmin(axis=1)
-        margins_out[3] = distance[rows, pair] - self.diameter
-        legs_out[3] = PAIRS_I[pair]
-        pairs_out[:, 0] = PAIRS_I[pair]
-        pairs_out[:, 1] = PAIRS_J[pair]
-
-    @staticmethod
-    def _angle_margin(
-        cosine: NDArray[np.float64],
-        limit: NDArray[np.float64],
-        equal: bool,
-        rows: NDArray[np.int64],
-        margin_out: NDArray[np.float64],
-        leg_out: NDArray[np.int64],
-    ) -> None:
-        """min_i (limit_i − arccos(cos_i)) and its leg; one arccos per pose when limits are equal
-        (the margin is then decreasing in the angle, so the smallest cosine is the limiting leg).
-        """
-        if equal:
-            leg = cosine.argmin(axis=1)
-            smallest = np.minimum(np.maximum(cosine[rows, leg], -1.0), 1.0)
-            margin_out[:] = limit[0] - np.arccos(smallest)
-        else:
-            per_leg = limit - np.arccos(np.minimum(np.maximum(cosine, -1.0), 1.0))
-            leg = per_leg.argmin(axis=1)
-            margin_out[:] = per_leg[rows, leg]
-        leg_out[:] = leg
 
 
 @dataclass(frozen=True)
@@ -468,19 +357,8 @@ def relative_margins(manipulator: Manipulator, margins: NDArray[np.float64]) -> 
         Leg length over half the mean stroke, joint angles over the mean maximum angle,
         interference over D (+inf when disabled). Dimensionless.
     """
-    return margins / _chunk_model(manipulator, True).relative_scale[:, None]
-
-
-def _relative_scale(manipulator: Manipulator) -> NDArray[np.float64]:
-    """Natural scale of each constraint's margin, shape (4,): see :func:`relative_margins`."""
-    return np.array(
-        [
-            float(np.mean(manipulator.leg_length_max - manipulator.leg_length_min)) / 2.0,
-            float(np.mean(manipulator.base_joint_max_angle)),
-            float(np.mean(manipulator.platform_joint_max_angle)),
-            manipulator.leg_diameter if manipulator.leg_diameter > 0.0 else 1.0,
-        ]
-    )
+    scale = kernels.model_vector(manipulator)[kernels.SCALE : kernels.SCALE + 4]
+    return margins / scale[:, None]
 
 
 def check(
@@ -512,42 +390,161 @@ def check(
     if angles.ndim != 2 or angles.shape[1] != 3:
         msg = f"angles: expected shape (N, 3) of (phi, theta, psi), got {angles.shape}"
         raise InputError(msg)
-    if angles.shape[0] > MAX_POSES:
-        msg = f"angles: at most {MAX_POSES} poses per call, got {angles.shape[0]}"
+    count = angles.shape[0]
+    if count > MAX_POSES:
+        msg = f"angles: at most {MAX_POSES} poses per call, got {count}"
         raise InputError(msg)
-    if not np.all(np.isfinite(angles)):
-        bad = int(np.flatnonzero(~np.all(np.isfinite(angles), axis=1))[0])
+    angles = np.ascontiguousarray(angles)
+    position = np.array(manipulator.position if position is None else position, dtype=float)
+    if position.shape != (3,):
+        _require_finite_angles(angles)
+        msg = f"position: expected 3 values (x, y, z), got shape {position.shape}"
+        raise InputError(msg)
+    if np.all(np.isfinite(position)):  # non-finite: refused below, after the angles
+        position = validate_position(manipulator, position)  # |p| bounded: finite margins
+
+    margins = np.empty((4, count))
+    ints = np.empty((6, count), dtype=np.int64)
+    pairs = np.empty((count, 2), dtype=np.int64)
+    reachable = np.empty(count, dtype=np.bool_)
+    model = kernels.model_vector(manipulator)
+    outputs = (margins, ints, pairs, reachable)
+    workers = _cores() if count >= PARALLEL_POSES else 1
+    if workers == 1:
+        status = kernels.check_angles(model, angles, position, 0, count, *outputs)
+    else:
+        _require_finite_angles(angles)
+        bounds = np.linspace(0, count, workers + 1).astype(int)
+        jobs = [
+            _pool().submit(kernels.check_angles, model, angles, position, start, stop, *outputs)
+            for start, stop in itertools.pairwise(bounds)
+        ]
+        status = min(job.result() for job in jobs)
+    if status >= 0:
+        _require_finite_angles(angles)
+    if status == -2:
+        msg = f"position: expected finite values, got {position.tolist()}"
+        raise InputError(msg)
+    legs = ints[:4]
+    return CheckResult(
+        position=position,
+        angles=angles,
+        reachable=reachable,
+        margins={name: margins[k] for k, name in enumerate(CONSTRAINT_NAMES)},
+        limiting_legs={name: legs[k] for k, name in enumerate(CONSTRAINT_NAMES)},
+        limiting_pair=pairs,
+        limiting_constraint=ints[4],
+        limiting_leg=ints[5],
+    )
+
+
+class PoseCheck(NamedTuple):
+    """Reachability of one pose (:func:`check_pose`): plain Python numbers, no arrays.
+
+    Attributes
+    ----------
+    reachable : bool
+        Every constraint holds.
+    margins : tuple of 4 float
+        Signed margins in :data:`CONSTRAINT_NAMES` order (m, rad, rad, m).
+    limiting_legs : tuple of 4 int
+        1-based leg with the smallest margin of each constraint (``leg_interference``: the
+        lower leg of the closest pair; 0 when the check is disabled).
+    limiting_pair : tuple of 2 int
+        1-based closest pair (0, 0 when the check is disabled).
+    limiting_constraint : int
+        Index into :data:`CONSTRAINT_NAMES` of the smallest relative margin.
+    limiting_leg : int
+        1-based leg of the limiting constraint.
+    """
+
+    reachable: bool
+    margins: tuple[float, float, float, float]
+    limiting_legs: tuple[int, int, int, int]
+    limiting_pair: tuple[int, int]
+    limiting_constraint: int
+    limiting_leg: int
+
+
+def check_pose(
+    manipulator: Manipulator,
+    phi: float,
+    theta: float,
+    psi: float,
+    position: ArrayLike | None = None,
+) -> PoseCheck:
+    """Check one orientation: the same verdict and margins as :func:`check`, in microseconds.
+
+    Parameters
+    ----------
+    manipulator : Manipulator
+    phi, theta, psi : float
+        Tilt-and-Torsion angles, rad.
+    position : array_like, shape (3,), optional
+        Tool-tip position OC, base frame, m. Default: ``manipulator.position``.
+
+    Returns
+    -------
+    PoseCheck
+
+    Raises
+    ------
+    InputError
+        NaN or infinite values, a position that is not 3 values.
+    """
+    angles = (float(phi), float(theta), float(psi))
+    if not all(map(math.isfinite, angles)):
+        msg = f"angles: expected finite values, pose 0 is {list(angles)}"
+        raise InputError(msg)
+    if position is None:
+        x, y, z = manipulator.position.tolist()
+    else:
+        values = np.asarray(position, dtype=np.float64)
+        if values.shape != (3,):
+            msg = f"position: expected 3 values (x, y, z), got shape {values.shape}"
+            raise InputError(msg)
+        x, y, z = values.tolist()
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+            msg = f"position: expected finite values, got {[x, y, z]}"
+            raise InputError(msg)
+        if math.sqrt(x * x + y * y + z * z) > MAX_POSITION_NORM:
+            validate_position(manipulator, values)  # raises, with the same reason as check()
+    result = np.empty(12)
+    kernels.check_one(kernels.model_vector(manipulator), *angles, x, y, z, result)
+    m_len, m_a, m_b, m_i, l_len, l_a, l_b, l_i, p_i, p_j, worst, leg = result.tolist()
+    return PoseCheck(
+        m_len >= 0.0 and m_a >= 0.0 and m_b >= 0.0 and m_i >= 0.0,
+        (m_len, m_a, m_b, m_i),
+        (int(l_len), int(l_a), int(l_b), int(l_i)),
+        (int(p_i), int(p_j)),
+        int(worst),
+        int(leg),
+    )
+
+
+def _require_finite_angles(angles: NDArray[np.float64]) -> None:
+    """Raise InputError naming the first pose (N, 3) with a non-finite angle, if any."""
+    finite = np.isfinite(angles).all(axis=1)
+    if not finite.all():
+        bad = int(np.flatnonzero(~finite)[0])
         msg = f"angles: expected finite values, pose {bad} is {angles[bad].tolist()}"
         raise InputError(msg)
-    position = validate_position(manipulator, position)  # shape, finite, |p| bounded
 
-    count = angles.shape[0]
-    margins = np.empty((4, count))
-    legs = np.zeros((4, count), dtype=np.int64)
-    pairs = np.zeros((count, 2), dtype=np.int64)
-    model = _chunk_model(manipulator, interference=True)
-    positions = np.broadcast_to(position, (CHUNK, 3))
-    for start in range(0, count, CHUNK):
-        stop = min(start + CHUNK, count)
-        model.evaluate(
-            tt_to_matrix(angles[start:stop]),
-            positions[: stop - start],
-            margins[:, start:stop],
-            legs[:, start:stop],
-            pairs[start:stop],
-        )
-    limiting = relative_margins(manipulator, margins).argmin(axis=0)
-    enabled = manipulator.leg_diameter > 0.0
-    legs_1 = legs + 1
-    if not enabled:
-        legs_1[3] = 0
-    return CheckResult(
-        position=position.copy(),
-        angles=angles,
-        reachable=np.all(margins >= 0.0, axis=0),
-        margins={name: margins[k] for k, name in enumerate(CONSTRAINT_NAMES)},
-        limiting_legs={name: legs_1[k] for k, name in enumerate(CONSTRAINT_NAMES)},
-        limiting_pair=pairs + 1 if enabled else pairs,
-        limiting_constraint=limiting,
-        limiting_leg=legs_1[limiting, np.arange(count)],
-    )
+
+_POOL: ThreadPoolExecutor | None = None
+
+
+def _cores() -> int:
+    """CPU cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def _pool() -> ThreadPoolExecutor:
+    """Threads for large batches (the kernels release the GIL), created on first use."""
+    global _POOL
+    if _POOL is None:
+        _POOL = ThreadPoolExecutor(max_workers=os.cpu_count(), thread_name_prefix="hexapod-check")
+    return _POOL

@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError, ResolutionError
+from . import kernels
 from .constraints import relative_margins
 from .manipulator import Manipulator
 from .projected import reference_torsion_interval, require_reachable_reference
@@ -48,7 +49,6 @@ from .resolution import (
 from .search import RaySearch
 
 #: numpy >= 2 names it trapezoid; numpy 1.x (Ubuntu 24.04's python3-numpy 1.26) trapz.
-_trapezoid = getattr(np, "trapezoid", None) or np.trapz  # noqa: NPY201
 
 __all__ = [
     "OrientationSlice",
@@ -60,6 +60,8 @@ __all__ = [
 
 #: Pattern-search rounds when refining ψmax / ψmin.
 PSI_LIMIT_ROUNDS = 24
+#: Longest scan step of :func:`torsion_range`, rad.
+TORSION_MAX_STEP = 0.25
 
 
 @dataclass(frozen=True)
@@ -216,14 +218,9 @@ class _Slicer:
         count = psis.size
         n = self.n_rays
         ends = np.concatenate([_ray_ends(c, self.directions) for c in centers])
-
-        def angles_at(rays: NDArray[np.int64], s: NDArray[np.float64]) -> NDArray[np.float64]:
-            which, k = np.divmod(rays, n)
-            x = centers[which, 0] + s * self.directions[k, 0]
-            y = centers[which, 1] + s * self.directions[k, 1]
-            return _xy_to_angles(x, y, psis[which])
-
-        found = self.search.first_violation(angles_at, count * n, ends, self.tolerance)
+        origins = np.column_stack([np.repeat(centers, n, axis=0), np.repeat(psis, n)])
+        directions = np.tile(np.column_stack([self.directions, np.zeros(n)]), (count, 1))
+        found = self.search.rays("cylindrical", origins, directions, ends, self.tolerance)
         result = []
         for index in range(count):
             s = found.feasible[index * n : (index + 1) * n]
@@ -275,11 +272,9 @@ class _Slicer:
         """For points (n, 2) feasible at psi_start, the torsion where feasibility ends going
         in direction ``sign``; points infeasible at psi_start get psi_start."""
 
-        def angles_at(rays: NDArray[np.int64], s: NDArray[np.float64]) -> NDArray[np.float64]:
-            return _xy_to_angles(points[rays, 0], points[rays, 1], psi_start + sign * s)
-
-        found = self.search.first_violation(
-            angles_at, points.shape[0], math.pi - sign * psi_start, self.tolerance
+        origins = np.column_stack([points, np.full(points.shape[0], psi_start)])
+        found = self.search.rays(
+            "cylindrical", origins, [0.0, 0.0, sign], math.pi - sign * psi_start, self.tolerance
         )
         reach = np.where(found.start_feasible, found.feasible, 0.0)
         return psi_start + sign * reach
@@ -386,7 +381,8 @@ def orientation_workspace(
     slices = lower[:0:-1] + upper
     areas = np.array([piece.area() for piece in slices])
     psis = np.array([piece.psi for piece in slices])
-    volume = float(_trapezoid(areas, psis)) if len(slices) > 1 else 0.0
+    # Trapezoid rule written out: numpy.trapezoid needs numpy >= 2 (Ubuntu 24.04 has 1.26).
+    volume = float(np.sum(0.5 * (areas[1:] + areas[:-1]) * np.diff(psis)))
     # Cones from the end slices to the extreme torsions (area shrinking to zero).
     volume += 0.5 * areas[-1] * (psi_max - psis[-1]) + 0.5 * areas[0] * (psis[0] - psi_min)
     if progress:
@@ -446,45 +442,23 @@ def torsion_range(
         msg = f"direction: expected theta in [0, pi] rad, got {theta!r}"
         raise InputError(msg)
     search = RaySearch(manipulator, position)
-
-    def margins_at(psi: NDArray[np.float64]) -> NDArray[np.float64]:
-        angles = np.column_stack([np.full(psi.size, phi), np.full(psi.size, theta), psi])
-        return search.margins(angles)
-
-    # Scan: sample points and their feasibility, with certified spacing.
-    samples, states = [], []
-    psi = -math.pi
-    while True:
-        margins = margins_at(np.array([psi]))
-        ok = bool(np.all(margins >= 0.0))
-        samples.append(psi)
-        states.append(ok)
-        if psi >= math.pi:
-            break
-        if ok:
-            step = float(search.certified_step(margins)[0])
-        else:
-            pose = np.array([[phi, theta, psi]])
-            step = float(search.recovery_step(pose, margins)[0])
-        psi = min(psi + float(np.clip(step, search.min_step, 0.25)), math.pi)
-    samples_array = np.array(samples)
-    states_array = np.array(states)
-    # Bisect every transition to the tolerance.
-    change = np.flatnonzero(states_array[1:] != states_array[:-1])
-    low = samples_array[change]
-    high = samples_array[change + 1]
-    rising = ~states_array[change]  # infeasible -> feasible
-    while change.size and np.max(high - low) > tolerance:
-        middle = 0.5 * (low + high)
-        ok = np.all(margins_at(middle) >= 0.0, axis=0)
-        # Keep the transition inside [low, high]: the side matching the start state moves.
-        move_low = ok != rising
-        low = np.where(move_low, middle, low)
-        high = np.where(move_low, high, middle)
-    # Feasible ends: for a rising edge the feasible side is high, for a falling edge low.
-    edges = np.where(rising, high, low)
+    capacity = math.ceil(2.0 * math.pi / search.min_step) + 2
+    edges = np.empty(capacity)
+    rising = np.empty(capacity, dtype=np.bool_)
+    count, start_feasible = kernels.torsion_scan(
+        search.model,
+        search.position,
+        float(phi),
+        float(theta),
+        search.min_step,
+        TORSION_MAX_STEP,
+        tolerance,
+        edges,
+        rising,
+    )
+    edges, rising = edges[:count], rising[:count]
     intervals = []
-    start = -math.pi if states_array[0] else None
+    start = -math.pi if start_feasible else None
     for edge, up in zip(edges, rising, strict=True):
         if up:
             start = float(edge)

@@ -142,13 +142,37 @@ def reference_torsion_interval(search: RaySearch, tolerance: float) -> tuple[flo
         When the reference orientation (0, 0, 0) is itself unreachable.
     """
     require_reachable_reference(search)
-    directions = np.array([1.0, -1.0])
-
-    def angles_at(rays: NDArray[np.int64], s: NDArray[np.float64]) -> NDArray[np.float64]:
-        return np.column_stack([np.zeros(rays.size), np.zeros(rays.size), directions[rays] * s])
-
-    found = search.first_violation(angles_at, 2, math.pi, tolerance)
+    # Torsion rays (0, 0, ±s) from the reference.
+    found = search.rays("tt", np.zeros(3), [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]], math.pi, tolerance)
     return -float(found.feasible[1]), float(found.feasible[0])
+
+
+def tilt_rays(
+    search: RaySearch,
+    phi: NDArray[np.float64],
+    psi: NDArray[np.float64],
+    tolerance: float,
+) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """Boundary tilt and limiting constraint along the tilt rays (φ_k, s, ψ_k) from θ = 0.
+
+    Parameters
+    ----------
+    search : RaySearch
+    phi, psi : ndarray, shape (n,)
+        Azimuth and torsion of each ray, rad.
+    tolerance : float
+        rad.
+
+    Returns
+    -------
+    theta : ndarray, shape (n,)
+        Last feasible tilt, rad.
+    limiting : ndarray, shape (n,), int
+        Constraint violated just beyond (−1: none up to θ = π).
+    """
+    origins = np.column_stack([phi, np.zeros(phi.size), psi])
+    found = search.rays("tt", origins, [0.0, 1.0, 0.0], math.pi, tolerance)
+    return found.feasible, found.limiting
 
 
 def projected_workspace(
@@ -202,25 +226,18 @@ def projected_workspace(
     search = RaySearch(manipulator, position)
     require_reachable_reference(search)
     phi = 2.0 * math.pi * np.arange(n_phi) / n_phi
-
-    def tilt_rays(psi: NDArray[np.float64]):
-        def angles_at(rays: NDArray[np.int64], s: NDArray[np.float64]) -> NDArray[np.float64]:
-            return np.column_stack([phi[rays % n_phi], s, psi[rays]])
-
-        return angles_at
-
     zero = np.zeros(n_phi)
-    base = search.first_violation(tilt_rays(zero), n_phi, math.pi, tolerance)
-    theta, psi, limiting = base.feasible, zero.copy(), base.limiting
+    theta_zero, limiting_zero = tilt_rays(search, phi, zero, tolerance)
+    theta, psi, limiting = theta_zero, zero.copy(), limiting_zero
     gap = None
     if method is Method.EXACT:
         if progress:
             progress(0.1)
         torsion = reference_torsion_interval(search, tolerance)
         theta, psi, limiting = _exact(
-            search, phi, torsion, tolerance, base.feasible, base.limiting, progress
+            search, phi, torsion, tolerance, theta_zero, limiting_zero, progress
         )
-        gap = theta - base.feasible
+        gap = theta - theta_zero
     if progress:
         progress(1.0)
     return ProjectedWorkspace(
@@ -266,12 +283,7 @@ def _exact(
         psi: NDArray[np.float64], tol: float = coarse
     ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
         """Boundary tilt and limiting constraint of rays (phi[k % n_phi], psi[k])."""
-
-        def angles_at(rays: NDArray[np.int64], s: NDArray[np.float64]) -> NDArray[np.float64]:
-            return np.column_stack([phi[rays % n_phi], s, psi[rays]])
-
-        found = search.first_violation(angles_at, psi.size, math.pi, tol)
-        return found.feasible, found.limiting
+        return tilt_rays(search, np.resize(phi, psi.size), psi, tol)
 
     others = grid[grid != 0.0]
     found, found_limits = boundary(np.repeat(others, n_phi))

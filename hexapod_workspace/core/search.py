@@ -41,27 +41,25 @@ point is the feasible end, so every reported boundary point satisfies all four c
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-from .constraints import inverse_kinematics, pose_margins, relative_margins
+from . import kernels
 from .manipulator import Manipulator
-from .rotations import tt_to_matrix
 
-__all__ = ["DEFAULT_MIN_STEP", "RaySearch", "RaySearchResult"]
+__all__ = ["DEFAULT_MIN_STEP", "RAY_KINDS", "RaySearch", "RaySearchResult"]
 
 #: Shortest step of the march (rad): below it, steps are no longer Lipschitz-certified.
 DEFAULT_MIN_STEP = 1e-3
 #: Longest step of the march (rad); steps are certified, this only bounds a single jump.
-MAX_STEP = 1.0
+MAX_STEP = kernels.MAX_STEP
 #: Shrink certified steps by this factor so that rounding cannot land on a violated point.
-SAFETY = 1.0 - 1e-9
-
-#: angles_at(ray_indices (n,), s (n,)) -> Tilt-and-Torsion angles (n, 3), rad.
-AnglesAt = Callable[[NDArray[np.int64], NDArray[np.float64]], NDArray[np.float64]]
+SAFETY = kernels.SAFETY
+#: Coordinates in which a ray is a straight line: T&T angles (φ, θ, ψ), or the cylindrical
+#: picture (x, y, ψ) = (θ cos φ, θ sin φ, ψ).
+RAY_KINDS = {"tt": kernels.KIND_TT, "cylindrical": kernels.KIND_CYLINDRICAL}
 
 
 @dataclass(frozen=True)
@@ -76,8 +74,8 @@ class RaySearchResult:
         First violated parameter found, ``feasible < violated ≤ feasible + tolerance``;
         ``inf`` when the ray reached its end without a violation.
     limiting : ndarray, shape (n,), int
-        Index into CONSTRAINT_NAMES of the most violated constraint at ``violated``
-        (−1 when none was met).
+        Index into CONSTRAINT_NAMES of the most violated constraint (relative margins) at
+        ``violated`` (−1 when none was met).
     start_feasible : ndarray, shape (n,), bool
         Whether the ray's start point was feasible (when not, ``feasible`` is NaN).
     evaluations : int
@@ -89,6 +87,16 @@ class RaySearchResult:
     limiting: NDArray[np.int64]
     start_feasible: NDArray[np.bool_]
     evaluations: int
+
+
+def _vectors(values: ArrayLike, count: int) -> NDArray[np.float64]:
+    """(count, 3) contiguous float64 from (3,) or (count, 3)."""
+    return np.ascontiguousarray(np.broadcast_to(np.asarray(values, dtype=np.float64), (count, 3)))
+
+
+def _scalars(values: ArrayLike, count: int) -> NDArray[np.float64]:
+    """(count,) contiguous float64 from a scalar or (count,)."""
+    return np.ascontiguousarray(np.broadcast_to(np.asarray(values, dtype=np.float64), (count,)))
 
 
 class RaySearch:
@@ -107,171 +115,80 @@ class RaySearch:
         self, manipulator: Manipulator, position: NDArray[np.float64], min_step: float = 1e-3
     ) -> None:
         self.manipulator = manipulator
-        self.position = np.asarray(position, dtype=np.float64)
+        self.position = np.ascontiguousarray(position, dtype=np.float64)
         self.min_step = float(min_step)
-        self.rho = float(np.max(np.linalg.norm(manipulator.platform_joints, axis=1)))
-        self.length_min = float(np.min(manipulator.leg_length_min))
+        self.model = kernels.model_vector(manipulator)
         self.evaluations = 0
 
-    # ------------------------------------------------------------------ evaluation
     def margins(self, angles: NDArray[np.float64]) -> NDArray[np.float64]:
         """The four margins of poses (n, 3) at the search position; shape (4, n)."""
-        self.evaluations += angles.shape[0]
-        return pose_margins(self.manipulator, tt_to_matrix(angles), self.position).margins
-
-    def certified_step(self, margins: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Length over which no margin can reach zero, from feasible margins (4, n); (n,)."""
-        # Shortest leg now: both leg-length margins are >= m_len, so l >= l_min + m_len.
-        length_now = self.length_min + np.maximum(margins[0], 0.0)
-        floor = np.maximum(self.length_min, 0.5 * length_now)
-        rho = self.rho
-        # fmin ignores NaN; +inf (interference disabled) never limits.
-        step = np.fmin(margins[0] / rho, margins[1] * floor / rho)
-        np.fmin(step, margins[2] / (1.0 + rho / floor), out=step)
-        np.fmin(step, margins[3] / (2.0 * rho), out=step)
-        np.fmin(step, 0.5 * length_now / rho, out=step)
-        np.fmin(step, MAX_STEP, out=step)
-        return np.fmax(step, 0.0, out=step) * SAFETY
-
-    def recovery_step(
-        self, angles: NDArray[np.float64], margins: NDArray[np.float64]
-    ) -> NDArray[np.float64]:
-        """Length over which violated poses (n, 3) stay violated; margins (4, n); shape (n,).
-
-        The most violated constraint, in Lipschitz units, cannot climb back to zero within
-        ``|m_c| / L_c``; the joint-angle bounds use the current shortest leg (from the inverse
-        kinematics) and a step that keeps every leg at least half that long.
-        """
-        lengths = inverse_kinematics(self.manipulator, tt_to_matrix(angles), self.position).lengths
-        floor = 0.5 * lengths.min(axis=1)
-        rho = self.rho
-        bounds = np.stack(
-            [
-                np.full_like(floor, rho),
-                rho / floor,
-                1.0 + rho / floor,
-                np.full_like(floor, 2.0 * rho),
-            ]
+        angles = np.ascontiguousarray(angles, dtype=np.float64)
+        count = angles.shape[0]
+        margins = np.empty((4, count))
+        kernels.check_angles(
+            self.model,
+            angles,
+            self.position,
+            0,
+            count,
+            margins,
+            np.empty((6, count), dtype=np.int64),
+            np.empty((count, 2), dtype=np.int64),
+            np.empty(count, dtype=np.bool_),
         )
-        with np.errstate(invalid="ignore"):
-            recover = np.where(margins < 0.0, -margins / bounds, 0.0).max(axis=0)
-        return np.minimum(recover, floor / rho) * SAFETY
+        self.evaluations += count
+        return margins
 
-    def distance_estimate(self, margins: NDArray[np.float64]) -> NDArray[np.float64]:
-        """A continuous signed estimate of the distance to the boundary along a ray (rad):
-        min_c m_c / L_c with fixed Lipschitz constants; ≥ 0 exactly when feasible."""
-        floor = max(self.length_min, 1e-3)
-        rho = self.rho
-        scale = np.array([rho, rho / floor, 1.0 + rho / floor, 2.0 * rho])[:, None]
-        return np.min(margins / scale, axis=0)
-
-    def most_violated(self, margins: NDArray[np.float64]) -> NDArray[np.int64]:
-        """Index of the most violated constraint (relative units) per pose; margins (4, n)."""
-        return relative_margins(self.manipulator, margins).argmin(axis=0)
-
-    # ------------------------------------------------------------------ search
-    def first_violation(
+    def rays(
         self,
-        angles_at: AnglesAt,
-        count: int,
-        s_end: NDArray[np.float64] | float,
+        kind: str,
+        origins: ArrayLike,
+        directions: ArrayLike,
+        s_end: ArrayLike,
         tolerance: float,
-        s_start: NDArray[np.float64] | float = 0.0,
+        s_start: ArrayLike = 0.0,
     ) -> RaySearchResult:
-        """Find, along ``count`` rays, the first violated parameter in [s_start, s_end].
+        """Find, along rays ``origins + s·directions``, the first violated s in [s_start, s_end].
 
         Parameters
         ----------
-        angles_at : callable
-            ``angles_at(ray_indices, s)`` gives the T&T angles (n, 3) of rays at parameters s.
-        count : int
-            Number of rays.
-        s_end : float or ndarray, shape (count,)
+        kind : {"tt", "cylindrical"}
+            Coordinates of ``origins`` and ``directions``: T&T angles (φ, θ, ψ), rad, or the
+            cylindrical picture (x, y, ψ), rad.
+        origins, directions : array_like, shape (n, 3) or (3,)
+            Ray i is ``origins[i] + s·directions[i]`` (the platform turns at most 1 rad per
+            unit s along the rays used here: see the module documentation).
+        s_end : float or array_like, shape (n,)
             End of each ray, rad.
         tolerance : float
-            Bracket width at which bisection stops, rad.
-        s_start : float or ndarray, shape (count,)
+            Bracket width at which the search stops, rad.
+        s_start : float or array_like, shape (n,)
             Start of each ray (normally a feasible point), rad.
 
         Returns
         -------
         RaySearchResult
         """
-        start_count = self.evaluations
-        s_end = np.broadcast_to(np.asarray(s_end, dtype=np.float64), (count,)).copy()
-        s = np.broadcast_to(np.asarray(s_start, dtype=np.float64), (count,)).copy()
-        feasible = np.full(count, np.nan)
-        violated = np.full(count, np.inf)
-        # Signed distance estimates at the feasible and violated ends, for the secant phase.
-        feasible_value = np.zeros(count)
-        violated_value = np.zeros(count)
-        limiting = np.full(count, -1, dtype=np.int64)
-        start_feasible = np.ones(count, dtype=bool)
-        first = np.ones(count, dtype=bool)
-        active = np.arange(count)
-        bracket: list[NDArray[np.int64]] = []
-        while active.size:
-            margins = self.margins(angles_at(active, s[active]))
-            bad = ~np.all(margins >= 0.0, axis=0)
-            estimate = self.distance_estimate(margins)
-            if np.any(bad):
-                rays = active[bad]
-                violated[rays] = s[rays]
-                violated_value[rays] = estimate[bad]
-                limiting[rays] = self.most_violated(margins[:, bad])
-                start_feasible[rays[first[rays]]] = False
-                bracket.append(rays[~first[rays]])
-            good = active[~bad]
-            first[active] = False
-            feasible[good] = s[good]
-            feasible_value[good] = estimate[~bad]
-            step = np.maximum(self.certified_step(margins[:, ~bad]), self.min_step)
-            done = s[good] >= s_end[good]
-            s[good] = np.minimum(s[good] + step, s_end[good])
-            active = good[~done]
-        rays = np.concatenate(bracket) if bracket else np.zeros(0, dtype=np.int64)
-        low, high = feasible[rays], violated[rays]
-        low_value, high_value = feasible_value[rays], violated_value[rays]
-        bisect = np.zeros(rays.size, dtype=bool)
-        open_ = np.flatnonzero(high - low > tolerance)
-        while open_.size:
-            width = high[open_] - low[open_]
-            # Secant estimate of the crossing of the signed distance estimate; midpoint where
-            # the last secant step failed to halve the bracket (safeguard).
-            with np.errstate(divide="ignore", invalid="ignore"):
-                secant = (
-                    low[open_] + low_value[open_] / (low_value[open_] - high_value[open_]) * width
-                )
-            guess = np.where(bisect[open_] | ~np.isfinite(secant), low[open_] + 0.5 * width, secant)
-            half = 0.25 * tolerance
-            guess = np.clip(guess, low[open_] + half, high[open_] - half)
-            # Probe on both sides of the guess: when it is right, the bracket is done.
-            probes = np.concatenate([guess - half, guess + half])
-            rays_twice = np.concatenate([rays[open_], rays[open_]])
-            margins = self.margins(angles_at(rays_twice, probes))
-            values = self.distance_estimate(margins)
-            bad = ~np.all(margins >= 0.0, axis=0)
-            count = open_.size
-            minus_bad, plus_bad = bad[:count], bad[count:]
-            minus, plus = guess - half, guess + half
-            new_low = np.where(minus_bad, low[open_], np.where(plus_bad, minus, plus))
-            new_high = np.where(minus_bad, minus, np.where(plus_bad, plus, high[open_]))
-            new_low_value = np.where(
-                minus_bad, low_value[open_], np.where(plus_bad, values[:count], values[count:])
-            )
-            new_high_value = np.where(
-                minus_bad, values[:count], np.where(plus_bad, values[count:], high_value[open_])
-            )
-            which = np.where(minus_bad, 0, np.where(plus_bad, 1, -1))
-            hit = which >= 0
-            if np.any(hit):
-                columns = np.where(which == 1, count, 0) + np.arange(count)
-                limiting[rays[open_][hit]] = self.most_violated(margins[:, columns[hit]])
-            bisect[open_] = (new_high - new_low) > 0.5 * width
-            low[open_], high[open_] = new_low, new_high
-            low_value[open_], high_value[open_] = new_low_value, new_high_value
-            open_ = open_[(new_high - new_low) > tolerance]
-        feasible[rays], violated[rays] = low, high
-        return RaySearchResult(
-            feasible, violated, limiting, start_feasible, self.evaluations - start_count
+        shapes = [np.shape(v) for v in (origins, directions)]
+        count = max([shape[0] for shape in shapes if len(shape) == 2] + [np.size(s_end), 1])
+        feasible = np.empty(count)
+        violated = np.empty(count)
+        limiting = np.empty(count, dtype=np.int64)
+        start_feasible = np.empty(count, dtype=np.bool_)
+        evaluations = kernels.search_rays(
+            self.model,
+            self.position,
+            RAY_KINDS[kind],
+            _vectors(origins, count),
+            _vectors(directions, count),
+            _scalars(s_start, count),
+            _scalars(s_end, count),
+            float(tolerance),
+            self.min_step,
+            feasible,
+            violated,
+            limiting,
+            start_feasible,
         )
+        self.evaluations += evaluations
+        return RaySearchResult(feasible, violated, limiting, start_feasible, evaluations)

@@ -1,0 +1,1198 @@
+"""Compiled kernels (numba): the four constraint margins of a pose, and the ray searches.
+
+Everything the workspace computations evaluate per pose runs here, compiled once and cached on
+disk (``cache=True``): the margins of :mod:`hexapod_workspace.core.constraints` (DESIGN.md
+section 2) and the certified march + secant/bisection of :mod:`hexapod_workspace.core.search`
+along whole families of rays, so that a search pays no per-call overhead per step.
+
+Batches are evaluated 128 poses at a time as planes of one flat array, stage by stage
+(:func:`_check_block`), so that every loop vectorises; single poses and the rare poses that need
+care go through the scalar :func:`_pose`. Both follow the numpy reference of
+``test/reference.py`` operation by operation: margins agree to rounding.
+
+The model of a manipulator is packed into one float64 vector (:func:`model_vector`, offsets
+below): the kernels take a handful of arrays, which keeps numba's dispatch cheap (a few
+microseconds per call).
+
+Compilation cache
+-----------------
+numba stores the compiled code next to this file (``__pycache__``) when that directory is
+writable, otherwise in the user cache directory (``$XDG_CACHE_HOME/hexapod_workspace/numba``,
+default ``~/.cache/hexapod_workspace/numba``), so a read-only install (colcon install space,
+system site-packages) compiles once per user. :func:`cache_is_warm` tells whether a run will
+compile; :func:`warm_up` compiles (or loads) every kernel and returns the seconds it took.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = [
+    "CACHE_DIRECTORY",
+    "cache_is_warm",
+    "compile_notice",
+    "model_vector",
+    "warm_up",
+]
+
+
+def _writable(directory: Path) -> bool:
+    """Whether files can be created in ``directory`` (created if missing)."""
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=directory):
+            pass
+    except OSError:
+        return False
+    return True
+
+
+def _cache_directory() -> Path | None:
+    """Where numba caches this module's compiled code (None: nowhere writable, no cache)."""
+    configured = os.environ.get("NUMBA_CACHE_DIR")
+    if configured:
+        return Path(configured)
+    in_tree = Path(__file__).resolve().parent / "__pycache__"
+    if _writable(in_tree):
+        return in_tree
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    user = Path(base) / "hexapod_workspace" / "numba"
+    if _writable(user):
+        # Must be set before numba is imported: numba reads it once, at import.
+        os.environ["NUMBA_CACHE_DIR"] = str(user)
+        return user
+    return None
+
+
+#: Directory of the compiled-code cache (None when no directory is writable: then every
+#: process compiles, which takes seconds, and nothing is cached).
+CACHE_DIRECTORY = _cache_directory()
+if CACHE_DIRECTORY is not None and "numba" in sys.modules:
+    # numba was imported earlier by someone else: point its configuration here as well.
+    import numba.core.config
+
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        numba.core.config.CACHE_DIR = os.environ["NUMBA_CACHE_DIR"]
+
+import numba  # noqa: E402
+import numba.core.event  # noqa: E402
+
+_CACHE = CACHE_DIRECTORY is not None
+
+
+def _jit(function):
+    """An entry point: nopython mode, releases the GIL, cached on disk (with its callees)."""
+    return numba.njit(cache=_CACHE, nogil=True, error_model="numpy")(function)
+
+
+def _helper(function):
+    """A function only kernels call: compiled into them, so not cached on its own (a process
+    that loads the kernels from the cache then never touches it)."""
+    return numba.njit(nogil=True, error_model="numpy")(function)
+
+
+# ------------------------------------------------------------------------------ model layout
+# Offsets into the model vector. Per-leg 3-vectors are stored leg-major (x, y, z of leg 0, ...).
+A = 0  # base joints a_i, base frame, m (18)
+B = 18  # platform joints b_i, mobile frame, m (18)
+JA = 36  # base joint axes jA_i, base frame (18)
+JB = 54  # platform joint axes jB_i, mobile frame (18)
+LMIN = 72  # leg length minima, m (6)
+LMAX = 78  # leg length maxima, m (6)
+ALPHA = 84  # base joint maximum angles, rad (6)
+BETA = 90  # platform joint maximum angles, rad (6)
+RPAIR = 96  # A_i − A_j for the 15 pairs i < j, m (45)
+RR = 141  # |A_i − A_j|² (15)
+DIAMETER = 156  # D, m
+INTERFERENCE = 157  # 1.0 when the interference check is on (D > 0)
+ALPHA_EQUAL = 158  # 1.0 when every base joint has the same maximum angle
+BETA_EQUAL = 159  # 1.0 when every platform joint has the same maximum angle
+SCALE = 160  # natural scale of each margin (4): see constraints.relative_margins
+RHO = 164  # max |b_i|, m (Lipschitz constants of the search)
+LENGTH_FLOOR = 165  # min ℓmin_i, m
+ESTIMATE_FLOOR = 166  # max(min ℓmin_i, 1e-3), m (fixed Lipschitz constants of the estimate)
+ORDER = 167  # the 15 pair indices, closest pair at the home pose first (as floats)
+MODEL_SIZE = 182
+
+#: Leg pairs (i < j) in the order of numpy.triu_indices(6, 1).
+PAIR_I = np.array([i for i in range(6) for j in range(i + 1, 6)], dtype=np.int64)
+PAIR_J = np.array([j for i in range(6) for j in range(i + 1, 6)], dtype=np.int64)
+
+# Search constants, shared with core.search (which documents them).
+MAX_STEP = 1.0
+SAFETY = 1.0 - 1e-9
+#: Ray kinds: angles along a ray are origin + s·direction in T&T coordinates (φ, θ, ψ), or in
+#: the cylindrical picture (x, y, ψ) with x = θ cos φ, y = θ sin φ.
+KIND_TT, KIND_CYLINDRICAL = 0, 1
+
+
+def model_vector(manipulator) -> NDArray[np.float64]:
+    """The packed model of a manipulator (cached on the immutable manipulator object).
+
+    Parameters
+    ----------
+    manipulator : Manipulator
+
+    Returns
+    -------
+    ndarray, shape (MODEL_SIZE,)
+        Read-only; layout given by the offsets of this module.
+    """
+    cached = manipulator.__dict__.get("_kernel_model")
+    if cached is not None:
+        return cached
+    model = np.zeros(MODEL_SIZE)
+    model[A : A + 18] = manipulator.base_joints.ravel()
+    model[B : B + 18] = manipulator.platform_joints.ravel()
+    model[JA : JA + 18] = manipulator.base_joint_axes.ravel()
+    model[JB : JB + 18] = manipulator.platform_joint_axes.ravel()
+    model[LMIN : LMIN + 6] = manipulator.leg_length_min
+    model[LMAX : LMAX + 6] = manipulator.leg_length_max
+    model[ALPHA : ALPHA + 6] = manipulator.base_joint_max_angle
+    model[BETA : BETA + 6] = manipulator.platform_joint_max_angle
+    r = manipulator.base_joints[PAIR_I] - manipulator.base_joints[PAIR_J]
+    model[RPAIR : RPAIR + 45] = r.ravel()
+    model[RR : RR + 15] = np.einsum("pk,pk->p", r, r)
+    model[DIAMETER] = manipulator.leg_diameter
+    model[INTERFERENCE] = 1.0 if manipulator.leg_diameter > 0.0 else 0.0
+    alpha, beta = manipulator.base_joint_max_angle, manipulator.platform_joint_max_angle
+    model[ALPHA_EQUAL] = 1.0 if np.all(alpha == alpha[0]) else 0.0
+    model[BETA_EQUAL] = 1.0 if np.all(beta == beta[0]) else 0.0
+    model[SCALE : SCALE + 4] = [
+        float(np.mean(manipulator.leg_length_max - manipulator.leg_length_min)) / 2.0,
+        float(np.mean(alpha)),
+        float(np.mean(beta)),
+        manipulator.leg_diameter if manipulator.leg_diameter > 0.0 else 1.0,
+    ]
+    model[RHO] = float(np.max(np.linalg.norm(manipulator.platform_joints, axis=1)))
+    model[LENGTH_FLOOR] = float(np.min(manipulator.leg_length_min))
+    model[ESTIMATE_FLOOR] = max(model[LENGTH_FLOOR], 1e-3)
+    home = manipulator.home_position + manipulator.platform_joints
+    home_distance = [
+        _segment_distance_literal(
+            manipulator.base_joints[i], home[i], manipulator.base_joints[j], home[j]
+        )
+        for i, j in zip(PAIR_I, PAIR_J, strict=True)
+    ]
+    model[ORDER : ORDER + 15] = np.argsort(home_distance, kind="stable")
+    model.setflags(write=False)
+    manipulator.__dict__["_kernel_model"] = model
+    return model
+
+
+def _segment_distance_literal(p0, p1, q0, q1) -> float:
+    """Segment distance by dense sampling of both (only to order the pairs; any estimate
+    works there)."""
+    s = np.linspace(0.0, 1.0, 65)[:, None]
+    first = p0 + s * (p1 - p0)
+    second = q0 + s * (q1 - q0)
+    return float(np.min(np.linalg.norm(first[:, None, :] - second[None, :, :], axis=2)))
+
+
+# ------------------------------------------------------------------------------ one pose
+# Slots of the per-pose result vector ``out``.
+OUT_LEG = 4  # limiting leg of each margin (4 slots, as float)
+OUT_PAIR = 8  # closest pair (2 slots)
+OUT_SHORTEST = 10  # shortest leg length, m
+OUT_SIZE = 11
+
+
+@_helper
+def _clamp01(value):
+    """Clamp to [0, 1]; NaN stays NaN."""
+    if value < 0.0:
+        return 0.0
+    if value > 1.0:
+        return 1.0
+    return value
+
+
+@_helper
+def _pose(model, r, px, py, pz, scratch, out, want_pair):
+    """Margins of one pose into ``out`` (OUT_SIZE,).
+
+    ``r`` (9,) is the rotation matrix row-major, (px, py, pz) the position (m), ``scratch``
+    (5, 6) working memory (leg vector planes and squared lengths). Follows the numpy reference
+    (test/reference.py, BatchedMargins) operation by operation, so margins agree to rounding:
+    the smallest margin of each constraint and its leg (first one on ties; NaN, a zero-length
+    leg, wins), the closest pair by Ericson's clamped closest points.
+    ``want_pair`` False skips the interference check (margin +inf).
+    """
+    lx = scratch[0]
+    ly = scratch[1]
+    lz = scratch[2]
+    sq = scratch[3]
+    inverse_sq = scratch[4]
+    r00, r01, r02 = r[0], r[1], r[2]
+    r10, r11, r12 = r[3], r[4], r[5]
+    r20, r21, r22 = r[6], r[7], r[8]
+    m_len = np.inf
+    leg_len = 0
+    m_a = np.inf
+    leg_a = 0
+    m_b = np.inf
+    leg_b = 0
+    shortest = np.inf
+    alpha_equal = model[ALPHA_EQUAL] != 0.0
+    beta_equal = model[BETA_EQUAL] != 0.0
+    for k in range(6):
+        bx = model[B + 3 * k]
+        by = model[B + 3 * k + 1]
+        bz = model[B + 3 * k + 2]
+        x = (r00 * bx + r01 * by + r02 * bz) + (px - model[A + 3 * k])
+        y = (r10 * bx + r11 * by + r12 * bz) + (py - model[A + 3 * k + 1])
+        z = (r20 * bx + r21 * by + r22 * bz) + (pz - model[A + 3 * k + 2])
+        lx[k] = x
+        ly[k] = y
+        lz[k] = z
+        squared = x * x + y * y + z * z
+        sq[k] = squared
+        length = math.sqrt(squared)
+        if length < shortest:
+            shortest = length
+        inverse = 1.0 / length
+        inverse_sq[k] = inverse * inverse
+        value = min(length - model[LMIN + k], model[LMAX + k] - length)
+        if value < m_len or (value != value and m_len == m_len):
+            m_len = value
+            leg_len = k
+        # Base joint: angle between jA_i and n_i.
+        cos_a = (
+            model[JA + 3 * k] * x + model[JA + 3 * k + 1] * y + model[JA + 3 * k + 2] * z
+        ) * inverse
+        # Platform joint: angle between R·jB_i and −n_i.
+        jx = model[JB + 3 * k]
+        jy = model[JB + 3 * k + 1]
+        jz = model[JB + 3 * k + 2]
+        cos_b = (
+            (r00 * jx + r01 * jy + r02 * jz) * x
+            + (r10 * jx + r11 * jy + r12 * jz) * y
+            + (r20 * jx + r21 * jy + r22 * jz) * z
+        ) * -inverse
+        # Equal limits: the margin decreases with the angle, the smallest cosine limits (one
+        # arccos per pose, below); otherwise the margin itself per leg.
+        value = cos_a if alpha_equal else model[ALPHA + k] - math.acos(min(max(cos_a, -1.0), 1.0))
+        if value < m_a or (value != value and m_a == m_a):
+            m_a = value
+            leg_a = k
+        value = cos_b if beta_equal else model[BETA + k] - math.acos(min(max(cos_b, -1.0), 1.0))
+        if value < m_b or (value != value and m_b == m_b):
+            m_b = value
+            leg_b = k
+    if alpha_equal:
+        m_a = model[ALPHA] - math.acos(min(max(m_a, -1.0), 1.0))
+    if beta_equal:
+        m_b = model[BETA] - math.acos(min(max(m_b, -1.0), 1.0))
+    out[0] = m_len
+    out[1] = m_a
+    out[2] = m_b
+    out[OUT_LEG] = leg_len
+    out[OUT_LEG + 1] = leg_a
+    out[OUT_LEG + 2] = leg_b
+    out[OUT_SHORTEST] = shortest
+    if not want_pair or model[INTERFERENCE] == 0.0:
+        out[3] = np.inf
+        out[OUT_LEG + 3] = 0
+        out[OUT_PAIR] = 0
+        out[OUT_PAIR + 1] = 0
+        return
+    # Pairs in the model's order (closest at the home pose first). A pair is skipped when an
+    # exact lower bound of its distance cannot beat the best so far: projected on the unit
+    # vector u = r/|r| (r = A_i − A_j), the segments are at least
+    # (|r|² + min(0, c) − max(0, f)) / |r| apart (c = L_i·r, f = L_j·r). The slack covers
+    # rounding, so a skipped pair never holds the minimum.
+    best = np.inf
+    best_squared = np.inf
+    best_pair = 0
+    for rank in range(15):
+        pair = int(model[ORDER + rank])
+        i = PAIR_I[pair]
+        j = PAIR_J[pair]
+        rx = model[RPAIR + 3 * pair]
+        ry = model[RPAIR + 3 * pair + 1]
+        rz = model[RPAIR + 3 * pair + 2]
+        rr = model[RR + pair]
+        xi = lx[i]
+        yi = ly[i]
+        zi = lz[i]
+        xj = lx[j]
+        yj = ly[j]
+        zj = lz[j]
+        c = xi * rx + yi * ry + zi * rz
+        f = xj * rx + yj * ry + zj * rz
+        a = sq[i]
+        e = sq[j]
+        gap = rr + min(c, 0.0) - max(f, 0.0)
+        if gap > 0.0 and gap * gap >= rr * (best_squared + 1e-12 * (rr + a + e)):
+            continue
+        b = xi * xj + yi * yj + zi * zj
+        denom = a * e - b * b
+        if denom > 1e-14 * a * e:
+            s = min(max((b * f - c * e) / denom, 0.0), 1.0)
+            t = min(max((b * s + f) * inverse_sq[j], 0.0), 1.0)
+            s = min(max((b * t - c) * inverse_sq[i], 0.0), 1.0)
+        else:
+            # Parallel or point-like segments (or NaN): start from s = 0.
+            t = 0.0 if e <= 1e-300 else _clamp01(f / e)
+            s = 0.0 if a <= 1e-300 else _clamp01((b * t - c) / a)
+        squared = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
+        # Compare distances, not their squares, where it matters: pairs whose squares differ
+        # in the last bit can have equal distances, and then the lower pair index limits.
+        if squared <= best_squared or squared != squared:
+            distance = math.sqrt(max(squared, 0.0))
+            if (
+                distance < best
+                or (distance == best and pair < best_pair)
+                or (distance != distance and best == best)
+            ):
+                best = distance
+                best_pair = pair
+            best_squared = min(squared, best_squared)
+    out[3] = best - model[DIAMETER]
+    out[OUT_LEG + 3] = PAIR_I[best_pair]
+    out[OUT_PAIR] = PAIR_I[best_pair]
+    out[OUT_PAIR + 1] = PAIR_J[best_pair]
+
+
+# ------------------------------------------------------------------------------ sin and cos
+# Cody–Waite reduction by π/2 in three parts of 33 bits (exact products for |k| < 2**20) and the
+# Cephes polynomials on [−π/4, π/4]: within 1 ulp of libm, and branch-free, so that loops over a
+# block of poses vectorise. Arguments beyond FAST_TRIG_LIMIT use libm (see _check_block).
+PIO2_1 = 1.57079632673412561417e00
+PIO2_2 = 6.07710050630396597660e-11
+PIO2_3 = 2.02226624879595063154e-21
+TWO_OVER_PI = 0.6366197723675814
+FAST_TRIG_LIMIT = 1e5
+SIN_0, SIN_1, SIN_2 = (
+    1.58962301576546568060e-10,
+    -2.50507477628578072866e-8,
+    2.75573136213857245213e-6,
+)
+SIN_3, SIN_4, SIN_5 = (
+    -1.98412698295895385996e-4,
+    8.33333333332211858878e-3,
+    -1.66666666666666307295e-1,
+)
+COS_0, COS_1, COS_2 = (
+    -1.13585365213876817300e-11,
+    2.08757008419747316778e-9,
+    -2.75573141792967388112e-7,
+)
+COS_3, COS_4, COS_5 = (
+    2.48015872888517045348e-5,
+    -1.38888888888730564116e-3,
+    4.16666666666665929218e-2,
+)
+
+
+@numba.njit(inline="always")
+def _sincos(x):
+    """(sin x, cos x) for |x| ≤ FAST_TRIG_LIMIT, branch-free."""
+    k = math.floor(x * TWO_OVER_PI + 0.5)
+    r = ((x - k * PIO2_1) - k * PIO2_2) - k * PIO2_3
+    z = r * r
+    sine = r + r * z * (((((SIN_0 * z + SIN_1) * z + SIN_2) * z + SIN_3) * z + SIN_4) * z + SIN_5)
+    cosine = (
+        1.0
+        - 0.5 * z
+        + z * z * (((((COS_0 * z + COS_1) * z + COS_2) * z + COS_3) * z + COS_4) * z + COS_5)
+    )
+    quadrant = k - 4.0 * math.floor(k * 0.25)
+    odd = quadrant == 1.0 or quadrant == 3.0
+    sin_value = cosine if odd else sine
+    cos_value = sine if odd else cosine
+    sin_value = -sin_value if quadrant >= 2.0 else sin_value
+    cos_value = -cos_value if (quadrant == 1.0 or quadrant == 2.0) else cos_value
+    return sin_value, cos_value
+
+
+@_helper
+def _tt_matrix(phi, theta, psi, r):
+    """R(φ, θ, ψ) = Rz(φ)·Ry(θ)·Rz(ψ − φ) into r (9,), row-major (as rotations.tt_to_matrix).
+
+    Huge angles are first reduced to their principal values (libm reduces exactly): ψ − φ of
+    two huge angles would be rounded to another orientation than the one they denote.
+    """
+    if max(abs(phi), abs(theta), abs(psi)) > FAST_TRIG_LIMIT:
+        phi = math.atan2(math.sin(phi), math.cos(phi))
+        theta = math.atan2(math.sin(theta), math.cos(theta))
+        psi = math.atan2(math.sin(psi), math.cos(psi))
+    gamma = psi - phi
+    if max(abs(phi), abs(theta), abs(gamma)) <= FAST_TRIG_LIMIT:
+        sa, ca = _sincos(phi)
+        sb, cb = _sincos(theta)
+        sg, cg = _sincos(gamma)
+    else:
+        ca, sa = math.cos(phi), math.sin(phi)
+        cb, sb = math.cos(theta), math.sin(theta)
+        cg, sg = math.cos(gamma), math.sin(gamma)
+    r[0] = ca * cb * cg - sa * sg
+    r[1] = -ca * cb * sg - sa * cg
+    r[2] = ca * sb
+    r[3] = sa * cb * cg + ca * sg
+    r[4] = -sa * cb * sg + ca * cg
+    r[5] = sa * sb
+    r[6] = -sb * cg
+    r[7] = sb * sg
+    r[8] = cb
+
+
+@_helper
+def _limiting_constraint(model, out):
+    """Index of the smallest relative margin (first on ties; NaN wins)."""
+    best = out[0] / model[SCALE]
+    index = 0
+    for c in range(1, 4):
+        value = out[c] / model[SCALE + c]
+        if value < best or (value != value and best == best):
+            best = value
+            index = c
+    return index
+
+
+@_helper
+def _feasible(out):
+    """Every margin ≥ 0 (NaN counts as violated)."""
+    return out[0] >= 0.0 and out[1] >= 0.0 and out[2] >= 0.0 and out[3] >= 0.0
+
+
+# ------------------------------------------------------------------------------ blocks of poses
+#: Poses per block of the vectorised check (its working planes stay in the L1/L2 cache).
+BLOCK = 128
+# Rows of the block scratch (each a plane of BLOCK poses, in one flat array).
+_CA, _SA, _CB, _SB, _CG, _SG = 0, 1, 2, 3, 4, 5
+_R = 6  # 9 rows: rotation matrix, row-major
+_PHI, _THETA, _PSI = 15, 16, 17
+_MIN = 18  # 9 rows: running minima, see the offsets below
+_LEGS = 27  # 7 rows per leg, see the offsets below
+_BLOCK_ROWS = _LEGS + 6 * 7
+# Rows of the running minima (offsets from _MIN): margins or cosines and their leg or pair.
+_M_LEN, _LEG_LEN, _M_A, _LEG_A, _M_B, _LEG_B, _BEST, _PAIR, _FIX = range(9)
+# Rows of one leg (offsets from _LEGS + 7·k): vector, squared length, 1/ℓ², joint cosines.
+_LX, _LY, _LZ, _SQ, _INV, _COS_A, _COS_B = range(7)
+
+
+@_helper
+def _planes(work, row, rows):
+    """The planes [row, row + rows) of a block scratch, as one flat view."""
+    return work[row * BLOCK : (row + rows) * BLOCK]
+
+
+# The leg and pair stages take their planes as separate views with constant row offsets inside:
+# the compiler then needs only a few run-time overlap checks between views, and vectorises.
+@_helper
+def _leg_planes(model, rotation, leg, minima, count, k, px, py, pz):
+    """Leg k over a block: vector, squared length, 1/ℓ², joint cosines; updates the running
+    minima of the leg-length margin and of both cosines with their legs (first leg on ties)."""
+    bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
+    ox, oy, oz = px - model[A + 3 * k], py - model[A + 3 * k + 1], pz - model[A + 3 * k + 2]
+    jax, jay, jaz = model[JA + 3 * k], model[JA + 3 * k + 1], model[JA + 3 * k + 2]
+    jbx, jby, jbz = model[JB + 3 * k], model[JB + 3 * k + 1], model[JB + 3 * k + 2]
+    lmin, lmax, kf = model[LMIN + k], model[LMAX + k], float(k)
+    for n in range(count):
+        r00, r01, r02 = rotation[n], rotation[BLOCK + n], rotation[2 * BLOCK + n]
+        r10, r11, r12 = rotation[3 * BLOCK + n], rotation[4 * BLOCK + n], rotation[5 * BLOCK + n]
+        r20, r21, r22 = rotation[6 * BLOCK + n], rotation[7 * BLOCK + n], rotation[8 * BLOCK + n]
+        x = (r00 * bx + r01 * by + r02 * bz) + ox
+        y = (r10 * bx + r11 * by + r12 * bz) + oy
+        z = (r20 * bx + r21 * by + r22 * bz) + oz
+        leg[_LX * BLOCK + n] = x
+        leg[_LY * BLOCK + n] = y
+        leg[_LZ * BLOCK + n] = z
+        squared = x * x + y * y + z * z
+        leg[_SQ * BLOCK + n] = squared
+        length = math.sqrt(squared)
+        inverse = 1.0 / length
+        leg[_INV * BLOCK + n] = inverse * inverse
+        value = min(length - lmin, lmax - length)
+        # Running minimum and its leg, one select per statement (so that the loop vectorises).
+        smallest = minima[_M_LEN * BLOCK + n]
+        minima[_LEG_LEN * BLOCK + n] = kf if value < smallest else minima[_LEG_LEN * BLOCK + n]
+        minima[_M_LEN * BLOCK + n] = min(value, smallest)
+        cos_a = (jax * x + jay * y + jaz * z) * inverse
+        cos_b = (
+            (r00 * jbx + r01 * jby + r02 * jbz) * x
+            + (r10 * jbx + r11 * jby + r12 * jbz) * y
+            + (r20 * jbx + r21 * jby + r22 * jbz) * z
+        ) * -inverse
+        leg[_COS_A * BLOCK + n] = cos_a
+        leg[_COS_B * BLOCK + n] = cos_b
+        smallest = minima[_M_A * BLOCK + n]
+        minima[_LEG_A * BLOCK + n] = kf if cos_a < smallest else minima[_LEG_A * BLOCK + n]
+        minima[_M_A * BLOCK + n] = min(cos_a, smallest)
+        smallest = minima[_M_B * BLOCK + n]
+        minima[_LEG_B * BLOCK + n] = kf if cos_b < smallest else minima[_LEG_B * BLOCK + n]
+        minima[_M_B * BLOCK + n] = min(cos_b, smallest)
+        degenerate = 0.0 if squared > 1e-300 else 1.0
+        minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], degenerate)
+
+
+@_helper
+def _pair_plane(model, leg_i, leg_j, minima, count, pair):
+    """Segment distance of two legs (pair index ``pair``) over a block (Ericson's clamped
+    closest points, as the reference); updates the running minimum and its pair (first pair on
+    ties) and flags parallel or point-like legs for the exact path."""
+    rx = model[RPAIR + 3 * pair]
+    ry = model[RPAIR + 3 * pair + 1]
+    rz = model[RPAIR + 3 * pair + 2]
+    rr, pf = model[RR + pair], float(pair)
+    for n in range(count):
+        xi, yi, zi = leg_i[_LX * BLOCK + n], leg_i[_LY * BLOCK + n], leg_i[_LZ * BLOCK + n]
+        xj, yj, zj = leg_j[_LX * BLOCK + n], leg_j[_LY * BLOCK + n], leg_j[_LZ * BLOCK + n]
+        a, e = leg_i[_SQ * BLOCK + n], leg_j[_SQ * BLOCK + n]
+        b = xi * xj + yi * yj + zi * zj
+        c = xi * rx + yi * ry + zi * rz
+        f = xj * rx + yj * ry + zj * rz
+        denom = a * e - b * b
+        s = min(max((b * f - c * e) / denom, 0.0), 1.0)
+        t = min(max((b * s + f) * leg_j[_INV * BLOCK + n], 0.0), 1.0)
+        s = min(max((b * t - c) * leg_i[_INV * BLOCK + n], 0.0), 1.0)
+        squared = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
+        distance = math.sqrt(max(squared, 0.0))
+        smallest = minima[_BEST * BLOCK + n]
+        minima[_PAIR * BLOCK + n] = pf if distance < smallest else minima[_PAIR * BLOCK + n]
+        minima[_BEST * BLOCK + n] = min(distance, smallest)
+        regular = 0.0 if denom > 1e-14 * a * e else 1.0
+        minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], regular)
+
+
+@_helper
+def _check_block(model, angles, position, first, count, work, scratch, out, r):
+    """Margins of poses angles[first : first + count] (count ≤ BLOCK) into ``work`` planes.
+
+    Every stage is a loop over the poses of the block without branches, which the compiler
+    vectorises; poses that need care (a zero-length leg, parallel or point-like legs, huge
+    angles) are flagged in the _FIX row and recomputed one by one by :func:`_pose` (with libm's
+    sin and cos for huge angles). Leaves in ``work``: margins in rows 0..3, legs in 4..7, pair
+    in 8..9 (as floats).
+    """
+    px, py, pz = position[0], position[1], position[2]
+    for n in range(count):  # strided reads: a loop of its own (it does not vectorise)
+        work[_PHI * BLOCK + n] = angles[first + n, 0]
+        work[_THETA * BLOCK + n] = angles[first + n, 1]
+        work[_PSI * BLOCK + n] = angles[first + n, 2]
+    for n in range(count):
+        phi = work[_PHI * BLOCK + n]
+        theta = work[_THETA * BLOCK + n]
+        gamma = work[_PSI * BLOCK + n] - phi
+        work[_SA * BLOCK + n], work[_CA * BLOCK + n] = _sincos(phi)
+        work[_SB * BLOCK + n], work[_CB * BLOCK + n] = _sincos(theta)
+        work[_SG * BLOCK + n], work[_CG * BLOCK + n] = _sincos(gamma)
+        largest = max(abs(phi), abs(theta), abs(work[_PSI * BLOCK + n]), abs(gamma))
+        work[(_MIN + _FIX) * BLOCK + n] = 1.0 if largest > FAST_TRIG_LIMIT else 0.0
+        work[(_MIN + _M_LEN) * BLOCK + n] = np.inf
+        work[(_MIN + _M_A) * BLOCK + n] = np.inf
+        work[(_MIN + _M_B) * BLOCK + n] = np.inf
+        work[(_MIN + _LEG_LEN) * BLOCK + n] = 0.0
+        work[(_MIN + _LEG_A) * BLOCK + n] = 0.0
+        work[(_MIN + _LEG_B) * BLOCK + n] = 0.0
+        work[(_MIN + _BEST) * BLOCK + n] = np.inf
+        work[(_MIN + _PAIR) * BLOCK + n] = 0.0
+    for n in range(count):
+        ca, sa = work[_CA * BLOCK + n], work[_SA * BLOCK + n]
+        cb, sb = work[_CB * BLOCK + n], work[_SB * BLOCK + n]
+        cg, sg = work[_CG * BLOCK + n], work[_SG * BLOCK + n]
+        work[_R * BLOCK + n] = ca * cb * cg - sa * sg
+        work[(_R + 1) * BLOCK + n] = -ca * cb * sg - sa * cg
+        work[(_R + 2) * BLOCK + n] = ca * sb
+        work[(_R + 3) * BLOCK + n] = sa * cb * cg + ca * sg
+        work[(_R + 4) * BLOCK + n] = -sa * cb * sg + ca * cg
+        work[(_R + 5) * BLOCK + n] = sa * sb
+        work[(_R + 6) * BLOCK + n] = -sb * cg
+        work[(_R + 7) * BLOCK + n] = sb * sg
+        work[(_R + 8) * BLOCK + n] = cb
+    rotation = _planes(work, _R, 9)
+    minima = _planes(work, _MIN, 9)
+    for k in range(6):
+        _leg_planes(model, rotation, _planes(work, _LEGS + 7 * k, 7), minima, count, k, px, py, pz)
+    interference = model[INTERFERENCE] != 0.0
+    if interference:
+        pair = 0
+        for i in range(5):  # pairs in index order: the first pair wins ties, as the reference
+            for j in range(i + 1, 6):
+                leg_i = _planes(work, _LEGS + 7 * i, 7)
+                leg_j = _planes(work, _LEGS + 7 * j, 7)
+                _pair_plane(model, leg_i, leg_j, minima, count, pair)
+                pair += 1
+    # Per pose: the joint-angle margins (arccos), the rare poses that need care, the outputs.
+    alpha_equal = model[ALPHA_EQUAL] != 0.0
+    beta_equal = model[BETA_EQUAL] != 0.0
+    for n in range(count):
+        if work[(_MIN + _FIX) * BLOCK + n] != 0.0:
+            _tt_matrix(angles[first + n, 0], angles[first + n, 1], angles[first + n, 2], r)
+            _pose(model, r, px, py, pz, scratch, out, True)
+            for slot in range(OUT_SHORTEST):
+                work[(slot) * BLOCK + n] = out[slot]
+            continue
+        work[(0) * BLOCK + n] = work[(_MIN + _M_LEN) * BLOCK + n]
+        work[OUT_LEG * BLOCK + n] = work[(_MIN + _LEG_LEN) * BLOCK + n]
+        if alpha_equal:
+            work[(1) * BLOCK + n] = model[ALPHA] - math.acos(
+                min(max(work[(_MIN + _M_A) * BLOCK + n], -1.0), 1.0)
+            )
+            work[(OUT_LEG + 1) * BLOCK + n] = work[(_MIN + _LEG_A) * BLOCK + n]
+        else:
+            work[(1) * BLOCK + n], work[(OUT_LEG + 1) * BLOCK + n] = _per_leg_angle(
+                model, ALPHA, work, _COS_A, n
+            )
+        if beta_equal:
+            work[(2) * BLOCK + n] = model[BETA] - math.acos(
+                min(max(work[(_MIN + _M_B) * BLOCK + n], -1.0), 1.0)
+            )
+            work[(OUT_LEG + 2) * BLOCK + n] = work[(_MIN + _LEG_B) * BLOCK + n]
+        else:
+            work[(2) * BLOCK + n], work[(OUT_LEG + 2) * BLOCK + n] = _per_leg_angle(
+                model, BETA, work, _COS_B, n
+            )
+        if interference:
+            pair = int(work[(_MIN + _PAIR) * BLOCK + n])
+            work[(3) * BLOCK + n] = work[(_MIN + _BEST) * BLOCK + n] - model[DIAMETER]
+            work[(OUT_LEG + 3) * BLOCK + n] = PAIR_I[pair]
+            work[OUT_PAIR * BLOCK + n] = PAIR_I[pair]
+            work[(OUT_PAIR + 1) * BLOCK + n] = PAIR_J[pair]
+        else:
+            work[(3) * BLOCK + n] = np.inf
+            work[(OUT_LEG + 3) * BLOCK + n] = 0.0
+            work[OUT_PAIR * BLOCK + n] = 0.0
+            work[(OUT_PAIR + 1) * BLOCK + n] = 0.0
+
+
+@_helper
+def _per_leg_angle(model, limits, work, row, n):
+    """min_i (limit_i − arccos(cos_i)) and its leg, for per-leg joint limits (``row`` is the
+    cosine row within each leg's planes)."""
+    best = np.inf
+    leg = 0.0
+    for k in range(6):
+        cosine = work[(_LEGS + 7 * k + row) * BLOCK + n]
+        value = model[limits + k] - math.acos(min(max(cosine, -1.0), 1.0))
+        if value < best:
+            best = value
+            leg = float(k)
+    return best, leg
+
+
+# ------------------------------------------------------------------------------ batches
+@_jit
+def check_angles(model, angles, position, start, stop, margins, ints, pairs, reachable):
+    """Check poses ``angles[start:stop]`` (N, 3) of T&T angles (rad) at ``position`` (3,), m.
+
+    Writes, for each pose n in [start, stop): ``margins[:, n]`` (4, N); ``ints[:4, n]`` (6, N),
+    the 1-based leg with the smallest margin of each constraint, ``ints[4, n]`` the constraint
+    with the smallest relative margin and ``ints[5, n]`` its leg; ``pairs[n]`` (N, 2), the
+    1-based closest pair; ``reachable[n]``. Legs and pairs of ``leg_interference`` are 0 when
+    the check is disabled. Releases the GIL (threads split large batches).
+
+    Returns
+    -------
+    int
+        −1 when every input is finite (and the outputs are written); otherwise nothing is
+        written and it is the first pose in [start, stop) with a non-finite angle, or −2 when
+        the angles are finite and the position is not.
+    """
+    for n in range(start, stop):
+        if not (
+            math.isfinite(angles[n, 0])
+            and math.isfinite(angles[n, 1])
+            and math.isfinite(angles[n, 2])
+        ):
+            return n
+    for k in range(3):
+        if not math.isfinite(position[k]):
+            return -2
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    work = np.empty(_BLOCK_ROWS * BLOCK)
+    enabled = 1 if model[INTERFERENCE] != 0.0 else 0
+    for first in range(start, stop, BLOCK):
+        count = min(BLOCK, stop - first)
+        _check_block(model, angles, position, first, count, work, scratch, out, r)
+        for m in range(count):
+            n = first + m
+            for c in range(4):
+                out[c] = work[c * BLOCK + m]
+                margins[c, n] = out[c]
+                ints[c, n] = int(work[(OUT_LEG + c) * BLOCK + m]) + 1
+            ints[3, n] *= enabled
+            pairs[n, 0] = (int(work[OUT_PAIR * BLOCK + m]) + 1) * enabled
+            pairs[n, 1] = (int(work[(OUT_PAIR + 1) * BLOCK + m]) + 1) * enabled
+            worst = _limiting_constraint(model, out)
+            ints[4, n] = worst
+            ints[5, n] = ints[worst, n]
+            reachable[n] = _feasible(out)
+    return -1
+
+
+@_jit
+def check_one(model, phi, theta, psi, px, py, pz, result):
+    """One pose (φ, θ, ψ) rad at (px, py, pz) m, finite; the fast path of constraints.check_pose.
+
+    Writes ``result`` (12,): margins (4), 1-based limiting legs (4; the interference leg 0 when
+    the check is disabled), closest pair (2, 1-based; 0 when disabled), the limiting constraint
+    and its leg.
+    """
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    _tt_matrix(phi, theta, psi, r)
+    _pose(model, r, px, py, pz, scratch, out, True)
+    enabled = 1.0 if model[INTERFERENCE] != 0.0 else 0.0
+    for c in range(4):
+        result[c] = out[c]
+        result[4 + c] = out[OUT_LEG + c] + 1.0
+    result[7] *= enabled
+    result[8] = (out[OUT_PAIR] + 1.0) * enabled
+    result[9] = (out[OUT_PAIR + 1] + 1.0) * enabled
+    worst = _limiting_constraint(model, out)
+    result[10] = worst
+    result[11] = result[4 + worst]
+
+
+@_jit
+def margins_rotations(model, rotations, positions, interference, margins, legs, pairs):
+    """Margins of N poses given as rotation matrices (N, 3, 3) at positions (M, 3), M ∈ {1, N}.
+
+    Writes ``margins`` (4, N), ``legs`` (4, N) and ``pairs`` (N, 2) as :func:`check_angles`.
+    """
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    shared = positions.shape[0] == 1
+    for n in range(rotations.shape[0]):
+        for i in range(3):
+            for j in range(3):
+                r[3 * i + j] = rotations[n, i, j]
+        p = 0 if shared else n
+        _pose(
+            model, r, positions[p, 0], positions[p, 1], positions[p, 2], scratch, out, interference
+        )
+        for c in range(4):
+            margins[c, n] = out[c]
+            legs[c, n] = int(out[OUT_LEG + c])
+        pairs[n, 0] = int(out[OUT_PAIR])
+        pairs[n, 1] = int(out[OUT_PAIR + 1])
+
+
+# ------------------------------------------------------------------------------ ray searches
+@_helper
+def _ray_angles(kind, origin, direction, s, angles, row):
+    """T&T angles of the ray origin + s·direction (KIND_TT or KIND_CYLINDRICAL) into angles[row]."""
+    if kind == KIND_TT:
+        angles[row, 0] = origin[0] + s * direction[0]
+        angles[row, 1] = origin[1] + s * direction[1]
+        angles[row, 2] = origin[2] + s * direction[2]
+    else:
+        x = origin[0] + s * direction[0]
+        y = origin[1] + s * direction[1]
+        theta = math.hypot(x, y)
+        angles[row, 0] = math.atan2(y, x) if theta > 0.0 else 0.0
+        angles[row, 1] = theta
+        angles[row, 2] = origin[2] + s * direction[2]
+
+
+@_helper
+def _estimate(model, out):
+    """Signed distance estimate min_c m_c / L_c with fixed Lipschitz constants, rad (NaN wins)."""
+    rho = model[RHO]
+    floor = model[ESTIMATE_FLOOR]
+    best = out[0] / rho
+    for value in (out[1] / (rho / floor), out[2] / (1.0 + rho / floor), out[3] / (2.0 * rho)):
+        if value < best or value != value:
+            best = value
+    return best
+
+
+@_helper
+def _fmin(a, b):
+    """numpy.fmin: the smaller, ignoring a NaN."""
+    if a != a:
+        return b
+    if b != b:
+        return a
+    return a if a < b else b
+
+
+@_helper
+def certified_step(model, out):
+    """Length over which no margin can reach zero, from feasible margins (core.search)."""
+    rho = model[RHO]
+    length_min = model[LENGTH_FLOOR]
+    length_now = length_min + max(out[0], 0.0)
+    floor = max(length_min, 0.5 * length_now)
+    step = _fmin(out[0] / rho, out[1] * floor / rho)
+    step = _fmin(step, out[2] / (1.0 + rho / floor))
+    step = _fmin(step, out[3] / (2.0 * rho))
+    step = _fmin(step, 0.5 * length_now / rho)
+    step = _fmin(step, MAX_STEP)
+    if not step > 0.0:  # numpy.fmax(step, 0) (a NaN step becomes 0)
+        step = 0.0
+    return step * SAFETY
+
+
+@_helper
+def recovery_step(model, out):
+    """Length over which a violated pose stays violated: the most violated constraint, in
+    Lipschitz units, cannot climb back to zero within |m_c| / L_c; joint-angle bounds use half
+    the current shortest leg, and the step keeps every leg at least that long."""
+    rho = model[RHO]
+    floor = 0.5 * out[OUT_SHORTEST]
+    recover = 0.0
+    bounds = (rho, rho / floor, 1.0 + rho / floor, 2.0 * rho)
+    for c in range(4):
+        value = -out[c] / bounds[c] if out[c] < 0.0 else 0.0
+        if value > recover or value != value:
+            recover = value
+    return min(recover, floor / rho) * SAFETY
+
+
+# Phases of a ray in search_rays.
+_MARCH, _GUESS, _PLUS, _DONE = 0, 1, 2, 3
+
+
+@_jit
+def search_rays(
+    model,
+    position,
+    kind,
+    origins,
+    directions,
+    s_start,
+    s_end,
+    tolerance,
+    min_step,
+    feasible,
+    violated,
+    limiting,
+    start_feasible,
+):
+    """First violation along rays (the algorithm of core.search, all rays in lockstep).
+
+    Each round takes the next probe of every unfinished ray and evaluates them together with
+    the vectorised block kernel; per ray, the sequence of probes is that of a search along it
+    alone: a march with certified steps, then secant guesses on the distance estimate
+    (bisection when a secant step fails to halve the bracket), two probes around each guess,
+    the second only when the first is feasible.
+
+    Parameters
+    ----------
+    model : ndarray, shape (MODEL_SIZE,)
+    position : ndarray, shape (3,)
+        m, base frame.
+    kind : int
+        KIND_TT or KIND_CYLINDRICAL.
+    origins, directions : ndarray, shape (n, 3)
+        Ray i is origins[i] + s·directions[i].
+    s_start, s_end : ndarray, shape (n,)
+        Parameter range of each ray, rad.
+    tolerance, min_step : float
+        Bracket width at which the search stops; shortest march step (rad).
+    feasible, violated, limiting, start_feasible : ndarray, shape (n,)
+        Outputs, see core.search.RaySearchResult.
+
+    Returns
+    -------
+    int
+        Poses evaluated.
+    """
+    count = origins.shape[0]
+    phase = np.zeros(count, dtype=np.int64)
+    s = s_start.copy()
+    low_value = np.zeros(count)
+    high_value = np.zeros(count)
+    minus_value = np.zeros(count)
+    minus = np.zeros(count)
+    plus = np.zeros(count)
+    width = np.zeros(count)
+    bisect = np.zeros(count, dtype=np.bool_)
+    first = np.ones(count, dtype=np.bool_)
+    for ray in range(count):
+        feasible[ray] = np.nan
+        violated[ray] = np.inf
+        limiting[ray] = -1
+        start_feasible[ray] = True
+    rays = np.empty(count, dtype=np.int64)
+    angles = np.empty((count, 3))
+    work = np.empty(_BLOCK_ROWS * BLOCK)
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    half = 0.25 * tolerance
+    evaluations = 0
+    while True:
+        # The next probe of every unfinished ray.
+        probes = 0
+        for ray in range(count):
+            state = phase[ray]
+            if state == _DONE:
+                continue
+            if state == _MARCH:
+                probe = s[ray]
+            elif state == _GUESS:
+                low, high = feasible[ray], violated[ray]
+                if not high - low > tolerance:
+                    phase[ray] = _DONE
+                    continue
+                width[ray] = high - low
+                secant = low + low_value[ray] / (low_value[ray] - high_value[ray]) * width[ray]
+                if bisect[ray] or not math.isfinite(secant):
+                    guess = low + 0.5 * width[ray]
+                else:
+                    guess = secant
+                guess = min(max(guess, low + half), high - half)
+                minus[ray] = guess - half
+                plus[ray] = guess + half
+                probe = minus[ray]
+            else:
+                probe = plus[ray]
+            _ray_angles(kind, origins[ray], directions[ray], probe, angles, probes)
+            rays[probes] = ray
+            probes += 1
+        if probes == 0:
+            break
+        evaluations += probes
+        for block in range(0, probes, BLOCK):
+            size = min(BLOCK, probes - block)
+            _check_block(model, angles, position, block, size, work, scratch, out, r)
+            for m in range(size):
+                ray = rays[block + m]
+                for slot in range(4):
+                    out[slot] = work[slot * BLOCK + m]
+                ok = _feasible(out)
+                estimate = _estimate(model, out)
+                state = phase[ray]
+                if state == _MARCH:
+                    if not ok:
+                        violated[ray] = s[ray]
+                        high_value[ray] = estimate
+                        limiting[ray] = _limiting_constraint(model, out)
+                        if first[ray]:
+                            start_feasible[ray] = False
+                            phase[ray] = _DONE
+                        else:
+                            phase[ray] = _GUESS
+                        continue
+                    first[ray] = False
+                    feasible[ray] = s[ray]
+                    low_value[ray] = estimate
+                    step = max(certified_step(model, out), min_step)
+                    if s[ray] >= s_end[ray]:
+                        phase[ray] = _DONE
+                    else:
+                        s[ray] = min(s[ray] + step, s_end[ray])
+                elif state == _GUESS:  # the probe below the guess
+                    if not ok:
+                        violated[ray] = minus[ray]
+                        high_value[ray] = estimate
+                        limiting[ray] = _limiting_constraint(model, out)
+                        bisect[ray] = (violated[ray] - feasible[ray]) > 0.5 * width[ray]
+                    else:
+                        minus_value[ray] = estimate
+                        phase[ray] = _PLUS
+                else:  # the probe above the guess
+                    if not ok:
+                        feasible[ray] = minus[ray]
+                        low_value[ray] = minus_value[ray]
+                        violated[ray] = plus[ray]
+                        high_value[ray] = estimate
+                        limiting[ray] = _limiting_constraint(model, out)
+                    else:
+                        feasible[ray] = plus[ray]
+                        low_value[ray] = estimate
+                    bisect[ray] = (violated[ray] - feasible[ray]) > 0.5 * width[ray]
+                    phase[ray] = _GUESS
+    return evaluations
+
+
+@_jit
+def torsion_scan(model, position, phi, theta, min_step, max_step, tolerance, edges, rising):
+    """Feasible-torsion transitions over ψ ∈ [−π, π] for one tool direction (φ, θ).
+
+    Scans with certified steps (recovery steps from violated samples), clipped to
+    [min_step, max_step], then bisects every transition, all of them together, until the widest
+    bracket is within the tolerance (as core.orientation.torsion_range did).
+
+    Parameters
+    ----------
+    edges, rising : ndarray, shape (K,)
+        Outputs: the feasible end of each transition, and whether it goes infeasible → feasible.
+        K must be at least the number of transitions (ceil(2π / min_step) + 1 is enough).
+
+    Returns
+    -------
+    count : int
+        Number of transitions written (−1 − count when the outputs were too short).
+    start_ok : bool
+        Whether ψ = −π is feasible.
+    """
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    capacity = edges.shape[0]
+    low = np.empty(capacity)
+    high = np.empty(capacity)
+    count = 0
+    psi = -math.pi
+    previous_ok = False
+    start_ok = False
+    first = True
+    previous = psi
+    while True:
+        _tt_matrix(phi, theta, psi, r)
+        _pose(model, r, position[0], position[1], position[2], scratch, out, True)
+        ok = _feasible(out)
+        if first:
+            start_ok = ok
+        elif ok != previous_ok:
+            if count >= capacity:
+                return -1 - count, start_ok
+            low[count] = previous
+            high[count] = psi
+            rising[count] = ok
+            count += 1
+        first = False
+        previous_ok = ok
+        previous = psi
+        if psi >= math.pi:
+            break
+        step = certified_step(model, out) if ok else recovery_step(model, out)
+        psi = min(psi + min(max(step, min_step), max_step), math.pi)
+    while count > 0:
+        widest = 0.0
+        for k in range(count):
+            widest = max(widest, high[k] - low[k])
+        if not widest > tolerance:
+            break
+        for k in range(count):
+            middle = 0.5 * (low[k] + high[k])
+            _tt_matrix(phi, theta, middle, r)
+            _pose(model, r, position[0], position[1], position[2], scratch, out, True)
+            # Keep the transition inside [low, high]: the side matching the start state moves.
+            if _feasible(out) != rising[k]:
+                low[k] = middle
+            else:
+                high[k] = middle
+    for k in range(count):
+        edges[k] = high[k] if rising[k] else low[k]
+    return count, start_ok
+
+
+# ------------------------------------------------------------------------------ compilation
+def _kernels() -> list:
+    return [check_angles, check_one, margins_rotations, search_rays, torsion_scan]
+
+
+def cache_is_warm() -> bool:
+    """Whether every kernel is already compiled in this process or in the on-disk cache.
+
+    False means the next use compiles (seconds). Uses numba's cache index (an internal
+    interface); when it cannot be read, answers False.
+    """
+    try:
+        for kernel in _kernels():
+            if kernel.signatures:
+                continue
+            if kernel._cache is None or not kernel._cache._cache_file._load_index():
+                return False
+    except (AttributeError, OSError, TypeError, ValueError):
+        return False
+    return True
+
+
+def warm_up() -> float:
+    """Compile (first run after install) or load from the cache every kernel; seconds taken.
+
+    Runs each kernel once on a tiny problem of the argument types production uses. For the
+    ROS node to call before it reports ready, and for the CLI.
+    """
+    started = time.perf_counter()
+    model = np.zeros(MODEL_SIZE)
+    model[A : A + 18] = np.tile([1.0, 0.0, 0.0], 6)
+    model[B : B + 18] = np.tile([0.5, 0.0, 0.0], 6)
+    model[SCALE : SCALE + 4] = 1.0
+    model[RHO] = 0.5
+    model[LENGTH_FLOOR] = model[ESTIMATE_FLOOR] = 1e-3
+    model[LMAX : LMAX + 6] = 2.0
+    model[ORDER : ORDER + 15] = np.arange(15)
+    model.setflags(write=False)
+    position = np.array([0.0, 0.0, 1.0])
+    angles = np.zeros((1, 3))
+    margins = np.empty((4, 1))
+    legs = np.empty((4, 1), dtype=np.int64)
+    pairs = np.empty((1, 2), dtype=np.int64)
+    check_angles(
+        model,
+        angles,
+        position,
+        0,
+        1,
+        margins,
+        np.empty((6, 1), dtype=np.int64),
+        pairs,
+        np.empty(1, dtype=np.bool_),
+    )
+    check_one(model, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, np.empty(12))
+    margins_rotations(model, np.eye(3)[None], position[None], True, margins, legs, pairs)
+    ones = np.ones(1)
+    search_rays(
+        model,
+        position,
+        KIND_TT,
+        angles,
+        np.array([[0.0, 1.0, 0.0]]),
+        np.zeros(1),
+        ones,
+        1e-3,
+        1e-3,
+        np.empty(1),
+        np.empty(1),
+        np.empty(1, dtype=np.int64),
+        np.empty(1, dtype=np.bool_),
+    )
+    torsion_scan(
+        model, position, 0.0, 0.0, 1e-3, 0.25, 1e-3, np.empty(8), np.empty(8, dtype=np.bool_)
+    )
+    return time.perf_counter() - started
+
+
+class _CompileAnnouncer(numba.core.event.Listener):
+    """Calls ``announce`` once, when the first kernel of this module starts compiling."""
+
+    def __init__(self, announce: Callable[[str], None]) -> None:
+        self.announce = announce
+        self.announced = False
+
+    def on_start(self, event: numba.core.event.Event) -> None:
+        dispatcher = (event.data or {}).get("dispatcher")
+        function = getattr(dispatcher, "py_func", None)
+        if self.announced or getattr(function, "__module__", None) != __name__:
+            return
+        self.announced = True
+        where = CACHE_DIRECTORY if CACHE_DIRECTORY is not None else "nowhere writable: not cached"
+        self.announce(
+            f"compiling the numerical kernels, once after install (about 10 s; cache: {where})"
+        )
+
+    def on_end(self, event: numba.core.event.Event) -> None:
+        """Nothing to do when a compilation ends."""
+
+
+@contextlib.contextmanager
+def compile_notice(announce: Callable[[str], None]) -> Iterator[None]:
+    """While active, ``announce(message)`` is called once if a kernel has to be compiled.
+
+    Loading compiled kernels from the cache says nothing; only a real compilation (the first
+    run after install, or after an upgrade) does. For the CLI's one line on stderr.
+    """
+    with numba.core.event.install_listener("numba:compile", _CompileAnnouncer(announce)):
+        yield

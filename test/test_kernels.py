@@ -1,0 +1,358 @@
+"""The compiled kernels against the numpy batch reference, the searches against themselves, the
+compilation cache in a read-only install.
+
+Reference: :func:`reference.batched_margins`, the numpy batch evaluation the package used before
+the kernels (commit 0b9ef59), and the literal per-pose definitions for spot checks. Margins must
+agree to 1e-12 and verdicts exactly on 10⁶ random poses per design; a limiting leg or pair may
+differ only where two candidates tie to rounding (checked against the reference's own values).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shutil
+import stat
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from reference import batched_margins, pose_margins_literal
+
+from hexapod_workspace import CONSTRAINT_NAMES, InputError, Manipulator, check
+from hexapod_workspace.core import constraints, kernels
+from hexapod_workspace.core.constraints import (
+    check_pose,
+    inverse_kinematics,
+    pose_margins,
+    segment_distance,
+)
+from hexapod_workspace.core.rotations import tt_to_matrix
+from hexapod_workspace.core.search import RaySearch
+
+POSES = 1_000_000
+PACKAGE = Path(__file__).resolve().parents[1] / "hexapod_workspace"
+CONFIG = Path(__file__).resolve().parents[1] / "config" / "example_gpm.yaml"
+
+
+def _design(example: Manipulator, name: str) -> Manipulator:
+    """The four designs of the issue: axisymmetric (the example), per-leg limits,
+    non-axisymmetric, crossed legs."""
+    parameters = example.to_parameters()
+    if name == "per_leg_limits":
+        parameters["limits.leg_length_min"] = [0.98, 1.0, 1.01, 0.99, 1.02, 0.97]
+        parameters["limits.leg_length_max"] = [1.55, 1.6, 1.58, 1.62, 1.57, 1.61]
+        parameters["limits.base_joint_max_angle"] = np.radians([40, 45, 50, 42, 47, 44]).tolist()
+        parameters["limits.platform_joint_max_angle"] = np.radians(
+            [35, 40, 38, 45, 36, 41]
+        ).tolist()
+    elif name == "non_axisymmetric":
+        rng = np.random.default_rng(7)
+        base = np.reshape(parameters["geometry.base_joints"], (6, 3))
+        platform = np.reshape(parameters["geometry.platform_joints"], (6, 3))
+        base[:, :2] += rng.normal(scale=0.04, size=(6, 2))
+        platform[:, :2] += rng.normal(scale=0.03, size=(6, 2))
+        parameters["geometry.base_joints"] = base.ravel().tolist()
+        parameters["geometry.platform_joints"] = platform.ravel().tolist()
+    elif name == "crossed_legs":
+        # Neighbouring legs swap their platform ends: each pair crosses like an X.
+        platform = np.reshape(parameters["geometry.platform_joints"], (6, 3))
+        parameters["geometry.platform_joints"] = platform[[1, 0, 3, 2, 5, 4]].ravel().tolist()
+    elif name != "axisymmetric":
+        raise ValueError(name)
+    return Manipulator.from_mapping(parameters, warn=False)
+
+
+def _random_poses(rng: np.random.Generator, count: int) -> np.ndarray:
+    return np.column_stack(
+        [
+            rng.uniform(-math.pi, math.pi, count),
+            rng.uniform(0.0, math.radians(60.0), count),
+            rng.uniform(-math.radians(90.0), math.radians(90.0), count),
+        ]
+    )
+
+
+@pytest.mark.parametrize(
+    "name", ["axisymmetric", "per_leg_limits", "non_axisymmetric", "crossed_legs"]
+)
+def test_check_equals_the_numpy_reference_on_a_million_poses(example, name):
+    model = _design(example, name)
+    rng = np.random.default_rng(20261123)
+    angles = _random_poses(rng, POSES)
+    position = model.position + np.array([0.01, -0.02, 0.03])
+    result = check(model, angles, position)
+    reference, legs, pairs = batched_margins(model, angles, position)
+    margins = np.stack([result.margins[name] for name in CONSTRAINT_NAMES])
+    assert np.all(np.isfinite(margins))
+    difference = np.abs(margins - reference)
+    np.testing.assert_array_less(difference[:3], 1e-12)
+    # Interference to 1e-12 too, except for legs all but touching: there both compute the
+    # distance as the root of a squared distance expanded from terms of order 1 m², whose
+    # rounding (~1e-16 m²) becomes ~1e-16 / (2 d) in the distance d (crossed legs: 3 in 10⁴).
+    loose = difference[3] > 1e-12
+    distance = reference[3, loose] + model.leg_diameter
+    assert np.count_nonzero(loose) <= 1e-3 * POSES
+    assert np.all(distance < 1e-3)
+    assert np.all(difference[3, loose] <= 1e-15 / distance)
+    np.testing.assert_array_equal(result.reachable, np.all(reference >= 0.0, axis=0))
+    # Both outcomes occur, or the comparison of verdicts would be empty.
+    assert 0.05 < result.reachable.mean() < 0.95
+    # Limiting legs: equal, or a tie to rounding in the reference's own per-leg values.
+    kinematics = inverse_kinematics(model, tt_to_matrix(angles[:20_000]), position)
+    per_leg = np.minimum(
+        kinematics.lengths - model.leg_length_min, model.leg_length_max - kinematics.lengths
+    )
+    ours = result.limiting_legs["leg_length"][:20_000] - 1
+    rows = np.arange(20_000)
+    assert np.all(per_leg[rows, ours] - reference[0, :20_000] <= 1e-12)
+    for row in range(3):
+        assert np.mean(result.limiting_legs[CONSTRAINT_NAMES[row]] - 1 == legs[row]) > 0.999
+    # Closest pair: at the reference's minimum distance (to 1e-12) wherever it differs.
+    ours = result.limiting_pair - 1
+    differ = np.flatnonzero(np.any(ours != pairs, axis=1))
+    assert differ.size < 0.05 * POSES
+    sample = differ[:2000]
+    ends = kinematics_ends(model, angles[sample], position)
+    distance = segment_distance(
+        ends[0][np.arange(sample.size), ours[sample, 0]],
+        ends[1][np.arange(sample.size), ours[sample, 0]],
+        ends[0][np.arange(sample.size), ours[sample, 1]],
+        ends[1][np.arange(sample.size), ours[sample, 1]],
+    )
+    np.testing.assert_allclose(
+        distance - model.leg_diameter, reference[3, sample], rtol=0.0, atol=1e-12
+    )
+
+
+def kinematics_ends(model: Manipulator, angles: np.ndarray, position: np.ndarray):
+    """Leg end points A_i (n, 6, 3) and B_i (n, 6, 3) of poses (n, 3)."""
+    platform = inverse_kinematics(model, tt_to_matrix(angles), position).platform_points
+    return np.broadcast_to(model.base_joints, platform.shape), platform
+
+
+def test_limiting_constraint_and_leg_follow_relative_margins(example, rng):
+    angles = _random_poses(rng, 50_000)
+    result = check(example, angles)
+    margins = np.stack([result.margins[name] for name in CONSTRAINT_NAMES])
+    expected = constraints.relative_margins(example, margins).argmin(axis=0)
+    np.testing.assert_array_equal(result.limiting_constraint, expected)
+    legs = np.stack([result.limiting_legs[name] for name in CONSTRAINT_NAMES])
+    np.testing.assert_array_equal(result.limiting_leg, legs[expected, np.arange(len(result))])
+
+
+def test_literal_definitions_agree_on_spot_checks(example, rng):
+    """Independent evidence: the per-pose literal definitions (another segment distance)."""
+    for name in ("per_leg_limits", "crossed_legs"):
+        model = _design(example, name)
+        angles = _random_poses(rng, 200)
+        result = check(model, angles)
+        for index in range(200):
+            literal = pose_margins_literal(model, angles[index], model.position)
+            for constraint in CONSTRAINT_NAMES:
+                assert result.margins[constraint][index] == pytest.approx(
+                    literal[constraint], abs=1e-9
+                ), (name, constraint)
+
+
+def test_huge_angles_and_degenerate_legs_take_the_exact_path(example):
+    # |angle| beyond the fast sin/cos range: the same rotation as the wrapped angle.
+    wrapped = np.array([[0.3, 0.4, -0.2]])
+    turns = 2.0 * math.pi * np.array([[1e6, -3e5, 2e6]])
+    far = check(example, wrapped + turns)
+    near = check(example, wrapped)
+    for name in CONSTRAINT_NAMES:
+        assert far.margins[name][0] == pytest.approx(near.margins[name][0], abs=1e-8)
+    # Parallel legs (a vertical design): the segment distance's parallel branch.
+    parameters = example.to_parameters()
+    base = np.reshape(parameters["geometry.base_joints"], (6, 3))
+    platform = base.copy()
+    platform[:, 2] = 0.0
+    base[:, 2] += 1.3
+    parameters["geometry.base_joints"] = base.ravel().tolist()
+    parameters["geometry.platform_joints"] = platform.ravel().tolist()
+    parameters["geometry.home_position"] = [0.0, 0.0, 0.0]
+    parameters["pose.position"] = [0.0, 0.0, 0.0]
+    parameters["limits.leg_diameter"] = 0.02
+    vertical = Manipulator.from_mapping(parameters, warn=False)
+    angles = np.array([[0.0, 0.0, 0.0], [0.2, 0.05, 0.1]])
+    result = check(vertical, angles)
+    reference, _, _ = batched_margins(vertical, angles, vertical.position)
+    margins = np.stack([result.margins[name] for name in CONSTRAINT_NAMES])
+    np.testing.assert_allclose(margins, reference, rtol=0.0, atol=1e-12)
+
+
+def test_check_pose_equals_check(example, rng):
+    angles = _random_poses(rng, 2000)
+    batch = check(example, angles)
+    for index in range(angles.shape[0]):
+        one = check_pose(example, *angles[index])
+        assert one.reachable == bool(batch.reachable[index])
+        for k, name in enumerate(CONSTRAINT_NAMES):
+            assert one.margins[k] == pytest.approx(batch.margins[name][index], abs=1e-12)
+        assert one.limiting_constraint == batch.limiting_constraint[index]
+    position = example.position + 0.01
+    one = check_pose(example, 0.1, 0.2, 0.3, position)
+    assert one.margins[0] == pytest.approx(
+        check(example, [0.1, 0.2, 0.3], position).margins["leg_length"][0], abs=1e-12
+    )
+
+
+def test_check_pose_rejects_bad_input_like_check(example):
+    with pytest.raises(InputError, match="angles: expected finite values, pose 0"):
+        check_pose(example, 0.0, math.nan, 0.0)
+    with pytest.raises(InputError, match="position: expected 3 values"):
+        check_pose(example, 0.0, 0.1, 0.0, [0.0, 0.0])
+    with pytest.raises(InputError, match="position: expected finite values"):
+        check_pose(example, 0.0, 0.1, 0.0, [0.0, math.inf, 0.0])
+
+
+def test_check_input_errors_keep_their_order(example):
+    # A non-finite angle is reported before a bad position, as before the kernels.
+    with pytest.raises(InputError, match="angles: expected finite values, pose 1"):
+        check(example, [[0.0, 0.1, 0.0], [math.inf, 0.0, 0.0]], [0.0, 0.0])
+    with pytest.raises(InputError, match="angles: expected finite values, pose 1"):
+        check(example, [[0.0, 0.1, 0.0], [0.0, math.nan, 0.0]], [0.0, math.nan, 0.0])
+    with pytest.raises(InputError, match="position: expected finite values"):
+        check(example, [[0.0, 0.1, 0.0]], [0.0, math.nan, 0.0])
+
+
+def test_threads_split_large_batches_without_changing_results(example, rng, monkeypatch):
+    angles = _random_poses(rng, 3 * constraints.PARALLEL_POSES)
+    monkeypatch.setattr(constraints, "_cores", lambda: 1)
+    serial = check(example, angles)
+    monkeypatch.setattr(constraints, "_cores", lambda: 3)
+    threaded = check(example, angles)
+    for name in CONSTRAINT_NAMES:
+        np.testing.assert_array_equal(threaded.margins[name], serial.margins[name])
+        np.testing.assert_array_equal(threaded.limiting_legs[name], serial.limiting_legs[name])
+    np.testing.assert_array_equal(threaded.limiting_pair, serial.limiting_pair)
+    np.testing.assert_array_equal(threaded.reachable, serial.reachable)
+    bad = angles.copy()
+    bad[-1, 2] = math.nan
+    with pytest.raises(InputError, match=f"pose {bad.shape[0] - 1} "):
+        check(example, bad)
+
+
+def test_pose_margins_from_rotations_equal_check(example, rng):
+    angles = _random_poses(rng, 5000)
+    positions = example.position + rng.normal(scale=0.02, size=(5000, 3))
+    batched = pose_margins(example, tt_to_matrix(angles), positions)
+    for index in range(0, 5000, 250):
+        single = check(example, angles[index], positions[index])
+        for k, name in enumerate(CONSTRAINT_NAMES):
+            assert batched.margins[k, index] == pytest.approx(single.margins[name][0], abs=1e-12)
+    no_interference = pose_margins(example, tt_to_matrix(angles), positions, interference=False)
+    assert np.all(np.isinf(no_interference.margins[3]))
+    np.testing.assert_array_equal(no_interference.margins[:3], batched.margins[:3])
+
+
+def test_lockstep_search_equals_rays_searched_alone(example):
+    """The search evaluates all rays together; each ray must see the probes it would alone."""
+    search = RaySearch(example, example.position)
+    phi = np.linspace(-math.pi, math.pi, 37)
+    origins = np.column_stack([phi, np.zeros(phi.size), 0.2 * np.sin(3.0 * phi)])
+    together = search.rays("tt", origins, [0.0, 1.0, 0.0], math.pi, 1e-7)
+    for index in range(phi.size):
+        alone = search.rays("tt", origins[index], [0.0, 1.0, 0.0], math.pi, 1e-7)
+        assert alone.feasible[0] == together.feasible[index]
+        assert alone.violated[0] == together.violated[index]
+        assert alone.limiting[0] == together.limiting[index]
+    assert np.all(together.violated - together.feasible <= 1e-7)
+    # Every reported boundary point is reachable, the first violation within the tolerance.
+    boundary = np.column_stack([phi, together.feasible, origins[:, 2]])
+    beyond = np.column_stack([phi, together.violated, origins[:, 2]])
+    assert np.all(check(example, boundary).reachable)
+    assert not np.any(check(example, beyond).reachable)
+
+
+def test_sincos_within_an_ulp_of_libm():
+    x = np.concatenate(
+        [np.linspace(-kernels.FAST_TRIG_LIMIT, kernels.FAST_TRIG_LIMIT, 200_001), [0.0, -0.0]]
+    )
+    rotations = np.empty((x.size, 9))
+    for index in range(0, x.size, 997):
+        kernels._tt_matrix(x[index], 0.0, x[index], rotations[index])
+        # R(φ, 0, φ) = Rz(φ): [cos, -sin, 0; sin, cos, 0; 0, 0, 1].
+        assert rotations[index, 0] == pytest.approx(math.cos(x[index]), abs=2.3e-16)
+        assert rotations[index, 3] == pytest.approx(math.sin(x[index]), abs=2.3e-16)
+
+
+def test_warm_up_compiles_everything_and_says_how_long(example):
+    seconds = kernels.warm_up()
+    assert 0.0 < seconds < 600.0
+    assert kernels.cache_is_warm()
+
+
+def test_compile_notice_only_when_compiling():
+    said = []
+    kernels.warm_up()
+    with kernels.compile_notice(said.append):
+        kernels.warm_up()  # already compiled in this process: nothing to say
+    assert said == []
+
+
+def _read_only_runner() -> list[str] | None:
+    """Command prefix under which a chmod'ed directory is really read-only (None: none)."""
+    if os.geteuid() != 0:
+        return []
+    unshare = shutil.which("unshare")
+    if unshare is None:
+        return None
+    probe = subprocess.run(
+        [unshare, "-U", "--map-user=1000", "--map-group=1000", "true"], check=False
+    )
+    return [unshare, "-U", "--map-user=1000", "--map-group=1000"] if probe.returncode == 0 else None
+
+
+def test_cache_works_in_a_read_only_install(tmp_path):
+    """A read-only copy of the package (as colcon's install space or system site-packages):
+    the first run compiles into the user cache and says so in one line; the second loads."""
+    runner = _read_only_runner()
+    if runner is None:
+        pytest.skip("root without user namespaces: cannot make a directory read-only here")
+    site = tmp_path / "site"
+    shutil.copytree(
+        PACKAGE, site / "hexapod_workspace", ignore=shutil.ignore_patterns("__pycache__")
+    )
+    for path in [site, *site.rglob("*")]:
+        mode = path.stat().st_mode
+        path.chmod(mode & ~(stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH))
+    cache = tmp_path / "cache"
+    environment = {key: value for key, value in os.environ.items() if not key.startswith("NUMBA_")}
+    environment.update(PYTHONPATH=str(site), XDG_CACHE_HOME=str(cache), HOME=str(tmp_path))
+    script = (
+        "import sys, hexapod_workspace as h; "
+        f"assert h.__file__.startswith({str(site)!r}), h.__file__; "
+        "sys.argv = ['hexapod-workspace', 'check', '--json', '--pose', '0', '10', '0', "
+        f"'--config', {str(CONFIG)!r}]; "
+        "from hexapod_workspace.cli import main; sys.exit(main())"
+    )
+    try:
+        runs = [
+            subprocess.run(
+                [*runner, sys.executable, "-c", script],
+                env=environment,
+                cwd=tmp_path,
+                capture_output=True,
+                text=True,
+                timeout=600,
+                check=False,
+            )
+            for _ in range(2)
+        ]
+    finally:
+        for path in [site, *site.rglob("*")]:
+            path.chmod(path.stat().st_mode | stat.S_IWUSR)
+    first, second = runs
+    assert first.returncode == 0, first.stderr
+    assert second.returncode == 0, second.stderr
+    assert first.stdout == second.stdout
+    lines = first.stderr.strip().splitlines()
+    assert len(lines) == 1 and "compiling the numerical kernels" in lines[0], first.stderr
+    assert str(cache / "hexapod_workspace" / "numba") in lines[0]
+    assert second.stderr == ""
+    assert any((cache / "hexapod_workspace" / "numba").rglob("*.nbi"))
+    assert not list(site.rglob("__pycache__/*.nbi"))
