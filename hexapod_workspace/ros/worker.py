@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from hexapod_workspace.core import kernels
 from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.core.orientation import orientation_workspace
 from hexapod_workspace.core.projected import projected_workspace
@@ -155,6 +156,7 @@ def _serve(connection: Connection, cancel: Any) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the node decides when the worker stops
     with contextlib.suppress(OSError):
         os.nice(WORKER_NICENESS)  # throughput work: the node's checks are scheduled first
+    kernels.warm_up()  # compiled (or loaded) before the first job arrives
     while True:
         try:
             job = connection.recv()
@@ -178,7 +180,8 @@ class WorkspaceWorker:
     :meth:`start`) and replaced when it dies; :meth:`close` terminates it for good.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, cancel_grace: float = CANCEL_GRACE) -> None:
+        self.cancel_grace = float(cancel_grace)
         self._context = multiprocessing.get_context("spawn")
         self._lock = threading.Lock()
         self._process: Any = None
@@ -230,7 +233,7 @@ class WorkspaceWorker:
             Called (in this thread) with the fraction done, 0..1, non-decreasing.
         canceled : threading.Event, optional
             Set by another thread to cancel: the job stops at its next progress report, or the
-            worker process is terminated after :data:`CANCEL_GRACE` s.
+            worker process is terminated after ``cancel_grace`` s (:data:`CANCEL_GRACE`).
 
         Returns
         -------
@@ -280,7 +283,7 @@ class WorkspaceWorker:
             if canceled is not None and canceled.is_set() and cancel_time is None:
                 cancel_time = time.monotonic()
                 self._cancel.set()
-            if cancel_time is not None and time.monotonic() - cancel_time > CANCEL_GRACE:
+            if cancel_time is not None and time.monotonic() - cancel_time >= self.cancel_grace:
                 self._stop_locked()  # the job did not stop by itself: end the process
                 return "canceled", None
             if not connection.poll(0.02):
