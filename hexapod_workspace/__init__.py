@@ -18,6 +18,7 @@ from .core.orientation import (
     orientation_workspace,
     torsion_range,
 )
+from .core.paths import PathCheck, TorsionPlan, check_path, check_waypoints, plan_torsion
 from .core.projected import ProjectedWorkspace, projected_workspace
 from .errors import (
     AtlasError,
@@ -50,13 +51,18 @@ __all__ = [
     "MissingExtraError",
     "OrientationSlice",
     "OrientationWorkspace",
+    "PathCheck",
     "ProjectedWorkspace",
     "RecordingError",
     "ResolutionError",
+    "TorsionPlan",
     "TorsionRange",
     "UnreachableReferenceError",
     "check",
+    "check_path",
+    "check_waypoints",
     "orientation_workspace",
+    "plan_torsion",
     "projected_workspace",
     "torsion_range",
     "workspace_atlas",

@@ -115,29 +115,39 @@ def test_distributed_cluster_gives_the_identical_store(reference, example, tmp_p
     xr.testing.assert_identical(run.dataset, reference)
 
 
-def test_a_worker_killed_mid_run_does_not_fail_the_job(reference, example, tmp_path):
-    killed: list[int] = []
-    with _cluster() as cluster, Client(cluster) as observer:
+#: Heavier per chunk (a 3-D workspace per position) so that a chunk is still computing when the
+#: first one reports: with the compiled kernels the light OPTIONS finish before a kill lands.
+HEAVY = AtlasOptions(n_phi=24, tolerance=1e-3, volume=True)
 
-        def kill_a_busy_worker(done: int, total: int) -> None:
-            if killed or done == 0:
+
+def test_a_worker_killed_mid_run_does_not_fail_the_job(example, tmp_path):
+    reference = workspace_atlas(
+        example, GRID, store=tmp_path / "heavy.zarr", options=HEAVY, workers=0, chunk=CHUNK
+    ).dataset
+    killed: list[int] = []
+    with _cluster() as cluster:
+        with Client(cluster) as observer:  # closed before the job: one client at a time
+            pids = sorted(observer.run(os.getpid).values())
+        assert len(pids) == 2
+
+        def kill_a_worker(done: int, total: int) -> None:
+            # After the first chunk, 5 of 6 (heavy) chunks are left for 2 workers: both are
+            # computing. SIGKILL one of them; the nanny restarts it, the scheduler reruns its task.
+            if killed or done == 0 or done >= total:
                 return
-            busy = [address for address, keys in observer.processing().items() if keys]
-            if busy:
-                pid = observer.run(os.getpid, workers=[busy[0]])[busy[0]]
-                os.kill(pid, signal.SIGKILL)
-                killed.append(pid)
+            os.kill(pids[0], signal.SIGKILL)
+            killed.append(pids[0])
 
         run = workspace_atlas(
             example,
             GRID,
             store=tmp_path / "killed.zarr",
-            options=OPTIONS,
+            options=HEAVY,
             scheduler=cluster.scheduler_address,
             chunk=CHUNK,
-            progress=kill_a_busy_worker,
+            progress=kill_a_worker,
         )
-    assert killed, "no worker was busy after the first chunk: nothing was tested"
+    assert killed, "the job ended before a worker could be killed: nothing was tested"
     assert run.chunks_computed == 6
     xr.testing.assert_identical(run.dataset, reference)
 

@@ -203,9 +203,9 @@ def test_check_pose_equals_check(example, rng):
 def test_check_pose_rejects_bad_input_like_check(example):
     with pytest.raises(InputError, match="angles: expected finite values, pose 0"):
         check_pose(example, 0.0, math.nan, 0.0)
-    with pytest.raises(InputError, match="position: expected 3 values"):
+    with pytest.raises(InputError, match="position: expected 3 finite values"):
         check_pose(example, 0.0, 0.1, 0.0, [0.0, 0.0])
-    with pytest.raises(InputError, match="position: expected finite values"):
+    with pytest.raises(InputError, match="position: expected 3 finite values"):
         check_pose(example, 0.0, 0.1, 0.0, [0.0, math.inf, 0.0])
 
 
@@ -215,7 +215,7 @@ def test_check_input_errors_keep_their_order(example):
         check(example, [[0.0, 0.1, 0.0], [math.inf, 0.0, 0.0]], [0.0, 0.0])
     with pytest.raises(InputError, match="angles: expected finite values, pose 1"):
         check(example, [[0.0, 0.1, 0.0], [0.0, math.nan, 0.0]], [0.0, math.nan, 0.0])
-    with pytest.raises(InputError, match="position: expected finite values"):
+    with pytest.raises(InputError, match="position: expected 3 finite values"):
         check(example, [[0.0, 0.1, 0.0]], [0.0, math.nan, 0.0])
 
 

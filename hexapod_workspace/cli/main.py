@@ -27,7 +27,7 @@ import numpy as np
 from .. import __version__
 from ..core import kernels, resolution
 from ..errors import HexapodWorkspaceError
-from . import atlas, commands
+from . import atlas, check_path, commands
 from .inputs import (
     PLOT_FORMATS,
     CliError,
@@ -405,6 +405,14 @@ for _command in (
         "orientation workspaces, plots and a log.",
         _demo_arguments,
         _demo_run,
+        uses=("config", "json"),
+    ),
+    Command(
+        "check-path",
+        check_path.CHECK_PATH_HELP,
+        check_path.CHECK_PATH_DESCRIPTION,
+        check_path.check_path_arguments,
+        check_path.cmd_check_path,
         uses=("config", "json"),
     ),
     Command(

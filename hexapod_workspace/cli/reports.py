@@ -20,6 +20,7 @@ from ..core.constraints import CONSTRAINT_NAMES, CheckResult
 from ..core.orientation import OrientationWorkspace, TorsionRange
 from ..core.projected import ProjectedWorkspace
 from ..core.resolution import WorkspaceKind
+from ..logs.paths import path_call_line, path_call_report
 from ..logs.summary import LogSummary, PoseCheckCall, WorkspaceRecord
 
 __all__ = [
@@ -387,6 +388,9 @@ def log_report(summary: LogSummary) -> dict[str, Any]:
             "unreachable": sum(bool(r["success"] and not r["check"]["reachable"]) for r in reach),
             "invalid": sum(not r["success"] for r in reach),
         },
+        "path_checks": [
+            path_call_report(i + 1, call, start) for i, call in enumerate(summary.paths)
+        ],
         "trigger_calls": [
             {
                 "topic": t["topic"],
@@ -455,6 +459,10 @@ def log_report_text(report: dict[str, Any], out: IO[str]) -> None:
             f"reachability results: {reach['count']} ({reach['reachable']} reachable, "
             f"{reach['unreachable']} unreachable, {reach['invalid']} invalid)\n"
         )
+    if report["path_checks"]:
+        out.write(f"path checks: {len(report['path_checks'])}\n")
+        for call in report["path_checks"]:
+            out.write(f"  {path_call_line(call)}\n")
     for call in report["trigger_calls"]:
         out.write(
             f"  trigger {call['topic']} +{call['time_s']:.3f} s: "

@@ -395,13 +395,11 @@ def check(
         msg = f"angles: at most {MAX_POSES} poses per call, got {count}"
         raise InputError(msg)
     angles = np.ascontiguousarray(angles)
-    position = np.array(manipulator.position if position is None else position, dtype=float)
-    if position.shape != (3,):
-        _require_finite_angles(angles)
-        msg = f"position: expected 3 values (x, y, z), got shape {position.shape}"
-        raise InputError(msg)
-    if np.all(np.isfinite(position)):  # non-finite: refused below, after the angles
-        position = validate_position(manipulator, position)  # |p| bounded: finite margins
+    if position is not None:
+        candidate = np.asarray(position, dtype=np.float64)
+        if candidate.shape != (3,) or not np.all(np.isfinite(candidate)):
+            _require_finite_angles(angles)  # bad angles are reported before a bad position
+    position = validate_position(manipulator, position)  # 3 finite values, |p| bounded
 
     margins = np.empty((4, count))
     ints = np.empty((6, count), dtype=np.int64)
@@ -422,8 +420,8 @@ def check(
         status = min(job.result() for job in jobs)
     if status >= 0:
         _require_finite_angles(angles)
-    if status == -2:
-        msg = f"position: expected finite values, got {position.tolist()}"
+    if status == -2:  # not reached: validate_position refused it above
+        msg = f"position: expected 3 finite values (x, y, z) in m, got {position.tolist()}"
         raise InputError(msg)
     legs = ints[:4]
     return CheckResult(
@@ -501,13 +499,12 @@ def check_pose(
     else:
         values = np.asarray(position, dtype=np.float64)
         if values.shape != (3,):
-            msg = f"position: expected 3 values (x, y, z), got shape {values.shape}"
-            raise InputError(msg)
+            validate_position(manipulator, values)  # raises, with the same reason as check()
         x, y, z = values.tolist()
-        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
-            msg = f"position: expected finite values, got {[x, y, z]}"
-            raise InputError(msg)
-        if math.sqrt(x * x + y * y + z * z) > MAX_POSITION_NORM:
+        if (
+            not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z))
+            or math.sqrt(x * x + y * y + z * z) > MAX_POSITION_NORM
+        ):
             validate_position(manipulator, values)  # raises, with the same reason as check()
     result = np.empty(12)
     kernels.check_one(kernels.model_vector(manipulator), *angles, x, y, z, result)

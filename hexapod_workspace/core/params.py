@@ -41,6 +41,7 @@ NODE_PARAMETERS = (
     "check.max_command_age",
     "recording.enabled",
     "recording.directory",
+    "motion.current_pose_topic",
 )
 #: Parameters every ROS 2 node has (prefixes end with a dot).
 ROS_PARAMETERS = ("use_sim_time", "start_type_description_service", "qos_overrides.")

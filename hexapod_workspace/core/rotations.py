@@ -27,10 +27,16 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import InputError
 
 __all__ = [
+    "approach_to_tilt",
     "approach_vector",
+    "axis_angle_to_quaternion",
     "degrees_to_radians",
     "matrix_to_quaternion",
     "matrix_to_tt",
+    "quaternion_angle",
+    "quaternion_conjugate",
+    "quaternion_multiply",
+    "quaternion_slerp",
     "quaternion_to_matrix",
     "quaternion_to_tt",
     "tt_to_matrix",
@@ -405,3 +411,163 @@ def approach_vector(phi: ArrayLike, theta: ArrayLike) -> NDArray[np.float64]:
     )
     sin_theta = np.sin(theta)
     return np.stack([np.cos(phi) * sin_theta, np.sin(phi) * sin_theta, np.cos(theta)], axis=-1)
+
+
+def approach_to_tilt(axis: ArrayLike) -> NDArray[np.float64]:
+    """Tool direction (φ, θ) of approach vectors (the inverse of :func:`approach_vector`).
+
+    Parameters
+    ----------
+    axis : array_like, shape (..., 3)
+        Tool axes z' in the base frame, any non-zero finite length (normalised first).
+
+    Returns
+    -------
+    ndarray, shape (..., 2)
+        (φ, θ) in rad, φ ∈ (−π, π], θ ∈ [0, π]; φ = 0 on the singularities θ = 0 and θ = π
+        (the same convention as :func:`matrix_to_tt`).
+
+    Raises
+    ------
+    InputError
+        When an axis is zero or not finite.
+    """
+    axis = _last_axis(axis, 3, "axis")
+    norm = np.linalg.norm(axis, axis=-1)
+    if not np.all(np.isfinite(norm) & (norm > 0.0)):
+        msg = "axis: expected finite, non-zero tool axes"
+        raise InputError(msg)
+    unit = axis / norm[..., None]
+    sin_theta = np.hypot(unit[..., 0], unit[..., 1])
+    theta = np.arctan2(sin_theta, unit[..., 2])
+    phi = np.where(sin_theta >= SINGULAR_SIN, np.arctan2(unit[..., 1], unit[..., 0]), 0.0)
+    return np.stack([wrap_angle(phi), theta], axis=-1)
+
+
+def axis_angle_to_quaternion(axis: ArrayLike, angle: ArrayLike) -> NDArray[np.float64]:
+    """Quaternions ``(x, y, z, w)`` of rotations by ``angle`` about ``axis``.
+
+    Parameters
+    ----------
+    axis : array_like, shape (..., 3)
+        Rotation axes, base frame, non-zero (normalised first).
+    angle : array_like, shape (...)
+        Rotation angles, rad (right-hand rule).
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+        ``(sin(a/2)·u, cos(a/2))``.
+    """
+    axis = _last_axis(axis, 3, "axis")
+    norm = np.linalg.norm(axis, axis=-1, keepdims=True)
+    if not np.all(np.isfinite(norm) & (norm > 0.0)):
+        msg = "axis: expected finite, non-zero rotation axes"
+        raise InputError(msg)
+    half = 0.5 * np.asarray(angle, dtype=np.float64)[..., None]
+    return np.concatenate([np.sin(half) * axis / norm, np.cos(half)], axis=-1)
+
+
+def quaternion_conjugate(quaternion: ArrayLike) -> NDArray[np.float64]:
+    """Conjugates ``(−x, −y, −z, w)`` (the inverse rotation of a unit quaternion).
+
+    Parameters
+    ----------
+    quaternion : array_like, shape (..., 4)
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+    """
+    quaternion = _last_axis(quaternion, 4, "quaternion")
+    return quaternion * np.array([-1.0, -1.0, -1.0, 1.0])
+
+
+def quaternion_multiply(left: ArrayLike, right: ArrayLike) -> NDArray[np.float64]:
+    """Hamilton products ``left ⊗ right`` (the rotation ``right`` first, then ``left``).
+
+    Parameters
+    ----------
+    left, right : array_like, shape (..., 4), broadcastable
+        Quaternions (x, y, z, w).
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+        Matches ``quaternion_to_matrix(left) @ quaternion_to_matrix(right)``.
+    """
+    left = _last_axis(left, 4, "left")
+    right = _last_axis(right, 4, "right")
+    x1, y1, z1, w1 = np.moveaxis(left, -1, 0)
+    x2, y2, z2, w2 = np.moveaxis(right, -1, 0)
+    return np.stack(
+        [
+            w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+            w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
+            w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+        ],
+        axis=-1,
+    )
+
+
+def quaternion_angle(first: ArrayLike, second: ArrayLike) -> NDArray[np.float64]:
+    """Angle of the shortest rotation between two orientations, in [0, π].
+
+    The quaternions (unit 4-vectors, ``q₁`` taken in the hemisphere of ``q₀``) are an angle
+    α = half the rotation angle apart, and ``|q₀ − q₁| = 2 sin(α/2)``, ``|q₀ + q₁| = 2 cos(α/2)``:
+    the rotation angle is ``4·atan2(|q₀ − q₁|, |q₀ + q₁|)``, accurate near 0 and π (unlike
+    ``2·acos|q₀·q₁|``).
+
+    Parameters
+    ----------
+    first, second : array_like, shape (..., 4), broadcastable
+        Unit quaternions (x, y, z, w).
+
+    Returns
+    -------
+    ndarray, shape (...)
+        rad.
+    """
+    first = _last_axis(first, 4, "first")
+    second = _last_axis(second, 4, "second")
+    dot = np.einsum("...k,...k->...", first, second)
+    second = np.where(dot[..., None] < 0.0, -second, second)
+    difference = np.linalg.norm(first - second, axis=-1)
+    total = np.linalg.norm(first + second, axis=-1)
+    return 4.0 * np.arctan2(difference, total)
+
+
+def quaternion_slerp(first: ArrayLike, second: ArrayLike, s: ArrayLike) -> NDArray[np.float64]:
+    """Spherical linear interpolation along the shortest rotation, at constant angular rate.
+
+    ``q(s) = sin((1 − s)Ω)/sin Ω · q₀ + sin(sΩ)/sin Ω · q₁`` with ``q₁`` in the hemisphere of
+    ``q₀`` and ``cos Ω = |q₀·q₁|``: the rotation ``R₀ → R(s)`` is ``s`` times the shortest
+    rotation ``R₀ → R₁`` (same axis), so the platform turns at the constant rate
+    ``2Ω = quaternion_angle(q₀, q₁)`` rad per unit ``s``.
+
+    Parameters
+    ----------
+    first, second : array_like, shape (..., 4), broadcastable
+        Unit quaternions (x, y, z, w) at s = 0 and s = 1.
+    s : array_like, shape (...), broadcastable
+        Interpolation parameters (normally in [0, 1]).
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+        Unit quaternions; at s = 0 exactly ``first``.
+    """
+    first = _last_axis(first, 4, "first")
+    second = _last_axis(second, 4, "second")
+    s = np.asarray(s, dtype=np.float64)[..., None]
+    dot = np.einsum("...k,...k->...", first, second)[..., None]
+    second = np.where(dot < 0.0, -second, second)
+    half = 0.5 * quaternion_angle(first, second)[..., None]
+    sin_half = np.sin(half)
+    small = sin_half < 1e-9
+    safe = np.where(small, 1.0, sin_half)
+    weight_first = np.where(small, 1.0 - s, np.sin((1.0 - s) * half) / safe)
+    weight_second = np.where(small, s, np.sin(s * half) / safe)
+    result = weight_first * first + weight_second * second
+    return result / np.linalg.norm(result, axis=-1, keepdims=True)

@@ -119,6 +119,31 @@ def tilt_torsion_fields(angles: ArrayLike) -> dict[str, float]:
     return {"phi": phi, "theta": theta, "psi": psi}
 
 
+def identity_pose_fields() -> dict[str, Any]:
+    """geometry_msgs/msg/Pose at the origin with the identity orientation (w = 1)."""
+    return {
+        "position": {"x": 0.0, "y": 0.0, "z": 0.0},
+        "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0},
+    }
+
+
+def unchecked_motion_fields() -> dict[str, Any]:
+    """hexapod_workspace_msgs/msg/PathSegmentCheck of a move that was not checked (NaN)."""
+    nan = math.nan
+    return {
+        "ok": False,
+        "first_violation_s": nan,
+        "position_at_violation": {"x": nan, "y": nan, "z": nan},
+        "pose_at_violation": {"phi": nan, "theta": nan, "psi": nan},
+        "violated": [],
+        "limiting_leg": 0,
+        "limiting_pair": [],
+        "min_relative_margin": nan,
+        "min_at_s": nan,
+        "min_relative_margin_bound": nan,
+    }
+
+
 # --------------------------------------------------------------------------- pose checks
 
 
@@ -177,6 +202,7 @@ def check_poses_request_fields(position: ArrayLike, angles: ArrayLike) -> dict[s
     return {
         "position": point_fields(position),
         "orientations": [{"phi": p, "theta": t, "psi": s} for p, t, s in angles.tolist()],
+        "poses": [],
     }
 
 
@@ -212,6 +238,8 @@ def commanded_pose_fields(
         "request_id": str(request_id),
         "position": point_fields(position),
         "orientation": tilt_torsion_fields(angles),
+        "use_pose": False,
+        "pose": identity_pose_fields(),
     }
 
 
@@ -247,6 +275,10 @@ def reachability_result_fields(
         "position": point_fields(position),
         "orientation": tilt_torsion_fields(angles),
         "check": check,
+        "motion_checked": False,
+        "motion_ok": False,
+        "current_pose": identity_pose_fields(),
+        "motion": unchecked_motion_fields(),
     }
 
 

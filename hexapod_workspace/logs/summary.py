@@ -21,6 +21,7 @@ from hexapod_workspace.logs import (
     messages,
     service_part,
 )
+from hexapod_workspace.logs.paths import path_call_fields
 
 if TYPE_CHECKING:
     pass
@@ -32,6 +33,8 @@ _WORKSPACE_RESPONSE = "hexapod_workspace_msgs/srv/ComputeWorkspace_Response"
 _CHECK_REQUEST = "hexapod_workspace_msgs/srv/CheckPoses_Request"
 _CHECK_RESPONSE = "hexapod_workspace_msgs/srv/CheckPoses_Response"
 _TRIGGER_RESPONSE = "std_srvs/srv/Trigger_Response"
+_PATH_REQUEST = "hexapod_workspace_msgs/srv/CheckPath_Request"
+_PATH_RESPONSE = "hexapod_workspace_msgs/srv/CheckPath_Response"
 
 
 # --------------------------------------------------------------------------- what a log holds
@@ -90,6 +93,7 @@ class LogSummary:
     checks: list[PoseCheckCall] = field(default_factory=list)
     reachability: list[dict[str, Any]] = field(default_factory=list)
     triggers: list[dict[str, Any]] = field(default_factory=list)
+    paths: list[dict[str, Any]] = field(default_factory=list)
     decoded: int = 0
 
 
@@ -175,6 +179,8 @@ def summarize_log(
             fields = message_to_fields(item.message)
             fields["log_time_ns"] = item.log_time_ns
             summary.reachability.append(fields)
+        elif msgtype in (_PATH_REQUEST, _PATH_RESPONSE):
+            path_call_fields(summary.paths, item.topic, item.log_time_ns, item.message)
         elif msgtype == _TRIGGER_RESPONSE:
             fields = message_to_fields(item.message)
             fields.update(topic=item.topic, log_time_ns=item.log_time_ns)

@@ -99,6 +99,8 @@ RECORDED_TYPES = {
     f"{INTERFACE_PACKAGE}/srv/ComputeWorkspace_Response": (
         f"{INTERFACE_PACKAGE}/msg/ComputeWorkspaceResponse"
     ),
+    f"{INTERFACE_PACKAGE}/srv/CheckPath_Request": f"{INTERFACE_PACKAGE}/msg/CheckPathRequest",
+    f"{INTERFACE_PACKAGE}/srv/CheckPath_Response": f"{INTERFACE_PACKAGE}/msg/CheckPathResponse",
     "std_srvs/srv/Trigger_Request": "std_msgs/msg/Empty",
     "std_srvs/srv/Trigger_Response": f"{INTERFACE_PACKAGE}/msg/TriggerResponse",
 }

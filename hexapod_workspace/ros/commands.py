@@ -27,6 +27,7 @@ from hexapod_workspace.errors import InputError
 from hexapod_workspace.logs import messages
 
 from .conversions import to_message
+from .paths import commanded_target
 
 __all__ = ["BATCH", "CommandStream"]
 
@@ -63,22 +64,29 @@ class CommandStream:
         state = node.state
         now_ns = node.get_clock().now().nanoseconds
         limit_ns = state.settings.max_command_age * 1e9
-        positions = np.array([[c.position.x, c.position.y, c.position.z] for c in batch])
-        angles = np.array(
-            [[c.orientation.phi, c.orientation.theta, c.orientation.psi] for c in batch]
-        )
+        positions = np.full((len(batch), 3), np.nan)
+        angles = np.full((len(batch), 3), np.nan)
+        verdicts: dict[int, tuple[Any, int, str | None]] = {}
+        for k, command in enumerate(batch):
+            try:  # T&T, or a geometry_msgs/Pose converted (hexapod_workspace.ros.paths)
+                position, target = commanded_target(command)
+            except InputError as error:
+                stats.commands_refused += 1
+                verdicts[k] = (None, 0, str(error))
+                continue
+            positions[k], angles[k] = position, target[0]
         sent_ns = np.array(
             [c.header.stamp.sec * 1_000_000_000 + c.header.stamp.nanosec for c in batch]
         )
         late = (sent_ns > 0) & (limit_ns > 0) & (now_ns - sent_ns > limit_ns)
-        verdicts: dict[int, tuple[Any, int, str | None]] = {}
+        late[list(verdicts)] = False  # refused already
         limit = state.settings.max_command_age
         for k in np.flatnonzero(late):
             age = (now_ns - sent_ns[k]) * 1e-9
             reason = f"overloaded: command {age:.3f} s old when its turn came (limit {limit:g} s)"
             verdicts[int(k)] = (None, 0, reason)
         stats.commands_overloaded += int(late.sum())
-        todo = np.flatnonzero(~late)
+        todo = np.array([k for k in np.flatnonzero(~late) if k not in verdicts], dtype=int)
         if todo.size:
             keys, groups = np.unique(positions[todo], axis=0, return_inverse=True)
             for g in range(keys.shape[0]):
@@ -96,6 +104,10 @@ class CommandStream:
                 frame_id=state.manipulator.frame_id,
                 request_id=command.request_id,
             )
+            if result is not None and node.paths is not None:  # the move from the current pose
+                fields = node.paths.with_motion(
+                    fields, state.manipulator, positions[k], angles[k][None, :]
+                )
             node.publish(self._publisher, to_message(ReachabilityResult, fields))
         stats.commands_answered += len(batch)
 

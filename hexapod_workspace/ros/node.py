@@ -86,6 +86,8 @@ from .parameters import (
     refusal,
     state_from,
 )
+from .paths import attach as attach_paths
+from .paths import check_poses_from_poses
 from .recorder import Recorder
 from .worker import WorkspaceWorker
 from .workspaces import WorkspaceServer
@@ -188,8 +190,11 @@ class WorkspaceNode(Node):
         self.jobs = self.workspaces.jobs
         self._diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self.create_timer(1.0, self._publish_diagnostics)
+        # ~/check_path, Pose inputs and the current-pose parameter (hexapod_workspace.ros.paths)
+        self.paths = attach_paths(self, lambda: self.state.manipulator, self.recorder)
         for attach in extensions:
             attach(self)
+        self._warn_unknown_overrides()
         if self.state.settings.recording_enabled:
             self.recorder.open(self.state.settings.recording_directory)
         self.worker.start()  # it warms its own kernels up meanwhile
@@ -264,14 +269,17 @@ class WorkspaceNode(Node):
 
     # ------------------------------------------------------------------ parameters
     def _declare_parameters(self) -> None:
-        """Declare the table; overrides of unknown names are reported (and ignored)."""
+        """Declare the table (a wrong type in the file: ConfigError naming it)."""
         for name, spec in self._specs.items():
             try:
                 self.declare_parameter(name, spec.default, spec.descriptor())
             except ParameterException as error:  # a wrong type in the file
                 raise ConfigError(f"{name}: {error}") from error
-        ours = set(self._specs) | {"use_sim_time", "start_type_description_service"}
-        unknown = sorted(set(self._override_names) - ours)
+
+    def _warn_unknown_overrides(self) -> None:
+        """Name the overrides no part of the node declared (after the extensions declared
+        theirs)."""
+        unknown = sorted(set(self._override_names) - set(self.list_parameters([], 0).names))
         if unknown:
             self.get_logger().warning(f"ignoring unknown parameters: {', '.join(unknown)}")
 
@@ -287,7 +295,12 @@ class WorkspaceNode(Node):
         wrong types included)."""
         for parameter in parameter_list:
             if parameter.name not in self._specs and self.has_parameter(parameter.name):
-                continue  # rclpy's own (use_sim_time, ...)
+                # an extension's or rclpy's own (use_sim_time, ...): rclpy checks the rest
+                if self.describe_parameter(parameter.name).read_only:
+                    reason = f"{parameter.name}: read-only, set at start only (value "
+                    reason += f"{parameter.value!r} refused)"
+                    return SetParametersResult(successful=False, reason=reason)
+                continue
             reason = refusal(self._specs, parameter)
             if reason is not None:
                 return SetParametersResult(successful=False, reason=reason)
@@ -343,6 +356,8 @@ class WorkspaceNode(Node):
 
     @staticmethod
     def _check_fields(state: State, request: CheckPoses.Request) -> dict[str, Any]:
+        if len(request.poses):  # the geometry_msgs/Pose form (hexapod_workspace.ros.paths)
+            return check_poses_from_poses(state.manipulator, request, state.settings.max_poses)
         count, limit = len(request.orientations), state.settings.max_poses
         reason = None
         if count == 0:

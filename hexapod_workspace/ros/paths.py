@@ -1,0 +1,361 @@
+"""ROS side of motions: ``~/check_path``, poses as ROS holds them, moves from the current pose.
+
+Everything here is wired onto a node by :func:`attach` (a few lines in the node), so the node
+module keeps only its own wiring:
+
+* service ``~/check_path`` (``hexapod_workspace_msgs/srv/CheckPath``): a path of
+  ``geometry_msgs/Pose`` in the base frame, checked move by move (certified), or with
+  ``free_torsion`` the rotation about each pose's z-axis (the tool axis) planned;
+* parameter ``motion.current_pose_topic`` (read-only, default ``""``): a
+  ``geometry_msgs/PoseStamped`` topic; when set, the last pose received there is the *current
+  pose* and :meth:`PathServices.motion_fields` checks each commanded pose as a move from it;
+* conversions of ``geometry_msgs/Pose`` to arrays and back, and of the Pose forms of
+  ``CheckPoses`` requests and ``CommandedPose`` messages.
+
+Units: m and rad; positions and quaternions ``(x, y, z, w)`` in the base frame.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from geometry_msgs.msg import PoseStamped
+from hexapod_workspace_msgs.srv import CheckPath
+from numpy.typing import NDArray
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.callback_groups import ReentrantCallbackGroup
+
+from ..core.manipulator import Manipulator
+from ..core.paths import (
+    DEFAULT_PATH_TOLERANCE,
+    DEFAULT_PSI_STEP,
+    INTERPOLATIONS,
+    check_path,
+    check_waypoints,
+    plan_torsion,
+)
+from ..core.rotations import matrix_to_tt, quaternion_to_matrix, tt_to_matrix, wrap_angle
+from ..errors import HexapodWorkspaceError, InputError
+from ..logs import SERVICE_QOS, messages, recorded_type, service_topics
+from ..logs import paths as path_fields
+from .conversions import to_message
+
+__all__ = [
+    "CURRENT_POSE_PARAMETER",
+    "PathServices",
+    "attach",
+    "check_path_response_fields",
+    "check_poses_from_poses",
+    "commanded_target",
+    "pose_arrays",
+]
+
+#: Parameter naming the current-pose topic (geometry_msgs/PoseStamped); "" = none.
+CURRENT_POSE_PARAMETER = "motion.current_pose_topic"
+
+
+def pose_arrays(poses: Sequence[Any]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Positions (N, 3), m, and quaternions (N, 4) ``(x, y, z, w)`` of ``geometry_msgs/Pose``s.
+
+    Not validated here (NaN stays NaN; the core refuses it with the waypoint's index).
+    """
+    flat = [
+        value
+        for pose in poses
+        for value in (
+            pose.position.x,
+            pose.position.y,
+            pose.position.z,
+            pose.orientation.x,
+            pose.orientation.y,
+            pose.orientation.z,
+            pose.orientation.w,
+        )
+    ]
+    values = np.array(flat, dtype=np.float64).reshape(-1, 7)
+    return values[:, :3], values[:, 3:]
+
+
+def commanded_target(command: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Position (3,), m, and T&T angles (1, 3), rad, of a ``CommandedPose`` in either form.
+
+    With ``use_pose`` the pose is ``command.pose`` (quaternion, converted here: a controller
+    never converts to T&T itself); otherwise ``position`` + ``orientation``.
+
+    Raises
+    ------
+    InputError
+        A zero or non-finite quaternion.
+    """
+    if getattr(command, "use_pose", False):
+        positions, quaternions = pose_arrays([command.pose])
+        return positions[0], matrix_to_tt(quaternion_to_matrix(quaternions))
+    point, tt = command.position, command.orientation
+    return (
+        np.array([point.x, point.y, point.z], dtype=np.float64),
+        np.array([[tt.phi, tt.theta, tt.psi]], dtype=np.float64),
+    )
+
+
+def check_poses_from_poses(
+    manipulator: Manipulator, request: Any, max_poses: int
+) -> dict[str, Any]:
+    """``CheckPoses_Response`` fields for a request that gives ``poses`` (geometry_msgs/Pose).
+
+    Each pose is checked at its own position; ``orientations`` must then be empty.
+    """
+    count = len(request.poses)
+    if len(request.orientations):
+        reason = "give either orientations (at position) or poses, not both"
+        return messages.check_poses_response_fields(None, success=False, message=reason)
+    if count > max_poses:
+        reason = f"poses: at most {max_poses} poses per request (check.max_poses), got {count}"
+        return messages.check_poses_response_fields(None, success=False, message=reason)
+    positions, quaternions = pose_arrays(request.poses)
+    try:
+        result = check_waypoints(manipulator, positions, quaternions=quaternions)
+    except InputError as error:
+        return messages.check_poses_response_fields(None, success=False, message=str(error))
+    return messages.check_poses_response_fields(result)
+
+
+def check_path_response_fields(manipulator: Manipulator, request: Any) -> dict[str, Any]:
+    """``CheckPath_Response`` fields answering a request (a refusal with the reason when the
+    request is malformed)."""
+    try:
+        if request.interpolation >= len(INTERPOLATIONS):
+            msg = (
+                f"interpolation: expected SLERP (0) or TILT_TORSION (1), got "
+                f"{request.interpolation}"
+            )
+            raise InputError(msg)
+        interpolation = INTERPOLATIONS[request.interpolation]
+        tolerance = _option(request.tolerance, "tolerance", DEFAULT_PATH_TOLERANCE)
+        positions, quaternions = pose_arrays(request.poses)
+        if request.free_torsion:
+            psi_step = _option(request.psi_step, "psi_step", DEFAULT_PSI_STEP)
+            max_dpsi = None
+            if request.limit_dpsi:
+                max_dpsi = float(request.max_dpsi)
+                if not (math.isfinite(max_dpsi) and max_dpsi >= 0.0):
+                    msg = f"max_dpsi: expected a finite value >= 0 rad, got {max_dpsi!r}"
+                    raise InputError(msg)
+            if len(quaternions) and not np.all(np.isfinite(quaternions)):
+                msg = "poses: expected finite quaternions"
+                raise InputError(msg)
+            axes = _tool_axes(quaternions)
+            result = plan_torsion(
+                manipulator,
+                positions,
+                axes,
+                psi_step=psi_step,
+                max_dpsi=max_dpsi,
+                interpolation=interpolation,
+                tolerance=tolerance,
+            )
+        else:
+            result = check_path(
+                manipulator,
+                positions,
+                quaternions=quaternions,
+                interpolation=interpolation,
+                tolerance=tolerance,
+            )
+    except HexapodWorkspaceError as error:
+        return path_fields.failed_check_path_response_fields(str(error))
+    return path_fields.check_path_response_fields(result, pairs=manipulator.leg_diameter > 0.0)
+
+
+def _option(value: float, name: str, default: float) -> float:
+    value = float(value)
+    if value == 0.0:
+        return default
+    if not (math.isfinite(value) and value > 0.0):
+        msg = f"{name}: expected a finite value > 0 rad (0 = default), got {value!r}"
+        raise InputError(msg)
+    return value
+
+
+def _tool_axes(quaternions: NDArray[np.float64]) -> NDArray[np.float64]:
+    """z-axes (N, 3) of the poses' orientations: the tool axes (InputError for a zero one)."""
+    if len(quaternions) == 0:
+        return np.zeros((0, 3))
+    return quaternion_to_matrix(quaternions)[:, :, 2]
+
+
+@dataclass
+class _CurrentPose:
+    position: NDArray[np.float64]
+    quaternion: NDArray[np.float64]
+    frame_id: str
+
+
+class PathServices:
+    """What :func:`attach` created on a node; see the module documentation.
+
+    Parameters
+    ----------
+    node : rclpy.node.Node
+    get_manipulator : callable
+        Returns the node's current manipulator (it changes with the parameters).
+    recorder : object, optional
+        With ``add_channel(topic, msgtype, qos)`` and ``write(topic, message)`` (the node's MCAP
+        recorder): requests and responses of ``~/check_path`` are recorded there.
+    """
+
+    def __init__(
+        self,
+        node: Any,
+        get_manipulator: Callable[[], Manipulator],
+        recorder: Any | None = None,
+    ) -> None:
+        self._node = node
+        self._get_manipulator = get_manipulator
+        self._recorder = recorder
+        self._lock = threading.Lock()
+        self._current: _CurrentPose | None = None
+        self.parameter_names = [CURRENT_POSE_PARAMETER]
+        group = ReentrantCallbackGroup()
+        self.service = node.create_service(
+            CheckPath, "~/check_path", self._on_check_path, callback_group=group
+        )
+        self._request_topic, self._response_topic = service_topics(
+            node.resolve_service_name("~/check_path")
+        )
+        if recorder is not None:
+            recorder.add_channel(
+                self._request_topic,
+                recorded_type(f"{path_fields.CHECK_PATH_TYPE}_Request"),
+                SERVICE_QOS,
+            )
+            recorder.add_channel(
+                self._response_topic,
+                recorded_type(f"{path_fields.CHECK_PATH_TYPE}_Response"),
+                SERVICE_QOS,
+            )
+        topic = node.declare_parameter(
+            CURRENT_POSE_PARAMETER,
+            "",
+            ParameterDescriptor(
+                description="geometry_msgs/PoseStamped topic of the platform's current pose "
+                "(base frame). When set, each commanded pose is validated as a move (slerp) "
+                "from the last pose received; empty = targets only.",
+                read_only=True,
+            ),
+        ).value
+        self.subscription = None
+        if topic:
+            self.subscription = node.create_subscription(
+                PoseStamped, str(topic), self._on_current_pose, 10, callback_group=group
+            )
+
+    # ------------------------------------------------------------------ check_path
+    def _on_check_path(self, request: Any, response: Any) -> Any:
+        self._record(self._request_topic, request)
+        try:
+            fields = check_path_response_fields(self._get_manipulator(), request)
+        except Exception as error:  # keep serving; the reason goes back to the caller
+            self._node.get_logger().error(f"check_path: internal error: {error!r}")
+            fields = path_fields.failed_check_path_response_fields(f"internal error: {error}")
+        response = to_message(CheckPath.Response, fields)
+        self._record(self._response_topic, response)
+        return response
+
+    def _record(self, topic: str, message: Any) -> None:
+        if self._recorder is not None:
+            self._recorder.write(topic, message)
+
+    # ------------------------------------------------------------------ current pose
+    def _on_current_pose(self, message: Any) -> None:
+        positions, quaternions = pose_arrays([message.pose])
+        with self._lock:
+            self._current = _CurrentPose(positions[0], quaternions[0], str(message.header.frame_id))
+
+    @property
+    def current_pose(self) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+        """The last current pose received (position (3,), quaternion (4,)), or None."""
+        with self._lock:
+            current = self._current
+        return None if current is None else (current.position, current.quaternion)
+
+    def with_motion(
+        self,
+        fields: dict[str, Any],
+        manipulator: Manipulator,
+        position: NDArray[np.float64],
+        angles: NDArray[np.float64],
+    ) -> dict[str, Any]:
+        """``ReachabilityResult`` fields with the move from the current pose added.
+
+        Parameters
+        ----------
+        fields : dict
+            The result's fields (``messages.reachability_result_fields``); returned unchanged
+            when the command was invalid or no current pose is known.
+        manipulator : Manipulator
+        position : ndarray, shape (3,)
+            Target position, m.
+        angles : ndarray, shape (1, 3) or (3,)
+            Target T&T angles, rad.
+
+        Returns
+        -------
+        dict
+            ``motion_checked``, ``motion_ok``, ``current_pose`` and ``motion`` filled, and a
+            clause about the move appended to ``message``.
+        """
+        with self._lock:
+            current = self._current
+        if current is None or not fields.get("success", False):
+            return fields
+        fields = dict(fields)
+        if current.frame_id and current.frame_id != manipulator.frame_id:
+            fields["message"] += (
+                f"; move not checked: the current pose is in frame {current.frame_id!r}, "
+                f"not {manipulator.frame_id!r}"
+            )
+            return fields
+        try:
+            start = quaternion_to_matrix(current.quaternion[None, :])
+            target = tt_to_matrix(wrap_angle(np.asarray(angles, dtype=float).reshape(1, 3)))
+            result = check_path(
+                manipulator,
+                np.vstack([current.position, np.asarray(position, dtype=float)]),
+                rotations=np.concatenate([start, target]),
+            )
+        except InputError as error:
+            fields["message"] += f"; move not checked: {error}"
+            return fields
+        segments = result.segments
+        if result.ok:
+            clause = "the move from the current pose runs"
+        elif not result.waypoints.reachable[0]:
+            clause = "the current pose itself is unreachable"
+        elif not segments.ok[0]:
+            clause = (
+                f"the move from the current pose leaves the workspace at s = "
+                f"{segments.first_violation_s[0]:.4f} ({', '.join(segments.violated[0])})"
+            )
+        else:
+            clause = "the target is unreachable"
+        fields.update(
+            motion_checked=True,
+            motion_ok=result.ok,
+            current_pose=path_fields.pose_fields(current.position, current.quaternion),
+            motion=path_fields.segment_check_fields(segments, 0),
+            message=f"{fields['message']}; {clause}",
+        )
+        return fields
+
+
+def attach(
+    node: Any, get_manipulator: Callable[[], Manipulator], recorder: Any | None = None
+) -> PathServices:
+    """Create ``~/check_path``, the ``motion.current_pose_topic`` parameter and its
+    subscription on ``node``; see :class:`PathServices`."""
+    return PathServices(node, get_manipulator, recorder)
