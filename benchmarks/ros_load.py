@@ -319,10 +319,11 @@ def idle_phase(samples: int) -> dict:
 class Computations:
     """Keeps a 3-D orientation workspace computing in the node (action, or the old service)."""
 
-    def __init__(self) -> None:
+    def __init__(self, every: float = 0.0) -> None:
         import rclpy
         from rclpy.executors import SingleThreadedExecutor
 
+        self.every = every  # s between goal starts (0: back to back)
         self.node = rclpy.create_node(f"load_compute_{os.getpid()}")
         self.executor = SingleThreadedExecutor()
         self.executor.add_node(self.node)
@@ -362,6 +363,7 @@ class Computations:
 
     def _run(self) -> None:
         while not self.stop.is_set():
+            started = time.monotonic()
             if self.kind == "action":
                 from hexapod_workspace_msgs.action import ComputeWorkspace
 
@@ -388,6 +390,7 @@ class Computations:
                 while not future.done():
                     time.sleep(0.01)
             self.done += 1
+            self.stop.wait(max(0.0, self.every - (time.monotonic() - started)))
 
     def close(self) -> None:
         self.stop.set()
@@ -403,7 +406,7 @@ def run(args: argparse.Namespace, node: subprocess.Popen, out_dir: Path) -> int:
     rclpy.init()
     try:
         idle = idle_phase(args.samples)
-        computations = Computations()
+        computations = Computations(args.compute_every)
         computations.start()
         time.sleep(1.0)  # the first computation is under way
         roles = [spawn_role("checker", args, out_dir) for _ in range(args.clients)]
@@ -437,8 +440,9 @@ def run(args: argparse.Namespace, node: subprocess.Popen, out_dir: Path) -> int:
         f" ratio {core_ratio:.2f}x (goal <= {GOAL_CORE_RATIO}x)"
     )
     print(
-        f"load: {args.clients} check_poses clients, a 3-D computation ({computations.kind}, "
-        f"{computations.done} finished), commands at {args.rate:g}/s for {args.duration:g} s"
+        f"load: {args.clients} check_poses clients, 3-D computations ({computations.kind}, "
+        f"{computations.done} finished, every {args.compute_every:g} s), commands at "
+        f"{args.rate:g}/s for {args.duration:g} s"
     )
     print(
         f"commands: published {command['published']} (at {command['publish_rate']:.0f}/s), "
@@ -479,6 +483,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--duration", type=float, default=10.0, help="seconds of commands")
     parser.add_argument("--clients", type=int, default=2, help="check_poses client processes")
     parser.add_argument("--samples", type=int, default=300, help="idle 1-pose calls")
+    parser.add_argument(
+        "--compute-every",
+        type=float,
+        default=0.0,
+        metavar="S",
+        help="start a 3-D workspace goal every S s (default 0: back to back; each publishes and "
+        "records its 274k-point cloud)",
+    )
     parser.add_argument("--role", choices=("commander", "checker"), help=argparse.SUPPRESS)
     parser.add_argument(
         "--node-arg", action="append", default=[], metavar="ARG", help="extra --ros-args"
