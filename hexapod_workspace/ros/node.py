@@ -95,8 +95,18 @@ from .workspaces import WorkspaceServer
 __all__ = ["EXTENSIONS", "NODE_NAME", "WorkspaceNode", "main"]
 
 NODE_NAME = "hexapod_workspace"
+
+
+def _attach_atlas(node: WorkspaceNode) -> object:
+    """``~/compute_atlas`` (hexapod_workspace.ros.atlas_action; goals refused with the install
+    hint when the ``atlas`` extra is missing)."""
+    from .atlas_action import attach_atlas_action
+
+    return attach_atlas_action(node, lambda: node.state.manipulator, recorder=node.recorder)
+
+
 #: Functions ``attach(node)`` run by :func:`main` after the node is built (one per extension).
-EXTENSIONS: list[Callable[[WorkspaceNode], object]] = []
+EXTENSIONS: list[Callable[[WorkspaceNode], object]] = [_attach_atlas]
 #: The commanded-pose subscription: nothing is dropped on the node's side.
 COMMAND_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_ALL, depth=1, reliability=ReliabilityPolicy.RELIABLE

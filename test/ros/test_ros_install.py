@@ -74,7 +74,14 @@ def node_topics(ros_client, tmp_path_factory):
         service = messages.TOPICS["compute_projected_workspace"]
         action = messages.TOPICS["compute_workspace"] + "/_action/send_goal"
         ros_client.spin_until(
-            lambda: {wanted, service, action, "/diagnostics"} <= set(offered()),
+            lambda: {
+                wanted,
+                service,
+                action,
+                "/diagnostics",
+                f"{NODE}/compute_atlas/_action/send_goal",
+            }
+            <= set(offered()),
             what="the node's interfaces",
             timeout=60.0,
         )
@@ -120,3 +127,8 @@ def test_node_offers_every_interface_of_the_issue(node_topics):
     assert node_topics.get(f"{action}/get_result") == [f"{package}_GetResult"]
     assert node_topics.get(f"{action}/feedback") == [f"{package}_FeedbackMessage"]
     assert node_topics.get("/diagnostics") == ["diagnostic_msgs/msg/DiagnosticArray"]
+    # the extensions: ~/check_path (ros/paths.py) and ~/compute_atlas (ros/atlas_action.py)
+    assert node_topics.get(f"{NODE}/check_path") == ["hexapod_workspace_msgs/srv/CheckPath"]
+    assert node_topics.get(f"{NODE}/compute_atlas/_action/send_goal") == [
+        "hexapod_workspace_msgs/action/ComputeAtlas_SendGoal"
+    ]

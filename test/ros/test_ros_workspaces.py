@@ -401,3 +401,35 @@ def test_a_killed_worker_process_is_replaced(client, workspace_node):
     assert response.success, response.message
     assert response.summary.request_id == "w"
     assert set(worker_pids(workspace_node.process.pid)).isdisjoint(pids)
+
+
+def test_an_atlas_goal_runs_in_the_node_while_checks_are_answered(client):
+    """~/compute_atlas is attached to the workspace node (an extension); its blocking run is in a
+    thread of its own (ros.jobs.in_thread), so the single-threaded executor keeps answering."""
+    from hexapod_workspace_msgs.action import ComputeAtlas
+    from rclpy.action import ActionClient
+
+    atlas = ActionClient(client.node, ComputeAtlas, f"{NODE}/compute_atlas")
+    try:
+        assert atlas.wait_for_server(timeout_sec=60)
+        goal = ComputeAtlas.Goal(box=[-0.1, 0.1, -0.1, 0.1, -1.35, -1.2], step=0.05, n_phi=24)
+        goal.tolerance = 1e-3
+        feedback: list = []
+        sent = atlas.send_goal_async(goal, feedback_callback=lambda m: feedback.append(m))
+        client.spin_until(sent.done, what="the atlas goal response")
+        result = sent.result().get_result_async()
+        client.spin_until(lambda: bool(feedback), what="atlas feedback")
+        pose = CheckPoses.Request(orientations=[TiltTorsion(phi=0.1, theta=0.2, psi=0.0)])
+        pose.position.z = -1.3
+        answered_during = 0
+        for _ in range(10):
+            response = client.call(CheckPoses, f"{NODE}/check_poses", pose)
+            assert response.success
+            answered_during += not result.done()
+        client.spin_until(result.done, what="the atlas result", timeout=600)
+        assert result.result().status == GoalStatus.STATUS_SUCCEEDED, result.result().result
+        assert result.result().result.positions == 5 * 5 * 4
+        print(f"{answered_during} of 10 checks answered while the atlas ran")
+        assert answered_during > 0, "no check was answered while the atlas ran (blocked?)"
+    finally:
+        atlas.destroy()
