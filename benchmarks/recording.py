@@ -18,6 +18,7 @@ import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -38,10 +39,12 @@ def timed(function: Callable[[int], object], repeat: int) -> float:
     return statistics.median(times)
 
 
-def drain_ms(writer: logs.LogWriter) -> float:
-    """How long a background writer still needs to get what was queued onto the disk, ms."""
+def drain_ms(recorder: Any, count: int) -> float:
+    """How long the node's recorder thread still needs until ``count`` messages are written, ms."""
     start = time.perf_counter()
-    writer.flush()
+    deadline = start + 600.0
+    while recorder.status().messages < count and time.perf_counter() < deadline:
+        time.sleep(0.001)
     return (time.perf_counter() - start) * 1e3
 
 
@@ -137,9 +140,10 @@ def service_impact(repeat: int, workdir: Path) -> None:
 
     Both variants compute the result and build its message objects (rosbags objects stand in for
     the rclpy messages the node publishes anyway). Recording adds serialising them (rclpy's
-    serialize_message in the node, rosbags' serialize_cdr here) and LogWriter.write on the
-    node's one log per run, in background mode. Uses the projected workspace when the core has
-    it, else a CheckPoses batch of 10^4 poses.
+    serialize_message in the node's recorder thread, rosbags' serialize_cdr here) and
+    LogWriter.write, here in the calling thread (the CLI's path; the node's callbacks only queue,
+    see node_path). Uses the projected workspace when the core has it, else a CheckPoses batch
+    of 10^4 poses.
     """
     from hexapod_workspace._resources import example_config_path
     from hexapod_workspace.core import constraints
@@ -203,25 +207,26 @@ def service_impact(repeat: int, workdir: Path) -> None:
     )
     for label, produce in ((name, outputs),):  # the 10^6-point cloud: node_path() below
         without = timed(lambda _, make=produce: serve(None, make), repeat)
-        with logs.LogWriter(workdir / "node_run.mcap", background=True) as writer:
+        with logs.LogWriter(workdir / "node_run.mcap") as writer:
             with_recording = timed(lambda _, make=produce: serve(writer, make), repeat)
-            drain = drain_ms(writer)
         print(
             f"service ({label}): {without:7.1f} ms without recording, {with_recording:7.1f} ms"
-            f" with: ratio {with_recording / without:.3f} (writer thread then needed "
-            f"{drain:.1f} ms more to reach the disk)"
+            f" with (written in the calling thread): ratio {with_recording / without:.3f}"
         )
 
 
 def node_path(points: np.ndarray, repeat: int, workdir: Path) -> None:
-    """The node's own path when rclpy is importable (ROS venv): rclpy PointCloud2 ->
-    serialize_message -> LogWriter(background=True).write, i.e. what recording adds to a
-    service callback that publishes the cloud anyway."""
+    """The node's own path when rclpy is importable (ROS venv): an rclpy PointCloud2 handed to
+    the node's Recorder (ros/recorder.py: the callback only queues; its thread serialises and
+    writes), i.e. what recording adds to a callback that publishes the cloud anyway."""
     try:
         import array
+        import logging
 
         from rclpy.serialization import serialize_message
         from sensor_msgs.msg import PointCloud2, PointField
+
+        from hexapod_workspace.ros.recorder import Recorder
     except ImportError as error:
         print(f"node path (rclpy): skipped ({error}); run under the ROS venv for it")
         return
@@ -236,20 +241,20 @@ def node_path(points: np.ndarray, repeat: int, workdir: Path) -> None:
         fields=[PointField(**f) for f in fields["fields"]],
     )
     cloud.data = array.array("B", fields["data"])
-    with logs.LogWriter(workdir / "node_path.mcap", background=True) as writer:
-        writer.add_channel("/hexapod_workspace/projected_workspace", CLOUD, logs.RESULT_QOS)
+    topic = "/hexapod_workspace/projected_workspace"
+    recorder = Recorder(logging.getLogger("bench-recorder"))
+    recorder.add_channel(topic, CLOUD, logs.RESULT_QOS)
+    recorder.open(workdir / "node_path")
+    try:
         serialize_ms = timed(lambda _: serialize_message(cloud), repeat)
-        record_ms = timed(
-            lambda _: writer.write(
-                "/hexapod_workspace/projected_workspace", serialize_message(cloud)
-            ),
-            repeat,
-        )
-        drain = drain_ms(writer)
+        record_ms = timed(lambda _: recorder.write(topic, cloud), repeat)
+        drain = drain_ms(recorder, repeat)
+    finally:
+        recorder.shutdown()
     print(
-        f"node path (rclpy, 10^6 points): serialize_message {serialize_ms:.1f} ms; serialize + "
-        f"queue (what the callback waits for) {record_ms:.1f} ms; the writer thread then "
-        f"needed {drain:.1f} ms more to reach the disk"
+        f"node path (rclpy, 10^6 points): serialize_message {serialize_ms:.1f} ms; the "
+        f"callback's part (queue) {record_ms:.3f} ms; the recorder thread then needed "
+        f"{drain:.1f} ms more to serialise and write"
     )
 
 

@@ -129,8 +129,10 @@ def main(argv: list[str] | None = None) -> int:
 
 def run(args: argparse.Namespace, domain: int) -> int:
     import rclpy
+    from hexapod_workspace_msgs.action import ComputeWorkspace
     from hexapod_workspace_msgs.msg import TiltTorsion, WorkspaceRequest
-    from hexapod_workspace_msgs.srv import CheckPoses, ComputeWorkspace
+    from hexapod_workspace_msgs.srv import CheckPoses
+    from rclpy.action import ActionClient
     from rclpy.executors import SingleThreadedExecutor
 
     from hexapod_workspace import Manipulator, check
@@ -145,11 +147,13 @@ def run(args: argparse.Namespace, domain: int) -> int:
     spinner = threading.Thread(target=executor.spin, name="client-spin", daemon=True)
     spinner.start()
     checks = client_node.create_client(CheckPoses, f"{NODE}/check_poses")
-    computes = client_node.create_client(ComputeWorkspace, f"{NODE}/compute_workspace")
+    computes = ActionClient(client_node, ComputeWorkspace, f"{NODE}/compute_workspace")
     floor_checks = client_node.create_client(CheckPoses, FLOOR)
     try:
-        clients = (checks, computes, floor_checks)
-        if not all(client.wait_for_service(timeout_sec=60) for client in clients):
+        clients = (checks, floor_checks)
+        if not all(client.wait_for_service(timeout_sec=60) for client in clients) or not (
+            computes.wait_for_server(timeout_sec=60)
+        ):
             print("services not discovered within 60 s", file=sys.stderr)
             return 2
 
@@ -196,8 +200,11 @@ def run(args: argparse.Namespace, domain: int) -> int:
             kind=WorkspaceRequest.ORIENTATION, n_rays=360, psi_step=0.005, tolerance=1e-7
         )
         request.position.z = -1.3
-        long_call = computes.call_async(ComputeWorkspace.Request(request=request))
-        time.sleep(0.5)  # let the request reach the node
+        goal = computes.send_goal_async(ComputeWorkspace.Goal(request=request))
+        while not goal.done():
+            time.sleep(0.01)
+        long_call = goal.result().get_result_async()
+        time.sleep(0.5)  # let the computation start
         loaded: list[float] = []
         while not long_call.done() and len(loaded) < args.samples:
             sample = timed(one)
@@ -208,7 +215,7 @@ def run(args: argparse.Namespace, domain: int) -> int:
         while not long_call.done() and time.perf_counter() < deadline:
             time.sleep(0.05)
         remaining = time.perf_counter() - computing_start
-        summary = long_call.result().summary if long_call.done() else None
+        summary = long_call.result().result.summary if long_call.done() else None
     finally:
         executor.shutdown()
         spinner.join(timeout=10)

@@ -6,7 +6,6 @@ own schemas, and mcap + mcap_ros2) and compared with what was written, after dec
 
 from __future__ import annotations
 
-import errno
 import io
 import signal
 import subprocess
@@ -233,70 +232,79 @@ def test_bag_directory_written_by_rosbags_is_read(tmp_path: Path) -> None:
     assert len(logs.read_log(bag).messages) == 1
 
 
-def test_close_is_idempotent_and_write_after_close_fails(tmp_path: Path) -> None:
+def test_finish_is_idempotent_and_misuse_raises_recording_error(tmp_path: Path) -> None:
     writer = logs.LogWriter(tmp_path / "a.mcap")
+    assert not (tmp_path / "a.mcap").exists(), "the constructor must not create the file"
+    with pytest.raises(RecordingError, match="not open"):
+        writer.write_fields("/t", SUMMARY, {})
+    writer.open()
+    with pytest.raises(RecordingError, match="already open"):
+        writer.open()
     writer.write_fields("/t", SUMMARY, {"request_id": "x"})
-    writer.close()
+    with pytest.raises(RecordingError, match="not registered"):
+        writer.write("/never-added", b"")
+    with pytest.raises(RecordingError, match="recorded as"):
+        writer.add_channel("/t", "hexapod_workspace_msgs/msg/CommandedPose")
+    with pytest.raises(RecordingError, match="unknown message type"):
+        writer.add_channel("/u", "no_such_pkg/msg/Nothing")
+    writer.finish()
     writer.finish()
     assert writer.closed
     with pytest.raises(RecordingError, match="closed"):
         writer.write_fields("/t", SUMMARY, {})
-    with pytest.raises(KeyError):
-        logs.LogWriter(tmp_path / "b.mcap").write("/never-added", b"")
+    with pytest.raises(RecordingError, match="flush_messages"):
+        logs.LogWriter(tmp_path / "b.mcap", flush_messages=0)
+    logs.LogWriter(tmp_path / "never_opened.mcap").finish()  # nothing to finish, no error
+    assert [m.message.request_id for m in logs.read_log(tmp_path / "a.mcap").messages] == ["x"]
 
 
 def test_unwritable_directory_raises_recording_error(tmp_path: Path) -> None:
     blocker = tmp_path / "a_file"
     blocker.write_text("not a directory")
     with pytest.raises(RecordingError, match="cannot create MCAP log"):
-        logs.LogWriter(blocker / "logs" / "x.mcap")
+        logs.LogWriter(blocker / "logs" / "x.mcap").open()
 
 
 @pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full (Linux)")
 def test_full_disk_at_creation_raises_recording_error() -> None:
     with pytest.raises(RecordingError, match="No space left on device"):
-        logs.LogWriter("/dev/full")
+        logs.LogWriter("/dev/full").open()
 
 
 # A file-size limit makes the disk "full" in the middle of a log, in a child process only.
 FULL_DISK_CHILD = textwrap.dedent(
     """
-    import resource, signal, sys, threading
+    import resource, signal, sys, time
     from hexapod_workspace import logs
     from hexapod_workspace.errors import RecordingError
     signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
     resource.setrlimit(resource.RLIMIT_FSIZE, (200_000, 200_000))
     path, mode = sys.argv[1], sys.argv[2]
-    reported = threading.Event()
-    def on_error(error):
-        print("on_error", error.__cause__.errno, flush=True)
-        reported.set()
-    writer = logs.LogWriter(path, flush_interval=0.01 if mode == "timer" else 0,
-                                 flush_messages=1 if mode == "background" else 64,
-                                 background=mode == "background", on_error=on_error)
+    writer = logs.LogWriter(path, flush_interval=0.01 if mode == "due" else 0).open()
     writer.add_channel("/t", "sensor_msgs/msg/PointCloud2")
     data = logs.serialize("sensor_msgs/msg/PointCloud2", {"data": bytes(300_000)})
     writer.write("/t", data)
-    if mode in ("timer", "background"):
-        print("reported", reported.wait(60), writer.closed, flush=True)
-    else:
-        try:
+    try:
+        if mode == "due":
+            time.sleep(0.02)
+            writer.flush_if_due()
+        else:
             writer.flush()
-        except RecordingError as error:
-            print("raised", error, flush=True)
-        print("closed", writer.closed, flush=True)
-        try:
-            writer.write("/t", data)
-        except RecordingError:
-            print("refused", flush=True)
-    writer.close()
+    except RecordingError as error:
+        print("raised", error, flush=True)
+    print("closed", writer.closed, flush=True)
+    try:
+        writer.write("/t", data)
+    except RecordingError:
+        print("refused", flush=True)
+    writer.finish()
     print("done", flush=True)
     """
 )
 
 
-@pytest.mark.parametrize("mode", ["flush", "timer", "background"])
-def test_disk_full_mid_log_is_reported_not_raised_elsewhere(tmp_path: Path, mode: str) -> None:
+@pytest.mark.parametrize("mode", ["flush", "due"])
+def test_disk_full_mid_log_raises_and_closes(tmp_path: Path, mode: str) -> None:
     child = subprocess.run(
         [sys.executable, "-c", FULL_DISK_CHILD, str(tmp_path / "full.mcap"), mode],
         capture_output=True,
@@ -306,23 +314,10 @@ def test_disk_full_mid_log_is_reported_not_raised_elsewhere(tmp_path: Path, mode
     )
     assert child.returncode == 0, child.stderr
     lines = child.stdout.splitlines()
-    if mode in ("timer", "background"):
-        assert lines == [f"on_error {errno.EFBIG}", "reported True True", "done"]
-    else:
-        assert lines[0].startswith("raised writing MCAP log") and "File too large" in lines[0]
-        assert lines[1:] == ["closed True", "refused", "done"]
+    assert lines[0].startswith("raised writing MCAP log") and "File too large" in lines[0]
+    assert lines[1:] == ["closed True", "refused", "done"]
     assert "Traceback" not in child.stderr
     logs.read_log(tmp_path / "full.mcap")  # what reached the disk is still readable
-
-
-def test_background_writer_keeps_order_and_drains_on_close(tmp_path: Path) -> None:
-    path = tmp_path / "background.mcap"
-    with logs.LogWriter(path, background=True, flush_messages=7) as writer:
-        for i in range(100):
-            writer.write_fields("/s", SUMMARY, {"n_points": i}, 1_000 + i)
-        writer.flush()
-        assert sum(writer.message_counts.values()) == 100
-    assert [m.message.n_points for m in logs.read_log(path).messages] == list(range(100))
 
 
 def test_run_log_path_is_named_by_start_time_and_unique(tmp_path: Path) -> None:
@@ -349,8 +344,9 @@ CHILD = textwrap.dedent(
                                 "hexapod_workspace_msgs/msg/WorkspaceSummary",
                                 {"request_id": f"r{i}", "n_points": i}, 1_000 + i)
         print("written", flush=True)
-        while True:
+        while True:  # the owner's idle loop, as the node's recorder thread
             time.sleep(0.05)
+            writer.flush_if_due()
     """
 )
 
@@ -386,11 +382,11 @@ def test_sigkill_keeps_every_flushed_message(tmp_path: Path) -> None:
 
 
 def test_sigkill_after_the_flush_interval_keeps_messages(tmp_path: Path) -> None:
-    """The background flusher writes pending messages out without further writes."""
+    """The owner's idle calls of flush_if_due write pending messages out (no further writes)."""
     path = tmp_path / "timer.mcap"
     child = start_child(path, "timer")
     try:
-        # Wait (no timed assertion) until the flusher has written the 3 messages out.
+        # Wait (no timed assertion) until the 3 messages are written out.
         for _ in range(1200):
             if len(logs.read_log(path).messages) == 3:
                 break

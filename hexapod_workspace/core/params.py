@@ -38,6 +38,7 @@ NODE_PARAMETERS = (
     "resolution.tolerance",
     "resolution.projected_method",
     "check.max_poses",
+    "check.max_command_age",
     "recording.enabled",
     "recording.directory",
     "motion.current_pose_topic",

@@ -511,13 +511,14 @@ def compute_workspace_response_fields(
     stamp_ns: int,
     frame_id: str,
     request_id: str = "",
-    summary: Mapping[str, Any] | None = None,
-    boundary: Mapping[str, Any] | None = None,
+    summary: Mapping[str, Any] | Any = None,
+    boundary: Mapping[str, Any] | Any = None,
 ) -> dict[str, Any]:
     """hexapod_workspace_msgs/srv/ComputeWorkspace_Response (summary + boundary cloud).
 
-    Pass ``summary``/``boundary`` dicts already built for publishing to avoid building them
-    twice; for a failure pass ``workspace=None`` and a failed ``summary``.
+    Pass ``summary``/``boundary`` already built for publishing (field dicts, or messages, which
+    are kept as they are) to avoid building them twice; for a failure pass ``workspace=None``
+    and a failed ``summary``.
     """
     if summary is None:
         summary = summary_fields(
@@ -527,10 +528,11 @@ def compute_workspace_response_fields(
         points = boundary_points(workspace) if workspace is not None else np.zeros((0, 6))
         boundary = pointcloud_fields(points, frame_id=frame_id, stamp_ns=stamp_ns)
     return {
-        "success": bool(summary["success"]),
-        "message": str(summary["message"]),
-        "summary": dict(summary),
-        "boundary": dict(boundary),
+        "success": bool(_get(summary, "success")),
+        "message": str(_get(summary, "message")),
+        # dicts are copied; message objects (the node's, already published) pass through
+        "summary": dict(summary) if isinstance(summary, Mapping) else summary,
+        "boundary": dict(boundary) if isinstance(boundary, Mapping) else boundary,
     }
 
 

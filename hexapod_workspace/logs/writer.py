@@ -14,13 +14,20 @@ Service calls are recorded as two messages of the generated types: the request
 answers the n-th request. (Jazzy's ``_service_event`` form nests ``pkg/srv/...`` types inside
 the event, which the ``ros2msg`` schema parsers of mcap_ros2 and Foxglove reject.)
 
-Durability: messages are collected in MCAP chunks and a chunk is written and the file flushed
-when ``flush_messages`` messages are pending, when the oldest pending message is
-``flush_interval`` seconds old (a background thread), when a chunk reaches ``chunk_size`` bytes,
-or on :meth:`LogWriter.flush`/:meth:`LogWriter.close`. Everything flushed survives a SIGKILL of
-the writing process (it is in the operating system's hands; ``fsync`` is not called, so a power
-cut may lose more). An interrupted file has no summary; :func:`read_log` reads it as far as it
-is intact, and :func:`recover_log` (or ``mcap recover``) makes it a finished file again.
+Durability: messages are collected in MCAP chunks; a chunk is written and the file flushed when
+``flush_messages`` messages are pending, when a :meth:`LogWriter.write` or
+:meth:`LogWriter.flush_if_due` finds the oldest pending message ``flush_interval`` seconds old,
+when a chunk reaches ``chunk_size`` bytes, or on :meth:`LogWriter.flush`/:meth:`LogWriter.finish`.
+Everything flushed survives a SIGKILL of the writing process (it is in the operating system's
+hands; ``fsync`` is not called, so a power cut may lose more). An interrupted file has no summary;
+:func:`read_log` reads it as far as it is intact, and :func:`recover_log` (or ``mcap recover``)
+makes it a finished file again.
+
+The writer has no thread and no queue of its own: it belongs to one thread at a time (like
+``mcap.writer.Writer`` and rosbags' ``Writer``). A process that records from several threads
+puts one queue in front of it and one thread behind it, as the node's recorder does
+(:mod:`hexapod_workspace.ros.recorder`); that thread calls :meth:`LogWriter.flush_if_due` when
+idle, which makes ``flush_interval`` the bound on how long a written message stays in memory.
 
 The type store (:func:`get_typestore`) is rosbags' Jazzy store plus the package's own
 interfaces (``hexapod_workspace_msgs``, parsed from the shipped ``.msg``/``.srv`` files) plus
@@ -29,15 +36,11 @@ interfaces (``hexapod_workspace_msgs``, parsed from the shipped ``.msg``/``.srv`
 
 from __future__ import annotations
 
-import atexit
 import contextlib
-import queue
-import threading
 import time
-import weakref
 from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from mcap.writer import CompressionType
 from mcap.writer import Writer as McapWriter
@@ -54,10 +57,6 @@ from .typestore import (
     message_definition,
     type_hash,
 )
-
-if TYPE_CHECKING:
-    from collections.abc import Callable
-
 
 #: Seconds after which a pending message is written out by the background flusher.
 DEFAULT_FLUSH_INTERVAL = 0.5
@@ -83,40 +82,28 @@ def run_log_path(
     return candidate
 
 
-def _flusher(ref: weakref.ref[LogWriter], stop: threading.Event, interval: float) -> None:
-    while not stop.wait(interval):
-        writer = ref()
-        if writer is None:
-            return
-        writer._flush_if_due()
-        del writer
-
-
 class LogWriter:
-    """Write one MCAP log in the rosbag2 form; thread-safe; a context manager.
+    """Write one MCAP log in the rosbag2 form; a context manager; one owning thread.
+
+    Created closed: :meth:`open` (or ``with``) creates the file, :meth:`finish` (idempotent,
+    also on leaving ``with``) writes the summary and closes it.
 
     Parameters
     ----------
     path : str or Path
         The ``.mcap`` file to create (parent folders are created; an existing file is replaced).
     flush_interval : float
-        Seconds: a pending message is on disk at most this long after :meth:`write` returned
-        (background thread; 0 disables the timer).
+        Seconds: a pending message is flushed by the first :meth:`write` or
+        :meth:`flush_if_due` after it is this old (0: only by count, size or :meth:`flush`).
     flush_messages : int
         Pending messages that trigger a write-out at once (>= 1).
     chunk_size : int
-        Bytes of pending messages that close a chunk at once.
-    on_error : callable, optional
-        Called with the :class:`RecordingError` when a background flush or a background write
-        fails (the writer is then closed; the node uses it to turn recording off).
-    background : bool
-        :meth:`write` only queues the message; a worker thread writes it (in order). A service
-        then does not wait for the disk. :meth:`flush` and :meth:`close` wait for the queue.
+        Bytes of pending messages that close a chunk at once (>= 1).
 
     Raises
     ------
     RecordingError
-        When the file cannot be created.
+        A flush setting out of range.
     """
 
     def __init__(
@@ -126,20 +113,17 @@ class LogWriter:
         flush_interval: float = DEFAULT_FLUSH_INTERVAL,
         flush_messages: int = DEFAULT_FLUSH_MESSAGES,
         chunk_size: int = DEFAULT_CHUNK_SIZE,
-        on_error: Callable[[RecordingError], None] | None = None,
-        background: bool = False,
     ) -> None:
-        if flush_messages < 1 or flush_interval < 0 or chunk_size < 1:
+        if not (flush_messages >= 1 and flush_interval >= 0 and chunk_size >= 1):
             msg = (
                 f"flush_messages must be >= 1, flush_interval >= 0, chunk_size >= 1; got "
                 f"{flush_messages}, {flush_interval}, {chunk_size}"
             )
-            raise ValueError(msg)
+            raise RecordingError(msg)
         self.path = Path(path)
         self.flush_interval = float(flush_interval)
         self.flush_messages = int(flush_messages)
-        self._on_error = on_error
-        self._lock = threading.RLock()
+        self._chunk_size = int(chunk_size)
         self._schemas: dict[str, int] = {}
         self._channels: dict[str, tuple[int, str]] = {}
         self._qos: dict[str, str] = {}
@@ -148,14 +132,29 @@ class LogWriter:
         self._oldest_pending = 0.0
         self._first_ns: int | None = None
         self._last_ns = 0
+        self._opened = False
         self._closed = False
         self.error: RecordingError | None = None
-        self._file = None
+        self._file: Any = None
+        self._mcap: Any = None
+
+    def open(self) -> LogWriter:
+        """Create the file and write the MCAP header; returns ``self``.
+
+        Raises
+        ------
+        RecordingError
+            The file cannot be created, or the writer was opened before.
+        """
+        if self._opened:
+            msg = f"MCAP log {self.path} is already open (a LogWriter opens once)"
+            raise RecordingError(msg)
+        self._opened = True
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self._file = self.path.open("wb")
             self._mcap = McapWriter(
-                self._file, chunk_size=chunk_size, compression=CompressionType.NONE
+                self._file, chunk_size=self._chunk_size, compression=CompressionType.NONE
             )
             self._mcap.start(profile=PROFILE, library="hexapod_workspace (python mcap)")
             self._file.flush()
@@ -168,22 +167,7 @@ class LogWriter:
                 reason = "a file is in the way of its folder"
             msg = f"cannot create MCAP log {self.path}: {reason}"
             raise RecordingError(msg) from err
-        self._queue: queue.Queue[Any] | None = queue.Queue() if background else None
-        self._worker: threading.Thread | None = None
-        if background:
-            self._worker = threading.Thread(target=self._drain, name="mcap-log-writer", daemon=True)
-            self._worker.start()
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
-        if self.flush_interval > 0:
-            self._thread = threading.Thread(
-                target=_flusher,
-                args=(weakref.ref(self), self._stop, self.flush_interval / 2),
-                name="mcap-log-flusher",
-                daemon=True,
-            )
-            self._thread.start()
-        atexit.register(self.close)
+        return self
 
     # -- channels and messages
 
@@ -201,34 +185,36 @@ class LogWriter:
 
         Raises
         ------
-        KeyError
-            Unknown type. ValueError: topic already registered with another type.
         RecordingError
-            The writer is closed or failed.
+            Unknown type, topic already registered with another type, writer not open, closed
+            or failed.
         """
-        with self._lock:
-            if topic in self._channels:
-                channel_id, known_type = self._channels[topic]
-                if known_type != msgtype:
-                    msg = f"topic {topic} is recorded as {known_type}, not {msgtype}"
-                    raise ValueError(msg)
-                return channel_id
-            self._check_open()
-            schema_text = message_definition(msgtype)
-            if msgtype not in self._schemas:
-                self._schemas[msgtype] = self._mcap.register_schema(
-                    name=msgtype, encoding=SCHEMA_ENCODING, data=schema_text.encode()
-                )
-            channel_id = self._mcap.register_channel(
-                topic=topic,
-                message_encoding=MESSAGE_ENCODING,
-                schema_id=self._schemas[msgtype],
-                metadata={"offered_qos_profiles": qos, "topic_type_hash": type_hash(msgtype)},
-            )
-            self._channels[topic] = (channel_id, msgtype)
-            self._qos[topic] = qos
-            self._counts[topic] = 0
+        if topic in self._channels:
+            channel_id, known_type = self._channels[topic]
+            if known_type != msgtype:
+                msg = f"topic {topic} is recorded as {known_type}, not {msgtype}"
+                raise RecordingError(msg)
             return channel_id
+        self._check_open()
+        try:
+            schema_text = message_definition(msgtype)
+        except KeyError as err:
+            msg = f"cannot record {topic}: unknown message type {msgtype!r}"
+            raise RecordingError(msg) from err
+        if msgtype not in self._schemas:
+            self._schemas[msgtype] = self._mcap.register_schema(
+                name=msgtype, encoding=SCHEMA_ENCODING, data=schema_text.encode()
+            )
+        channel_id = self._mcap.register_channel(
+            topic=topic,
+            message_encoding=MESSAGE_ENCODING,
+            schema_id=self._schemas[msgtype],
+            metadata={"offered_qos_profiles": qos, "topic_type_hash": type_hash(msgtype)},
+        )
+        self._channels[topic] = (channel_id, msgtype)
+        self._qos[topic] = qos
+        self._counts[topic] = 0
+        return channel_id
 
     def write(
         self,
@@ -253,33 +239,20 @@ class LogWriter:
 
         Raises
         ------
-        KeyError
-            Topic not registered.
         RecordingError
-            The file could not be written (disk full, ...); the writer is closed.
+            Topic not registered, writer not open or closed, or the file could not be written
+            (disk full, ...; the writer is then closed).
         """
         log_time_ns = time.time_ns() if log_time_ns is None else int(log_time_ns)
         publish_time_ns = log_time_ns if publish_time_ns is None else int(publish_time_ns)
-        with self._lock:
-            self._check_open()
-            if topic not in self._channels:
-                msg = f"topic {topic!r} is not registered (call add_channel first)"
-                raise KeyError(msg)
-            if self._queue is None:
-                self._write_locked(topic, data, log_time_ns, publish_time_ns)
-                return
-        self._queue.put((topic, data, log_time_ns, publish_time_ns))
-
-    def _write_locked(
-        self,
-        topic: str,
-        data: bytes | bytearray | memoryview,
-        log_time_ns: int,
-        publish_time_ns: int,
-    ) -> None:
+        self._check_open()
+        channel = self._channels.get(topic)
+        if channel is None:
+            msg = f"topic {topic!r} is not registered (call add_channel first)"
+            raise RecordingError(msg)
         try:
             self._mcap.add_message(
-                channel_id=self._channels[topic][0],
+                channel_id=channel[0],
                 log_time=log_time_ns,
                 data=data,  # copied into the chunk at once: no bytes() copy here
                 publish_time=publish_time_ns,
@@ -294,26 +267,9 @@ class LogWriter:
             self._oldest_pending = time.monotonic()
         self._pending += 1
         if self._pending >= self.flush_messages:
-            self._flush_locked()
-
-    def _drain(self) -> None:
-        """Background mode: write queued messages in order until the stop sentinel."""
-        assert self._queue is not None
-        while True:
-            item = self._queue.get()
-            try:
-                if item is None:
-                    return
-                with self._lock:
-                    if self._closed:
-                        continue  # failed earlier: what is still queued is dropped
-                    try:
-                        self._write_locked(*item)
-                    except RecordingError as err:
-                        if self._on_error is not None:
-                            self._on_error(err)
-            finally:
-                self._queue.task_done()
+            self._flush_pending()
+        else:
+            self.flush_if_due()
 
     def write_fields(
         self,
@@ -339,15 +295,27 @@ class LogWriter:
         Raises
         ------
         RecordingError
-            The file could not be written; the writer is closed.
+            Not open, closed, or the file could not be written (the writer is then closed).
         """
-        if self._queue is not None:
-            self._queue.join()
-        with self._lock:
-            self._check_open()
-            self._flush_locked()
+        self._check_open()
+        self._flush_pending()
 
-    def _flush_locked(self) -> None:
+    def flush_if_due(self) -> bool:
+        """Flush when the oldest pending message is ``flush_interval`` s old; True if flushed.
+
+        Raises
+        ------
+        RecordingError
+            The file could not be written (the writer is then closed).
+        """
+        if self._pending == 0 or self.flush_interval <= 0 or self._closed:
+            return False
+        if time.monotonic() - self._oldest_pending < self.flush_interval:
+            return False
+        self._flush_pending()
+        return True
+
+    def _flush_pending(self) -> None:
         if self._pending == 0:
             return
         try:
@@ -356,21 +324,12 @@ class LogWriter:
             raise self._fail(err) from err
         self._pending = 0
 
-    def _flush_if_due(self) -> None:
-        with self._lock:
-            if self._closed or self._pending == 0:
-                return
-            if time.monotonic() - self._oldest_pending < self.flush_interval / 2:
-                return
-            try:
-                self._flush_locked()
-            except RecordingError as err:
-                if self._on_error is not None:
-                    self._on_error(err)
-
     def _check_open(self) -> None:
         if self.error is not None:
             raise self.error
+        if not self._opened:
+            msg = f"MCAP log {self.path} is not open (call open() or use `with`)"
+            raise RecordingError(msg)
         if self._closed:
             msg = f"MCAP log {self.path} is closed"
             raise RecordingError(msg)
@@ -379,7 +338,6 @@ class LogWriter:
         """Close the file without finishing it and remember why."""
         self.error = RecordingError(f"writing MCAP log {self.path} failed: {err.strerror or err}")
         self._closed = True
-        self._stop.set()
         self._close_file_quietly()
         return self.error
 
@@ -390,43 +348,40 @@ class LogWriter:
 
     @property
     def closed(self) -> bool:
-        """True after :meth:`close` or a write failure."""
+        """True after :meth:`finish` or a write failure (False before :meth:`open`)."""
         return self._closed
+
+    @property
+    def pending(self) -> int:
+        """Messages written but not yet flushed to the file."""
+        return self._pending
 
     @property
     def message_counts(self) -> dict[str, int]:
         """Messages written per topic."""
-        with self._lock:
-            return dict(self._counts)
+        return dict(self._counts)
 
-    def close(self) -> None:
-        """Finish the log (summary, Statistics, footer) and close the file. Idempotent.
+    def finish(self) -> None:
+        """Finish the log (summary, Statistics, footer) and close the file. Idempotent; a
+        writer that never opened or that failed has nothing to finish.
 
         Raises
         ------
         RecordingError
             When finishing fails (disk full); the file then stays readable up to its last chunk.
         """
-        if self._worker is not None and self._worker is not threading.current_thread():
-            self._queue.put(None)
-            self._worker.join()
-            self._worker = None
-        with self._lock:
-            if self._closed:
-                return
+        if self._closed or not self._opened:
             self._closed = True
-            self._stop.set()
-            atexit.unregister(self.close)
-            try:
-                self._mcap.add_metadata("rosbag2", self._rosbag2_metadata())
-                self._mcap.finish()
-                self._file.close()
-            except OSError as err:
-                raise self._fail(err) from err
-        if self._thread is not None and self._thread is not threading.current_thread():
-            self._thread.join()
+            return
+        self._closed = True
+        try:
+            self._mcap.add_metadata("rosbag2", self._rosbag2_metadata())
+            self._mcap.finish()
+            self._file.close()
+        except OSError as err:
+            raise self._fail(err) from err
 
-    finish = close
+    close = finish
 
     def _rosbag2_metadata(self) -> dict[str, str]:
         """The ``rosbag2`` metadata record rosbag2_storage_mcap writes on close."""
@@ -474,7 +429,9 @@ class LogWriter:
         }
 
     def __enter__(self) -> LogWriter:
+        if not self._opened:
+            self.open()
         return self
 
     def __exit__(self, *exc_info: object) -> None:
-        self.close()
+        self.finish()

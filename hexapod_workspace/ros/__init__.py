@@ -1,9 +1,14 @@
 """The ROS 2 face of hexapod_workspace: the only subpackage that imports rclpy.
 
-:mod:`hexapod_workspace.ros.node` holds the node ``hexapod_workspace`` (executable
-``workspace_node``); :mod:`hexapod_workspace.ros.conversions` fills rclpy messages from the
-ROS-free field dicts of :mod:`hexapod_workspace.logs.messages`; :mod:`hexapod_workspace.ros.worker`
-computes workspaces in a worker process (ROS-free). Nothing here is imported by the core.
+:mod:`~hexapod_workspace.ros.node` wires the node ``hexapod_workspace`` (executable
+``workspace_node``) and its callbacks; :mod:`~.parameters` declares and validates its
+parameters; :mod:`~.commands` answers the CommandedPose stream; :mod:`~.workspaces` serves the
+``~/compute_workspace`` action, the Trigger services and the request topic through the job queue
+of :mod:`~.jobs`, which runs them in the worker process of :mod:`~.worker` (ROS-free);
+:mod:`~.recorder` owns the MCAP log; :mod:`~.health` builds ``/diagnostics``;
+:mod:`~.conversions` fills rclpy messages from the ROS-free field dicts of
+:mod:`hexapod_workspace.logs.messages`; :mod:`~.republish` replays logs. Nothing here is
+imported by the core.
 """
 
 from __future__ import annotations
@@ -17,6 +22,8 @@ __all__ = ["main"]
 _ROS_MODULES = {
     "rclpy",
     "rcl_interfaces",
+    "action_msgs",
+    "diagnostic_msgs",
     "rosidl_parser",
     "sensor_msgs",
     "std_srvs",

@@ -38,6 +38,7 @@ from ..errors import HexapodWorkspaceError
 from ..logs import qos_profile_text
 from ..logs.messages import header_fields
 from .conversions import to_message
+from .jobs import in_thread
 
 __all__ = ["ACTION_NAME", "CLOUD_FIELDS", "CLOUD_TOPIC", "atlas_cloud", "attach_atlas_action"]
 
@@ -230,7 +231,9 @@ def attach_atlas_action(
         node,
         ComputeAtlas,
         ACTION_NAME,
-        execute_callback=execute,
+        # the run blocks for minutes: in a thread of its own, so that a single-threaded
+        # executor (the workspace node's) keeps serving meanwhile
+        execute_callback=in_thread(node, execute),
         goal_callback=on_goal,
         cancel_callback=on_cancel,
         callback_group=ReentrantCallbackGroup(),

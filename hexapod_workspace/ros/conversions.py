@@ -68,24 +68,40 @@ def type_name(message_class: type) -> str:
     return f"{package}/{kind}/{message_class.__name__}"
 
 
-def _value(definition: Any, value: Any) -> Any:
-    """Convert one field value from the dict form to what the rclpy message accepts."""
+def _plain(value: Any) -> Any:
+    return value.item() if isinstance(value, np.generic) else value
+
+
+def _octets(value: Any) -> Any:
+    # the fast path for PointCloud2.data (bytes in the dict form)
+    return array.array("B", bytes(value))
+
+
+def _numbers(value: Any) -> Any:
+    return value.tolist() if isinstance(value, np.ndarray) else list(value)
+
+
+def _converter(definition: Any) -> Any:
+    """The function that turns a dict-form value of a field of type ``definition`` into what
+    the rclpy message accepts."""
     if isinstance(definition, NamespacedType):
-        return to_message(_namespaced_class(definition), value)
+        nested = _namespaced_class(definition)
+        return functools.partial(to_message, nested)
     if isinstance(definition, (AbstractSequence, Array)):
         element = definition.value_type
         if isinstance(element, NamespacedType):
             element_class = _namespaced_class(element)
-            return [to_message(element_class, item) for item in value]
+            return lambda value: [to_message(element_class, item) for item in value]
         if isinstance(element, BasicType) and element.typename in ("uint8", "octet"):
-            # the fast path for PointCloud2.data (bytes in the dict form)
-            return array.array("B", bytes(value))
-        if isinstance(value, np.ndarray):
-            return value.tolist()
-        return list(value)
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
+            return _octets
+        return _numbers
+    return _plain
+
+
+@functools.cache
+def _converters(message_class: type) -> dict[str, Any]:
+    """Field name -> converter of a generated message class (built once per class)."""
+    return {name: _converter(definition) for name, definition in _slots(message_class).items()}
 
 
 def to_message(message_class: type, fields: Mapping[str, Any] | Any) -> Any:
@@ -113,10 +129,10 @@ def to_message(message_class: type, fields: Mapping[str, Any] | Any) -> Any:
     """
     if isinstance(fields, message_class):
         return fields
-    slots = _slots(message_class)
+    converters = _converters(message_class)
     message = message_class()
     for name, value in fields.items():
-        setattr(message, name, _value(slots[name], value))
+        setattr(message, name, converters[name](value))
     return message
 
 

@@ -14,12 +14,15 @@ import multiprocessing
 import os
 import signal
 import threading
+import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from multiprocessing.connection import Connection
 from typing import Any
 
 import numpy as np
 
+from hexapod_workspace.core import kernels
 from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.core.orientation import orientation_workspace
 from hexapod_workspace.core.projected import projected_workspace
@@ -27,15 +30,32 @@ from hexapod_workspace.core.resolution import WorkspaceKind
 from hexapod_workspace.errors import HexapodWorkspaceError
 from hexapod_workspace.logs import messages
 
-__all__ = ["WORKER_NICENESS", "WorkerError", "WorkspaceJob", "WorkspaceWorker", "compute_fields"]
+__all__ = [
+    "CANCEL_GRACE",
+    "WORKER_NICENESS",
+    "CanceledError",
+    "WorkerError",
+    "WorkspaceJob",
+    "WorkspaceWorker",
+    "compute_fields",
+]
 
 #: Niceness added to the worker process: on a busy machine the operating system runs the node's
 #: latency-critical pose checks before the long computations.
 WORKER_NICENESS = 5
+#: Seconds a canceled computation has to stop by itself (at its next progress report) before
+#: the worker process is terminated (and replaced on next use).
+CANCEL_GRACE = 0.3
+#: Smallest progress step reported to the node (fewer messages through the pipe).
+_PROGRESS_STEP = 0.01
 
 
 class WorkerError(RuntimeError):
     """The worker process died or could not be reached (the node restarts it on next use)."""
+
+
+class CanceledError(HexapodWorkspaceError):
+    """The computation was canceled before it finished."""
 
 
 @dataclass(frozen=True)
@@ -71,8 +91,12 @@ class WorkspaceJob:
     request_id: str = ""
 
 
-def compute_fields(job: WorkspaceJob) -> tuple[dict[str, Any], dict[str, Any]]:
+def compute_fields(
+    job: WorkspaceJob, progress: Callable[[float], None] | None = None
+) -> tuple[dict[str, Any], dict[str, Any]]:
     """Compute a workspace and return its WorkspaceSummary and PointCloud2 field dicts.
+
+    ``progress`` receives the fraction done (0..1, non-decreasing); it may raise to stop.
 
     Raises
     ------
@@ -87,6 +111,7 @@ def compute_fields(job: WorkspaceJob) -> tuple[dict[str, Any], dict[str, Any]]:
             n_rays=job.n_rays,
             psi_step=job.psi_step,
             tolerance=job.tolerance,
+            progress=progress,
         )
     else:
         workspace = projected_workspace(
@@ -95,6 +120,7 @@ def compute_fields(job: WorkspaceJob) -> tuple[dict[str, Any], dict[str, Any]]:
             method=WorkspaceKind(job.kind).label,
             n_phi=job.n_rays,
             tolerance=job.tolerance,
+            progress=progress,
         )
     points = messages.boundary_points(workspace)
     summary = messages.summary_fields(
@@ -109,18 +135,37 @@ def compute_fields(job: WorkspaceJob) -> tuple[dict[str, Any], dict[str, Any]]:
     return summary, cloud
 
 
-def _serve(connection: Connection) -> None:
-    """Worker process main loop: one job in, ``("ok", result)`` or ``("error", exc)`` out."""
+def _reporter(connection: Connection, cancel: Any) -> Callable[[float], None]:
+    """The progress callback of one job in the worker: sends steps, raises when canceled."""
+    last = [-1.0]
+
+    def progress(fraction: float) -> None:
+        if cancel.is_set():
+            raise CanceledError("canceled")
+        if fraction >= last[0] + _PROGRESS_STEP or fraction >= 1.0:
+            last[0] = fraction
+            connection.send(("progress", float(fraction)))
+
+    return progress
+
+
+def _serve(connection: Connection, cancel: Any) -> None:
+    """Worker process main loop: one job in; ``("progress", fraction)`` messages, then
+    ``("ok", result)``, ``("error", exc)`` or ``("canceled", None)`` out. ``cancel`` (an event
+    the node sets) stops the job at its next progress report."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the node decides when the worker stops
     with contextlib.suppress(OSError):
         os.nice(WORKER_NICENESS)  # throughput work: the node's checks are scheduled first
+    kernels.warm_up()  # compiled (or loaded) before the first job arrives
     while True:
         try:
             job = connection.recv()
         except (EOFError, OSError):
             return
         try:
-            reply: tuple[str, Any] = ("ok", compute_fields(job))
+            reply: tuple[str, Any] = ("ok", compute_fields(job, _reporter(connection, cancel)))
+        except CanceledError:
+            reply = ("canceled", None)
         except HexapodWorkspaceError as error:
             reply = ("error", error)
         except Exception as error:  # a bug: report it, keep serving
@@ -135,11 +180,13 @@ class WorkspaceWorker:
     :meth:`start`) and replaced when it dies; :meth:`close` terminates it for good.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, cancel_grace: float = CANCEL_GRACE) -> None:
+        self.cancel_grace = float(cancel_grace)
         self._context = multiprocessing.get_context("spawn")
         self._lock = threading.Lock()
         self._process: Any = None
         self._connection: Connection | None = None
+        self._cancel = self._context.Event()
         self._closed = False
 
     def start(self) -> None:
@@ -155,15 +202,38 @@ class WorkspaceWorker:
             self._stop_locked()
             parent, child = self._context.Pipe()
             process = self._context.Process(
-                target=_serve, args=(child,), name="hexapod_workspace_worker", daemon=True
+                target=_serve,
+                args=(child, self._cancel),
+                name="hexapod_workspace_worker",
+                daemon=True,
             )
             process.start()
             child.close()
             self._process, self._connection = process, parent
         return self._connection
 
-    def compute(self, job: WorkspaceJob) -> tuple[dict[str, Any], dict[str, Any]]:
+    @property
+    def alive(self) -> bool:
+        """True while the worker process runs (False before the first start or after a death)."""
+        process = self._process
+        return process is not None and process.is_alive()
+
+    def compute(
+        self,
+        job: WorkspaceJob,
+        progress: Callable[[float], None] | None = None,
+        canceled: threading.Event | None = None,
+    ) -> tuple[dict[str, Any], dict[str, Any]]:
         """Run ``job`` in the worker; block until done.
+
+        Parameters
+        ----------
+        job : WorkspaceJob
+        progress : callable, optional
+            Called (in this thread) with the fraction done, 0..1, non-decreasing.
+        canceled : threading.Event, optional
+            Set by another thread to cancel: the job stops at its next progress report, or the
+            worker process is terminated after ``cancel_grace`` s (:data:`CANCEL_GRACE`).
 
         Returns
         -------
@@ -172,6 +242,8 @@ class WorkspaceWorker:
 
         Raises
         ------
+        CanceledError
+            ``canceled`` was set before the job finished.
         HexapodWorkspaceError
             As :func:`compute_fields`.
         WorkerError
@@ -181,18 +253,46 @@ class WorkspaceWorker:
         with self._lock:
             for attempt in range(2):  # a job is a pure function: run it again in a new worker
                 connection = self._ensure_started()
+                self._cancel.clear()
                 try:
                     connection.send(job)
-                    status, payload = connection.recv()
+                    status, payload = self._wait(connection, progress, canceled)
                     break
                 except (EOFError, OSError) as error:
                     self._stop_locked()
+                    if canceled is not None and canceled.is_set():
+                        raise CanceledError("canceled") from None
                     if attempt == 1 or self._closed:
                         msg = "the workspace worker process died during the computation"
                         raise WorkerError(msg) from error
+        if status == "canceled":
+            raise CanceledError("canceled")
         if status == "error":
             raise payload
         return payload
+
+    def _wait(
+        self,
+        connection: Connection,
+        progress: Callable[[float], None] | None,
+        canceled: threading.Event | None,
+    ) -> tuple[str, Any]:
+        """Receive until the job's reply; forward progress; enforce a cancel (under the lock)."""
+        cancel_time = None
+        while True:
+            if canceled is not None and canceled.is_set() and cancel_time is None:
+                cancel_time = time.monotonic()
+                self._cancel.set()
+            if cancel_time is not None and time.monotonic() - cancel_time >= self.cancel_grace:
+                self._stop_locked()  # the job did not stop by itself: end the process
+                return "canceled", None
+            if not connection.poll(0.02):
+                continue
+            status, payload = connection.recv()
+            if status != "progress":
+                return status, payload
+            if progress is not None:
+                progress(payload)
 
     def _stop_locked(self) -> None:
         process, connection = self._process, self._connection

@@ -36,7 +36,7 @@ class Recorder:
 def main() -> None:
     rclpy.init()
     manipulator = Manipulator.from_params_file(example_config_path())
-    writer = LogWriter(sys.argv[1])
+    writer = LogWriter(sys.argv[1]).open()
     node = rclpy.create_node("hexapod_workspace")
     executor = MultiThreadedExecutor(num_threads=3)
     try:

@@ -234,6 +234,48 @@ class RosClient:
                 raise AssertionError(msg)
             print(f"no response from {name} within {resend_after} s: request sent again")
 
+    def action_client(self, name: str) -> Any:
+        """A (cached) ComputeWorkspace action client, waited for until its server is seen."""
+        from hexapod_workspace_msgs.action import ComputeWorkspace
+        from rclpy.action import ActionClient
+
+        key = f"action:{name}"
+        if key not in self._clients:
+            client = ActionClient(self.node, ComputeWorkspace, name)
+            if not client.wait_for_server(timeout_sec=DISCOVERY_TIMEOUT):
+                msg = f"action server {name} not discovered within {DISCOVERY_TIMEOUT} s"
+                raise AssertionError(msg)
+            self._clients[key] = client
+        return self._clients[key]
+
+    def send_goal(self, name: str, request: Any, feedback: list | None = None) -> Any:
+        """Send a ComputeWorkspace goal with ``request`` (a WorkspaceRequest); return the
+        accepted goal handle. Feedback messages are appended to ``feedback``."""
+        from hexapod_workspace_msgs.action import ComputeWorkspace
+
+        client = self.action_client(name)
+        goal = ComputeWorkspace.Goal(request=request)
+        callback = (
+            (lambda message: feedback.append(message.feedback)) if feedback is not None else None
+        )
+        future = client.send_goal_async(goal, feedback_callback=callback)
+        self.spin_until(future.done, what=f"the goal response of {name}")
+        handle = future.result()
+        assert handle.accepted, "the node rejected a goal"
+        return handle
+
+    def goal_result(self, handle: Any, timeout: float = CALL_TIMEOUT) -> tuple[int, Any]:
+        """Wait for a goal's end; return (GoalStatus status, ComputeWorkspace.Result)."""
+        future = handle.get_result_async()
+        self.spin_until(future.done, what="the goal's result", timeout=timeout)
+        response = future.result()
+        return response.status, response.result
+
+    def compute(self, name: str, request: Any, feedback: list | None = None) -> Any:
+        """Run one ComputeWorkspace goal to its end; return its result."""
+        _, result = self.goal_result(self.send_goal(name, request, feedback))
+        return result
+
     def collect(self, message_type: type, topic: str, *, transient_local: bool = False) -> list:
         """Subscribe to ``topic``; received messages are appended to the returned list."""
         from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy

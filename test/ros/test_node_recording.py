@@ -12,6 +12,7 @@ import math
 import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -53,6 +54,7 @@ from recording_support import (  # noqa: E402
 NAMESPACES = {
     "sigint": "/rec_sigint",
     "sigkill": "/rec_sigkill",
+    "stream": "/rec_stream",
     True: "/rec_unwritable",
     False: "/rec_disabled",
 }
@@ -136,8 +138,13 @@ def test_sigint_log_holds_exactly_what_the_node_did(ros_domain, ros_client, tmp_
         compute.request.request_id = "recording-test"
         compute.request.kind = WorkspaceKind.PROJECTED_TORSION_ZERO
         compute.request.position.z = -1.3
-        compute_response = ros_client.call(
-            ComputeWorkspace, f"{node_name}/compute_workspace", compute
+        # the action's goal and result are recorded in the service's form (same fields)
+        result = ros_client.compute(f"{node_name}/compute_workspace", compute.request)
+        compute_response = ComputeWorkspace.Response(
+            success=result.success,
+            message=result.message,
+            summary=result.summary,
+            boundary=result.boundary,
         )
         trigger_response = ros_client.call(
             Trigger, f"{node_name}/compute_projected_workspace", Trigger.Request()
@@ -206,6 +213,83 @@ def test_sigkill_keeps_what_was_flushed(ros_domain, ros_client, tmp_path) -> Non
     assert recorded[f"{node_name}/check_poses/request"] == [plain(request)]
     assert recorded[f"{node_name}/check_poses/response"] == [plain(response)]
     assert by_topic(read_with_mcap_ros2(path)) == recorded
+
+
+#: Commands per second of the stream killed by SIGKILL, and how many kills at random points.
+STREAM_RATE, KILLS = 200.0, 3
+
+
+@pytest.mark.parametrize("kill", range(KILLS))
+def test_sigkill_under_a_stream_loses_nothing_older_than_the_flush_bound(
+    ros_domain, ros_client, tmp_path, kill: int
+) -> None:
+    """A 200 Hz CommandedPose stream; SIGKILL at a random point: every result this process
+    received more than FLUSH_BOUND s before the kill is in the log, with its command."""
+    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+    from hexapod_workspace.ros.recorder import FLUSH_BOUND
+
+    rng = np.random.default_rng(100 + kill)
+    node_name, args = node_args("stream", tmp_path)
+    args = ["-r", f"__ns:={NAMESPACES['stream']}{kill}", *args[2:]]
+    node_name = f"{NAMESPACES['stream']}{kill}/hexapod_workspace"
+    qos = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE)
+    received: dict[str, float] = {}
+    with running_node(tmp_path, NODE_PARAMS, args) as node:
+        ros_client.node.create_subscription(  # transient local: no result lost to discovery
+            ReachabilityResult,
+            f"{node_name}/reachability",
+            lambda m: received.setdefault(m.request_id, time.monotonic()),
+            QoSProfile(
+                history=HistoryPolicy.KEEP_ALL,
+                reliability=ReliabilityPolicy.RELIABLE,
+                durability=DurabilityPolicy.TRANSIENT_LOCAL,
+            ),
+        )
+        publisher = ros_client.node.create_publisher(
+            CommandedPose, f"{node_name}/commanded_pose", qos
+        )
+        ros_client.spin_until(
+            lambda: publisher.get_subscription_count() > 0
+            and ros_client.node.count_publishers(f"{node_name}/reachability") > 0,
+            what="the node's command topics",
+            timeout=DISCOVERY_TIMEOUT,
+        )
+        warm = CommandedPose(request_id=f"k{kill}-warm-up")
+        warm.position.z = -1.3
+        publisher.publish(warm)
+        ros_client.spin_until(lambda: warm.request_id in received, what="the warm-up result")
+        kill_after = rng.uniform(1.5, 4.0)  # s of stream before the kill
+        start = time.monotonic()
+        index = 0
+        while time.monotonic() - start < kill_after:
+            command = CommandedPose(request_id=f"k{kill}-{index}")
+            command.position.z = -1.3
+            command.orientation.theta = float(rng.uniform(0.0, 0.6))
+            command.orientation.phi = float(rng.uniform(-math.pi, math.pi))
+            publisher.publish(command)
+            index += 1
+            deadline = start + index / STREAM_RATE
+            while time.monotonic() < deadline:
+                ros_client.executor.spin_once(timeout_sec=max(0.0, deadline - time.monotonic()))
+        killed_at = time.monotonic()
+        node.stop(signal.SIGKILL)
+    acknowledged = [rid for rid, at in received.items() if at < killed_at - FLUSH_BOUND]
+    assert len(acknowledged) > STREAM_RATE * 0.5, "too few results before the kill to judge"
+    contents = logs.read_log(the_log(tmp_path / "logs"))
+    assert not contents.finished
+    logged = {
+        topic: {m.message.request_id for m in contents.messages if m.topic == topic}
+        for topic in (f"{node_name}/reachability", f"{node_name}/commanded_pose")
+    }
+    for topic, ids in logged.items():
+        missing = sorted(set(acknowledged) - ids)
+        assert not missing, f"{len(missing)} acknowledged messages missing from {topic}"
+    print(
+        f"kill {kill} after {kill_after:.2f} s: {index} commands sent, {len(received)} results, "
+        f"{len(acknowledged)} older than {FLUSH_BOUND} s, all logged; "
+        f"{len(logged[f'{node_name}/reachability'])} results in the log"
+    )
 
 
 @pytest.mark.parametrize("enabled", [True, False])

@@ -14,10 +14,12 @@ import pytest
 import yaml
 from ros_support import INSTALL, NODE_EXECUTABLE, require_ros, running_node
 
+from hexapod_workspace.logs import messages
+
 require_ros()
 
 SHARE = INSTALL / "hexapod_workspace" / "share" / "hexapod_workspace"
-NODE = "/hexapod_workspace"
+NODE = "/hexapod_workspace"  # the RViz layout and the launch file name it literally
 
 
 def test_executables_are_installed_where_ros2_run_looks():
@@ -33,7 +35,12 @@ def test_package_is_registered_in_the_ament_index():
     msgs = INSTALL / "hexapod_workspace_msgs" / "share" / "ament_index" / "resource_index"
     assert (msgs / "packages" / "hexapod_workspace_msgs").is_file()
     interfaces = (msgs / "rosidl_interfaces" / "hexapod_workspace_msgs").read_text()
-    for name in ("msg/TiltTorsion.msg", "srv/CheckPoses.srv", "srv/ComputeWorkspace.srv"):
+    for name in (
+        "msg/TiltTorsion.msg",
+        "srv/CheckPoses.srv",
+        "srv/ComputeWorkspace.srv",
+        "action/ComputeWorkspace.action",
+    ):
         assert name in interfaces.split()
 
 
@@ -56,7 +63,7 @@ def test_launch_file_names_installed_files():
 def node_topics(ros_client, tmp_path_factory):
     """Topic and service name -> types offered by a running node (seen from this process)."""
     with running_node(tmp_path_factory.mktemp("install_node")) as node:
-        wanted = f"{NODE}/orientation_workspace"
+        wanted = messages.TOPICS["orientation_workspace"]
 
         def offered() -> dict:
             return {
@@ -64,9 +71,19 @@ def node_topics(ros_client, tmp_path_factory):
                 **dict(ros_client.node.get_service_names_and_types()),
             }
 
-        service = f"{NODE}/compute_projected_workspace"
+        service = messages.TOPICS["compute_projected_workspace"]
+        action = messages.TOPICS["compute_workspace"] + "/_action/send_goal"
         ros_client.spin_until(
-            lambda: {wanted, service} <= set(offered()), what="the node's interfaces", timeout=60.0
+            lambda: {
+                wanted,
+                service,
+                action,
+                "/diagnostics",
+                f"{NODE}/compute_atlas/_action/send_goal",
+            }
+            <= set(offered()),
+            what="the node's interfaces",
+            timeout=60.0,
         )
         topics = offered()
         node.stop()
@@ -90,16 +107,28 @@ def test_rviz_layout_shows_the_node_clouds(node_topics):
 
 def test_node_offers_every_interface_of_the_issue(node_topics):
     expected = {
-        f"{NODE}/orientation_workspace": "sensor_msgs/msg/PointCloud2",
-        f"{NODE}/projected_workspace": "sensor_msgs/msg/PointCloud2",
-        f"{NODE}/workspace_summary": "hexapod_workspace_msgs/msg/WorkspaceSummary",
-        f"{NODE}/reachability": "hexapod_workspace_msgs/msg/ReachabilityResult",
-        f"{NODE}/workspace_request": "hexapod_workspace_msgs/msg/WorkspaceRequest",
-        f"{NODE}/commanded_pose": "hexapod_workspace_msgs/msg/CommandedPose",
-        f"{NODE}/check_poses": "hexapod_workspace_msgs/srv/CheckPoses",
-        f"{NODE}/compute_workspace": "hexapod_workspace_msgs/srv/ComputeWorkspace",
-        f"{NODE}/compute_orientation_workspace": "std_srvs/srv/Trigger",
-        f"{NODE}/compute_projected_workspace": "std_srvs/srv/Trigger",
+        "orientation_workspace": "sensor_msgs/msg/PointCloud2",
+        "projected_workspace": "sensor_msgs/msg/PointCloud2",
+        "workspace_summary": "hexapod_workspace_msgs/msg/WorkspaceSummary",
+        "reachability": "hexapod_workspace_msgs/msg/ReachabilityResult",
+        "workspace_request": "hexapod_workspace_msgs/msg/WorkspaceRequest",
+        "commanded_pose": "hexapod_workspace_msgs/msg/CommandedPose",
+        "check_poses": "hexapod_workspace_msgs/srv/CheckPoses",
+        "compute_orientation_workspace": "std_srvs/srv/Trigger",
+        "compute_projected_workspace": "std_srvs/srv/Trigger",
     }
-    for topic, type_name in expected.items():
-        assert node_topics.get(topic) == [type_name], topic
+    assert set(expected) | {"compute_workspace"} == set(messages.TOPICS)
+    for key, type_name in expected.items():
+        assert node_topics.get(messages.TOPICS[key]) == [type_name], key
+    # ~/compute_workspace is an action: its hidden services and topics
+    action = messages.TOPICS["compute_workspace"] + "/_action"
+    package = "hexapod_workspace_msgs/action/ComputeWorkspace"
+    assert node_topics.get(f"{action}/send_goal") == [f"{package}_SendGoal"]
+    assert node_topics.get(f"{action}/get_result") == [f"{package}_GetResult"]
+    assert node_topics.get(f"{action}/feedback") == [f"{package}_FeedbackMessage"]
+    assert node_topics.get("/diagnostics") == ["diagnostic_msgs/msg/DiagnosticArray"]
+    # the extensions: ~/check_path (ros/paths.py) and ~/compute_atlas (ros/atlas_action.py)
+    assert node_topics.get(f"{NODE}/check_path") == ["hexapod_workspace_msgs/srv/CheckPath"]
+    assert node_topics.get(f"{NODE}/compute_atlas/_action/send_goal") == [
+        "hexapod_workspace_msgs/action/ComputeAtlas_SendGoal"
+    ]

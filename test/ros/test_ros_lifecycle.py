@@ -35,6 +35,32 @@ def test_node_stops_cleanly_on_signal(ros_client, tmp_path, sig):
     assert list((tmp_path / "logs").glob("*.mcap")), "the run's log is missing"
 
 
+def test_node_stops_cleanly_while_goals_compute_and_queue(ros_client, tmp_path):
+    """SIGINT with one goal computing and one queued: both end, the node exits 0, the log is
+    finished."""
+    from hexapod_workspace_msgs.msg import WorkspaceRequest
+
+    from hexapod_workspace import logs
+
+    with running_node(tmp_path) as node:
+        serve_one_check(ros_client)
+        ros_client.drop_client(f"{NODE}/check_poses")
+        long = WorkspaceRequest(kind=0, n_rays=720, psi_step=0.001, tolerance=1e-9)
+        long.position.z = -1.3
+        feedback: list = []
+        ros_client.send_goal(f"{NODE}/compute_workspace", long, feedback)
+        ros_client.send_goal(f"{NODE}/compute_workspace", long)
+        ros_client.spin_until(
+            lambda: any(f.stage == "computing" for f in feedback), what="the first goal computing"
+        )
+        status = node.stop(signal.SIGINT)
+        output = node.output()
+    assert status == 0, output
+    assert "Traceback" not in output, output
+    (log,) = (tmp_path / "logs").glob("*.mcap")
+    assert logs.read_log(log).finished
+
+
 @pytest.mark.parametrize(
     ("overrides", "named"),
     [

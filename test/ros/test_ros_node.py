@@ -328,3 +328,33 @@ def test_recording_switched_off_finishes_the_log_and_on_starts_a_new_one(client,
     assert result.successful, result.reason
     log_files = sorted(workspace_node.record_dir.glob("*.mcap"))
     assert len(log_files) == 2 and first in log_files
+
+
+# ---------------------------------------------------------------------------- diagnostics
+
+
+def test_diagnostics_report_the_counts_at_1_hz(client, model):
+    from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+
+    arrays = client.collect(DiagnosticArray, "/diagnostics")
+    publisher = client.publisher(CommandedPose, f"{NODE}/commanded_pose")
+    publisher.publish(commanded("diag-ok", (0.0, 0.1, 0.0)))
+    publisher.publish(commanded("diag-bad", (0.0, math.nan, 0.0)))
+
+    def values(array) -> dict[str, str]:
+        return {kv.key: kv.value for kv in array.status[0].values}
+
+    client.spin_until(
+        lambda: any(int(values(a)["commands answered"]) >= 2 for a in arrays),
+        what="diagnostics counting both commands",
+    )
+    latest = values(arrays[-1])
+    status = arrays[-1].status[0]
+    assert status.name == NODE and status.hardware_id == model.frame_id
+    assert status.level in (DiagnosticStatus.OK, DiagnosticStatus.WARN, DiagnosticStatus.ERROR)
+    assert int(latest["commands received"]) == int(latest["commands answered"]) >= 2
+    assert int(latest["commands refused"]) >= 1
+    assert latest["worker alive"] == "True"
+    assert latest["recording"] == "on" and int(latest["recorded bytes"]) > 0
+    for key in ("commands overloaded", "recorder queue depth", "last error"):
+        assert key in latest

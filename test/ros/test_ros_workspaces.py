@@ -1,4 +1,4 @@
-"""Workspace services and topics of workspace_node over real Fast DDS.
+"""Workspace action, services and topics of workspace_node over real Fast DDS.
 
 Summaries and boundary clouds received from the node (another process) are compared with the
 ROS-free core computed here with the same parameters file.
@@ -6,10 +6,11 @@ ROS-free core computed here with the same parameters file.
 
 from __future__ import annotations
 
+import contextlib
+import itertools
 import math
 import os
 import signal
-import time
 from pathlib import Path
 
 import numpy as np
@@ -18,12 +19,14 @@ from ros_support import require_ros
 
 require_ros()
 
+from action_msgs.msg import GoalStatus  # noqa: E402
+from hexapod_workspace_msgs.action import ComputeWorkspace  # noqa: E402
 from hexapod_workspace_msgs.msg import (  # noqa: E402
     TiltTorsion,
     WorkspaceRequest,
     WorkspaceSummary,
 )
-from hexapod_workspace_msgs.srv import CheckPoses, ComputeWorkspace  # noqa: E402
+from hexapod_workspace_msgs.srv import CheckPoses  # noqa: E402
 from sensor_msgs.msg import PointCloud2, PointField  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 
@@ -76,10 +79,9 @@ def workspace_request(kind, position=HOME, request_id="", n_rays=0, psi_step=0.0
     return request
 
 
-def compute(client, request: WorkspaceRequest) -> ComputeWorkspace.Response:
-    return client.call(
-        ComputeWorkspace, f"{NODE}/compute_workspace", ComputeWorkspace.Request(request=request)
-    )
+def compute(client, request: WorkspaceRequest, feedback=None) -> ComputeWorkspace.Result:
+    """Run the ~/compute_workspace action (rclpy ActionClient) to its end."""
+    return client.compute(f"{NODE}/compute_workspace", request, feedback)
 
 
 def assert_cloud_matches(cloud: PointCloud2, workspace, frame_id: str) -> None:
@@ -260,43 +262,128 @@ def test_workspace_request_topic_publishes_results(client, model):
 # ---------------------------------------------------------------------------- responsiveness
 
 
-def test_pose_checks_are_answered_during_a_long_computation(client, model):
-    """A 3-D workspace computation (workspace callback group, worker process) does not hold up
-    check_poses (check group, multi-threaded executor): checks are answered before it ends."""
-    request = ComputeWorkspace.Request(
-        request=workspace_request(
-            WorkspaceKind.ORIENTATION, n_rays=180, psi_step=0.01, tolerance=1e-6
-        )
+#: A 3-D request that takes far longer than the checks below (it is canceled once they are done).
+LONG = {"n_rays": 720, "psi_step": 0.001, "tolerance": 1e-9}
+
+
+def wait_for_stage(client, feedback: list, stage: str) -> None:
+    client.spin_until(
+        lambda: any(f.stage == stage for f in feedback), what=f"feedback stage {stage!r}"
     )
-    long_call = client.client(ComputeWorkspace, f"{NODE}/compute_workspace").call_async(request)
-    # let the request reach the node (not an assertion: a slow delivery only weakens the test)
-    deadline = time.monotonic() + 0.5
-    while time.monotonic() < deadline:
-        client.executor.spin_once(timeout_sec=0.05)
+
+
+def test_pose_checks_are_answered_during_a_long_computation(client, model):
+    """A 3-D workspace computation (job thread, worker process) does not hold up check_poses:
+    every check is answered while the goal is still computing (no result yet)."""
+    feedback: list = []
+    handle = client.send_goal(
+        f"{NODE}/compute_workspace",
+        workspace_request(WorkspaceKind.ORIENTATION, request_id="long", **LONG),
+        feedback,
+    )
+    result_future = handle.get_result_async()
+    wait_for_stage(client, feedback, "computing")
     check_client = client.client(CheckPoses, f"{NODE}/check_poses")
     pose = CheckPoses.Request(orientations=[TiltTorsion(phi=0.1, theta=0.2, psi=0.0)])
     pose.position.z = -1.3
-    answered_during = 0
     for _ in range(20):
         future = check_client.call_async(pose)
         client.executor.spin_until_future_complete(future, timeout_sec=60.0)
         assert future.done() and future.result().success
-        if not long_call.done():
-            answered_during += 1
-    if answered_during == 0:
-        pytest.skip("the computation ended before the first check: nothing overlapped")
-    assert answered_during > 0
-    client.executor.spin_until_future_complete(long_call, timeout_sec=600.0)
-    assert long_call.done()
-    assert long_call.result().success, long_call.result().message
+    assert not result_future.done(), "the computation ended before the checks: make LONG longer"
+    handle.cancel_goal_async()
+    client.spin_until(result_future.done, what="the canceled goal's result")
+    assert result_future.result().status == GoalStatus.STATUS_CANCELED
+
+
+def test_action_progress_is_monotonic_and_ends_at_one(client, model):
+    feedback: list = []
+    request = workspace_request(WorkspaceKind.ORIENTATION, request_id="progress", psi_step=0.02)
+    status, result = client.goal_result(
+        client.send_goal(f"{NODE}/compute_workspace", request, feedback)
+    )
+    assert status == GoalStatus.STATUS_SUCCEEDED and result.success, result.message
+    progress = [f.progress for f in feedback]
+    assert len(progress) >= 3
+    assert all(0.0 <= p <= 1.0 for p in progress)
+    assert all(b >= a for a, b in itertools.pairwise(progress))
+    assert {"queued", "computing"} <= {f.stage for f in feedback}
+    expected = core_workspace(model, WorkspaceKind.ORIENTATION, psi_step=0.02)
+    assert_summary_matches(result.summary, expected, WorkspaceKind.ORIENTATION)
+
+
+def test_cancel_stops_the_computation_and_the_node_keeps_serving(client, workspace_node):
+    feedback: list = []
+    handle = client.send_goal(
+        f"{NODE}/compute_workspace",
+        workspace_request(WorkspaceKind.ORIENTATION, request_id="cancel-me", **LONG),
+        feedback,
+    )
+    wait_for_stage(client, feedback, "computing")
+    (worker,) = worker_pids(workspace_node.process.pid)
+    cancel = handle.cancel_goal_async()
+    client.spin_until(cancel.done, what="the cancel response")
+    assert len(cancel.result().goals_canceling) == 1
+    status, result = client.goal_result(handle)
+    assert status == GoalStatus.STATUS_CANCELED
+    assert not result.success and result.message == "canceled"
+    # the worker stopped computing: it waits for the next job (or was replaced)
+    if worker in worker_pids(workspace_node.process.pid):
+        assert process_state(worker) == "S", "the worker still computes after the cancel"
+    response = compute(client, workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO))
+    assert response.success, response.message
+
+
+def test_goals_queue_in_order_and_a_queued_goal_can_be_canceled(client):
+    first_feedback: list = []
+    first = client.send_goal(
+        f"{NODE}/compute_workspace",
+        workspace_request(WorkspaceKind.ORIENTATION, request_id="first", **LONG),
+        first_feedback,
+    )
+    wait_for_stage(client, first_feedback, "computing")
+    queued_feedback: list = []
+    queued = client.send_goal(
+        f"{NODE}/compute_workspace",
+        workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO, request_id="queued"),
+        queued_feedback,
+    )
+    third = client.send_goal(
+        f"{NODE}/compute_workspace",
+        workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO, request_id="third"),
+    )
+    wait_for_stage(client, queued_feedback, "queued")
+    cancel = queued.cancel_goal_async()
+    client.spin_until(cancel.done, what="the cancel response")
+    status, result = client.goal_result(queued)
+    assert status == GoalStatus.STATUS_CANCELED and result.message == "canceled"
+    assert not any(f.stage == "computing" for f in queued_feedback), "a canceled goal ran"
+    first.cancel_goal_async()
+    assert client.goal_result(first)[0] == GoalStatus.STATUS_CANCELED
+    status, result = client.goal_result(third)
+    assert status == GoalStatus.STATUS_SUCCEEDED and result.summary.request_id == "third"
+
+
+def test_invalid_goal_is_aborted_with_the_reason(client):
+    request = workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO, (math.nan, 0, 0))
+    status, result = client.goal_result(client.send_goal(f"{NODE}/compute_workspace", request))
+    assert status == GoalStatus.STATUS_ABORTED
+    assert not result.success and "position" in result.message and "finite" in result.message
+
+
+def process_state(pid: int) -> str:
+    """The scheduler state letter of a process (R running, S sleeping, ...), from /proc."""
+    return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
 
 
 def worker_pids(node_pid: int) -> list[int]:
-    """Child processes of the node (its workspace worker), from /proc."""
+    """The node's workspace worker processes (multiprocessing spawn children), from /proc."""
     children: list[int] = []
     for task in Path(f"/proc/{node_pid}/task").iterdir():
-        text = (task / "children").read_text().split()
-        children += [int(pid) for pid in text]
+        for pid in map(int, (task / "children").read_text().split()):
+            with contextlib.suppress(OSError):
+                if b"spawn_main" in Path(f"/proc/{pid}/cmdline").read_bytes():
+                    children.append(pid)
     return children
 
 
@@ -314,3 +401,35 @@ def test_a_killed_worker_process_is_replaced(client, workspace_node):
     assert response.success, response.message
     assert response.summary.request_id == "w"
     assert set(worker_pids(workspace_node.process.pid)).isdisjoint(pids)
+
+
+def test_an_atlas_goal_runs_in_the_node_while_checks_are_answered(client):
+    """~/compute_atlas is attached to the workspace node (an extension); its blocking run is in a
+    thread of its own (ros.jobs.in_thread), so the single-threaded executor keeps answering."""
+    from hexapod_workspace_msgs.action import ComputeAtlas
+    from rclpy.action import ActionClient
+
+    atlas = ActionClient(client.node, ComputeAtlas, f"{NODE}/compute_atlas")
+    try:
+        assert atlas.wait_for_server(timeout_sec=60)
+        goal = ComputeAtlas.Goal(box=[-0.1, 0.1, -0.1, 0.1, -1.35, -1.2], step=0.05, n_phi=24)
+        goal.tolerance = 1e-3
+        feedback: list = []
+        sent = atlas.send_goal_async(goal, feedback_callback=lambda m: feedback.append(m))
+        client.spin_until(sent.done, what="the atlas goal response")
+        result = sent.result().get_result_async()
+        client.spin_until(lambda: bool(feedback), what="atlas feedback")
+        pose = CheckPoses.Request(orientations=[TiltTorsion(phi=0.1, theta=0.2, psi=0.0)])
+        pose.position.z = -1.3
+        answered_during = 0
+        for _ in range(10):
+            response = client.call(CheckPoses, f"{NODE}/check_poses", pose)
+            assert response.success
+            answered_during += not result.done()
+        client.spin_until(result.done, what="the atlas result", timeout=600)
+        assert result.result().status == GoalStatus.STATUS_SUCCEEDED, result.result().result
+        assert result.result().result.positions == 5 * 5 * 4
+        print(f"{answered_during} of 10 checks answered while the atlas ran")
+        assert answered_during > 0, "no check was answered while the atlas ran (blocked?)"
+    finally:
+        atlas.destroy()

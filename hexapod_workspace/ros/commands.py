@@ -1,0 +1,134 @@
+"""The CommandedPose stream: every command gets exactly one ReachabilityResult.
+
+The subscription is reliable KEEP_ALL (:data:`~hexapod_workspace.ros.node.COMMAND_QOS`): DDS
+never drops a command on the node's side. When the executor hands over one command, the callback
+also takes the commands that arrived since (up to :data:`BATCH`) from the same subscription, as
+the executor would, one after the other, and answers them together: one pass of the executor per
+batch instead of per command, and one vectorised ``check`` per distinct position. The results
+are published in the order the commands arrived.
+
+A command whose header stamp is older than ``check.max_command_age`` when its turn comes is
+answered ``success`` false, "overloaded: ..." (counted), not checked: a verdict that late is of
+no use to a controller, and skipping the check lets the node catch up. Commands with a zero
+stamp are always checked.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from typing import Any
+
+import numpy as np
+from hexapod_workspace_msgs.msg import CommandedPose, ReachabilityResult
+from rclpy.exceptions import InvalidHandle
+
+from hexapod_workspace.core.constraints import check
+from hexapod_workspace.errors import InputError
+from hexapod_workspace.logs import messages
+
+from .conversions import to_message
+from .paths import commanded_target
+
+__all__ = ["BATCH", "CommandStream"]
+
+#: Most commands answered in one callback.
+BATCH = 256
+
+
+class CommandStream:
+    """Answers the commands of ``subscription`` on ``publisher`` for ``node``."""
+
+    def __init__(self, node: Any, subscription: Any, publisher: Any) -> None:
+        self._node = node
+        self._subscription = subscription
+        self._publisher = publisher
+
+    def on_command(self, command: CommandedPose) -> None:
+        """Subscription callback: answer ``command`` and those queued behind it."""
+        batch = [command]
+        handle = self._subscription.handle
+        with contextlib.suppress(InvalidHandle), handle:
+            while len(batch) < BATCH:
+                taken = handle.take_message(CommandedPose, False)
+                if taken is None:
+                    break
+                batch.append(taken[0])
+        self.answer(batch)
+
+    def answer(self, batch: list[CommandedPose]) -> None:
+        node, stats = self._node, self._node.stats
+        stats.commands_received += len(batch)
+        topic = self._subscription.topic_name
+        for command in batch:
+            node.recorder.write(topic, command)
+        state = node.state
+        now_ns = node.get_clock().now().nanoseconds
+        limit_ns = state.settings.max_command_age * 1e9
+        positions = np.full((len(batch), 3), np.nan)
+        angles = np.full((len(batch), 3), np.nan)
+        verdicts: dict[int, tuple[Any, int, str | None]] = {}
+        for k, command in enumerate(batch):
+            try:  # T&T, or a geometry_msgs/Pose converted (hexapod_workspace.ros.paths)
+                position, target = commanded_target(command)
+            except InputError as error:
+                stats.commands_refused += 1
+                verdicts[k] = (None, 0, str(error))
+                continue
+            positions[k], angles[k] = position, target[0]
+        sent_ns = np.array(
+            [c.header.stamp.sec * 1_000_000_000 + c.header.stamp.nanosec for c in batch]
+        )
+        late = (sent_ns > 0) & (limit_ns > 0) & (now_ns - sent_ns > limit_ns)
+        late[list(verdicts)] = False  # refused already
+        limit = state.settings.max_command_age
+        for k in np.flatnonzero(late):
+            age = (now_ns - sent_ns[k]) * 1e-9
+            reason = f"overloaded: command {age:.3f} s old when its turn came (limit {limit:g} s)"
+            verdicts[int(k)] = (None, 0, reason)
+        stats.commands_overloaded += int(late.sum())
+        todo = np.array([k for k in np.flatnonzero(~late) if k not in verdicts], dtype=int)
+        if todo.size:
+            keys, groups = np.unique(positions[todo], axis=0, return_inverse=True)
+            for g in range(keys.shape[0]):
+                members = todo[groups.reshape(-1) == g]
+                self._check_group(state, keys[g], angles, members, verdicts)
+        for k, command in enumerate(batch):
+            result, index, reason = verdicts[k]
+            fields = messages.reachability_result_fields(
+                result,
+                index=index,
+                message=reason,
+                position=positions[k],
+                angles=angles[k],
+                stamp_ns=now_ns,
+                frame_id=state.manipulator.frame_id,
+                request_id=command.request_id,
+            )
+            if result is not None and node.paths is not None:  # the move from the current pose
+                fields = node.paths.with_motion(
+                    fields, state.manipulator, positions[k], angles[k][None, :]
+                )
+            node.publish(self._publisher, to_message(ReachabilityResult, fields))
+        stats.commands_answered += len(batch)
+
+    def _check_group(
+        self, state: Any, position: Any, angles: Any, members: Any, verdicts: dict
+    ) -> None:
+        """One check for the commands ``members`` at ``position``; one by one if it fails."""
+        try:
+            result = check(state.manipulator, angles[members], position)
+        except InputError as error:
+            if members.size > 1:  # find the invalid one(s)
+                for k in members:
+                    self._check_group(state, position, angles, np.array([k]), verdicts)
+                return
+            self._node.stats.commands_refused += 1
+            verdicts[int(members[0])] = (None, 0, str(error))
+            return
+        except Exception as error:  # a bug: every command still gets its answer
+            for k in members:
+                self._node.stats.commands_refused += 1
+                verdicts[int(k)] = (None, 0, self._node.internal_error(error))
+            return
+        for index, k in enumerate(members):
+            verdicts[int(k)] = (result, index, None)

@@ -1,0 +1,357 @@
+"""The node's parameters: the table, their descriptors, validation and the state they build.
+
+One table (:func:`parameter_specs`) declares every parameter: name, default, description and the
+range or read-only flag shown by ``ros2 param describe``. The manipulator model's names and
+defaults are those of :meth:`hexapod_workspace.Manipulator.to_parameters` for the packaged
+example GPM; the resolution bounds and defaults come from :mod:`hexapod_workspace.core.resolution`.
+
+:func:`refusal` checks one parameter as a client sent it (unknown name, wrong type, read-only,
+out of range) and :func:`state_from` the would-be full set (it builds the
+:class:`~hexapod_workspace.Manipulator`): every refusal names the parameter and the value given.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+from rclpy.parameter import Parameter
+
+from hexapod_workspace._resources import example_config_path
+from hexapod_workspace.core import resolution
+from hexapod_workspace.core.manipulator import Manipulator
+from hexapod_workspace.errors import ConfigError
+
+__all__ = [
+    "MODEL_DESCRIPTIONS",
+    "Settings",
+    "Spec",
+    "State",
+    "command_line_override_names",
+    "parameter_specs",
+    "refusal",
+    "state_from",
+]
+
+#: Parameter ranges: the core's resolution bounds (one definition, core/resolution.py).
+RAYS_RANGE = (resolution.MIN_RAYS, resolution.MAX_RAYS)
+PROJECTED_METHODS = tuple(method.value for method in resolution.Method)
+
+MODEL_DESCRIPTIONS = {
+    "frame_id": "Base frame: frame_id of every published cloud and result header.",
+    "geometry.base_joints": (
+        "a_1..a_6 = OA_i: base (universal) joint centres, base frame, m; 18 floats (x y z)."
+    ),
+    "geometry.platform_joints": (
+        "b_1..b_6 = CB'_i: platform (spherical) joint centres, mobile frame (origin at the tool "
+        "tip C, z' along the tool), m; 18 floats (x' y' z')."
+    ),
+    "geometry.home_position": (
+        "Home position OC, base frame, m (3 floats); default joint axes = leg directions there."
+    ),
+    "geometry.base_joint_axes": (
+        "Axes of symmetry of the base joints, base frame, pointing into the legs: 18 floats, or "
+        "empty/unset = leg directions at the home pose."
+    ),
+    "geometry.platform_joint_axes": (
+        "Axes of symmetry of the platform joints, mobile frame, pointing into the legs: 18 "
+        "floats, or empty/unset = reversed leg directions at the home pose."
+    ),
+    "limits.leg_length_min": "Minimum leg length |A_iB_i|, m: 1 value (all legs) or 6.",
+    "limits.leg_length_max": "Maximum leg length |A_iB_i|, m: 1 value (all legs) or 6.",
+    "limits.base_joint_max_angle": (
+        "Maximum angle between a base joint axis and its leg, rad, in (0, pi): 1 or 6 values."
+    ),
+    "limits.platform_joint_max_angle": (
+        "Maximum angle between a platform joint axis and its leg, rad, in (0, pi): 1 or 6 values."
+    ),
+    "limits.leg_diameter": (
+        "Leg diameter D, m: legs (segments A_iB_i) must stay D apart; 0 disables the check."
+    ),
+    "pose.position": (
+        "Default tool-tip position OC, base frame, m (3 floats): used by the Trigger services."
+    ),
+}
+#: Axes that may be empty: an empty YAML list arrives as an unset parameter of any type.
+_OPTIONAL_AXES = ("geometry.base_joint_axes", "geometry.platform_joint_axes")
+
+
+@dataclass(frozen=True)
+class Spec:
+    """Declaration of one parameter."""
+
+    name: str
+    default: Any
+    description: str
+    read_only: bool = False
+    dynamic_typing: bool = False
+    float_range: tuple[float, float] | None = None
+    int_range: tuple[int, int] | None = None
+    constraints: str = ""
+
+    @property
+    def type_(self) -> Parameter.Type:
+        return Parameter.Type.from_parameter_value(self.default)
+
+    def descriptor(self) -> ParameterDescriptor:
+        descriptor = ParameterDescriptor(
+            name=self.name,
+            description=self.description,
+            read_only=self.read_only,
+            dynamic_typing=self.dynamic_typing,
+            additional_constraints=self.constraints,
+        )
+        if not self.dynamic_typing:
+            descriptor.type = self.type_.value
+        if self.float_range is not None:
+            low, high = self.float_range
+            descriptor.floating_point_range = [
+                FloatingPointRange(from_value=low, to_value=high, step=0.0)
+            ]
+        if self.int_range is not None:
+            low, high = self.int_range
+            descriptor.integer_range = [IntegerRange(from_value=low, to_value=high, step=1)]
+        return descriptor
+
+
+def parameter_specs() -> dict[str, Spec]:
+    """Every parameter of the node by name, model defaults from the packaged example."""
+    example = Manipulator.from_params_file(example_config_path(), warn=False).to_parameters()
+    specs = [
+        Spec(
+            name,
+            [] if name in _OPTIONAL_AXES else default,
+            MODEL_DESCRIPTIONS[name],
+            read_only=name == "frame_id",
+            dynamic_typing=name in _OPTIONAL_AXES,  # the model validation refuses non-numbers
+            float_range=(0.0, 10.0) if name == "limits.leg_diameter" else None,
+        )
+        for name, default in example.items()
+    ]
+    specs += [
+        Spec(
+            "resolution.n_phi",
+            resolution.DEFAULT_N_PHI,
+            "Projected workspace: number of equally spaced azimuths phi (rays).",
+            int_range=RAYS_RANGE,
+        ),
+        Spec(
+            "resolution.n_rays",
+            resolution.DEFAULT_N_RAYS,
+            "Orientation workspace: rays per psi slice.",
+            int_range=RAYS_RANGE,
+        ),
+        Spec(
+            "resolution.psi_step",
+            resolution.DEFAULT_PSI_STEP,
+            "Orientation workspace: torsion step between slices, rad.",
+            float_range=(resolution.MIN_PSI_STEP, resolution.MAX_PSI_STEP),
+        ),
+        Spec(
+            "resolution.tolerance",
+            resolution.DEFAULT_TOLERANCE,
+            "Boundary tolerance of every workspace computation, rad.",
+            float_range=(resolution.MIN_TOLERANCE, resolution.MAX_TOLERANCE),
+        ),
+        Spec(
+            "resolution.projected_method",
+            resolution.Method.TORSION_ZERO.value,
+            "Method of ~/compute_projected_workspace: torsion_zero (psi = 0, the paper's) or "
+            "exact (true shadow over all psi).",
+            constraints=f"one of: {', '.join(PROJECTED_METHODS)}",
+        ),
+        Spec(
+            "check.max_poses",
+            100_000,
+            "Largest number of orientations accepted in one check_poses request.",
+            read_only=True,
+            int_range=(1, 10_000_000),
+        ),
+        Spec(
+            "check.max_command_age",
+            0.5,
+            "A CommandedPose whose header stamp is older than this when its turn comes (s, node "
+            "clock) is answered success=false 'overloaded' instead of checked; 0 = never. "
+            "Commands with a zero stamp are always checked.",
+            float_range=(0.0, 3600.0),
+        ),
+        Spec(
+            "recording.enabled",
+            True,
+            "Record every request and result to an MCAP log (rosbag2 form); false stops.",
+        ),
+        Spec(
+            "recording.directory",
+            "",
+            "Folder of the MCAP logs (one per run, named by start time); empty = "
+            "$ROS_HOME/hexapod_workspace/logs (ROS_HOME defaults to ~/.ros).",
+            read_only=True,
+        ),
+    ]
+    return {spec.name: spec for spec in specs}
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Node settings that are not part of the manipulator model."""
+
+    n_phi: int
+    n_rays: int
+    psi_step: float
+    tolerance: float
+    projected_method: str
+    max_poses: int
+    max_command_age: float
+    recording_enabled: bool
+    recording_directory: Path
+
+
+@dataclass(frozen=True)
+class State:
+    """What the callbacks read: swapped as a whole when parameters change."""
+
+    manipulator: Manipulator
+    settings: Settings
+
+
+def _plain(value: Any) -> Any:
+    """A parameter value as the model wants it (unset/empty arrays as empty lists)."""
+    if value is None:
+        return []
+    if isinstance(value, (str, bool, int, float)):
+        return value
+    return list(value)
+
+
+def _shown(value: Any) -> str:
+    """A parameter value for a refusal text (long arrays shortened)."""
+    value = _plain(value)
+    if isinstance(value, list) and len(value) > 8:
+        return f"[{', '.join(map(repr, value[:6]))}, ... ({len(value)} values)]"
+    return repr(value)
+
+
+def _type_label(type_: Parameter.Type) -> str:
+    return type_.name.lower().replace("_array", "[]")
+
+
+def _article(type_: Parameter.Type) -> str:
+    label = _type_label(type_)
+    return f"{'an' if label[0] in 'aeiou' else 'a'} {label}"
+
+
+def refusal(specs: dict[str, Spec], parameter: Parameter) -> str | None:
+    """Why a client's new value of one parameter is refused, or None when it may be applied.
+
+    Checks what rclpy would refuse with a text that names neither the parameter nor the value:
+    an unknown name, a wrong type, a read-only parameter, a value out of the declared range,
+    unsetting. The full-set checks (the model) are :func:`state_from`'s.
+    """
+    name, value = parameter.name, parameter.value
+    spec = specs.get(name)
+    if spec is None:
+        return f"{name}: no such parameter of this node (value {_shown(value)} refused)"
+    if spec.read_only:
+        return f"{name}: read-only, set at start only (value {_shown(value)} refused)"
+    if parameter.type_ == Parameter.Type.NOT_SET:
+        if spec.dynamic_typing:
+            return None
+        return f"{name}: parameters of this node cannot be unset (deleted)"
+    if not spec.dynamic_typing and parameter.type_ != spec.type_:
+        return (
+            f"{name}: expected {_article(spec.type_)}, got {_shown(value)} "
+            f"({_type_label(parameter.type_)})"
+        )
+    for bounds in (spec.float_range, spec.int_range):
+        if bounds is not None and not (bounds[0] <= value <= bounds[1]):
+            return f"{name}: expected {bounds[0]:g} to {bounds[1]:g}, got {_shown(value)}"
+    return None
+
+
+def state_from(values: dict[str, Any]) -> State:
+    """Build (and so validate) the node state from a full set of parameter values.
+
+    Raises
+    ------
+    ConfigError
+        Invalid model or settings; the message names the parameter and the value.
+    """
+    manipulator = Manipulator.from_mapping(
+        {name: _plain(values[name]) for name in MODEL_DESCRIPTIONS}, warn=False
+    )
+    method = str(values["resolution.projected_method"])
+    if method not in PROJECTED_METHODS:
+        msg = (
+            f"resolution.projected_method: expected one of {', '.join(PROJECTED_METHODS)}, "
+            f"got {method!r}"
+        )
+        raise ConfigError(msg)
+    age = float(values["check.max_command_age"])
+    if not (math.isfinite(age) and age >= 0.0):
+        msg = f"check.max_command_age: expected a finite value >= 0 s, got {age!r}"
+        raise ConfigError(msg)
+    directory = str(values["recording.directory"]).strip()
+    if directory:
+        folder = Path(directory).expanduser()
+    else:
+        ros_home = os.environ.get("ROS_HOME") or str(Path("~/.ros").expanduser())
+        folder = Path(ros_home) / "hexapod_workspace" / "logs"
+    settings = Settings(
+        n_phi=int(values["resolution.n_phi"]),
+        n_rays=int(values["resolution.n_rays"]),
+        psi_step=float(values["resolution.psi_step"]),
+        tolerance=float(values["resolution.tolerance"]),
+        projected_method=method,
+        max_poses=int(values["check.max_poses"]),
+        max_command_age=age,
+        recording_enabled=bool(values["recording.enabled"]),
+        recording_directory=folder,
+    )
+    return State(manipulator, settings)
+
+
+def _flatten(tree: dict[str, Any], prefix: str = "") -> list[str]:
+    names: list[str] = []
+    for key, value in tree.items():
+        if isinstance(value, dict):
+            names += _flatten(value, f"{prefix}{key}.")
+        else:
+            names.append(f"{prefix}{key}")
+    return names
+
+
+def command_line_override_names(argv: list[str], node_name: str) -> list[str]:
+    """Names of the parameters the command line gives the node (``-p``, ``--params-file``).
+
+    Parameters
+    ----------
+    argv : list of str
+        The process arguments (``--ros-args`` sections are read).
+    node_name : str
+        The node's name: a parameters file's ``<name>``, ``/<name>`` and ``/**`` entries count.
+    """
+    names: list[str] = []
+    in_ros_args = False
+    tokens = iter(argv)
+    for token in tokens:
+        if token == "--ros-args":
+            in_ros_args = True
+        elif token == "--":
+            in_ros_args = False
+        elif in_ros_args and token in ("-p", "--param"):
+            names.append(next(tokens, "").split(":=", 1)[0])
+        elif in_ros_args and token == "--params-file":
+            path = next(tokens, "")
+            try:
+                document = yaml.safe_load(Path(path).read_text(encoding="utf-8")) or {}
+            except (OSError, yaml.YAMLError):
+                continue  # rcl reports an unreadable file itself
+            for key in ("/**", node_name, f"/{node_name}"):
+                section = document.get(key) or {}
+                names += _flatten(section.get("ros__parameters") or {})
+    return names

@@ -1,0 +1,283 @@
+"""Workspace requests of the node: the ``~/compute_workspace`` action, the Trigger services and
+the request topic, all through one first-in first-out :class:`~hexapod_workspace.ros.jobs.
+JobQueue`.
+
+A request is checked here (a refusal names the field and the value) and becomes a
+:class:`~hexapod_workspace.ros.worker.WorkspaceJob` with the node's resolution parameters filled
+in. The job queue's thread runs it in the worker process, publishes (and records) the summary and
+the cloud, and completes the request: the action's execute coroutine and the Trigger services
+await it without holding the executor. Goals are always accepted and queue with the other
+requests; an invalid goal is aborted with the reason in ``result.message``; a canceled goal,
+queued or running, ends CANCELED with the message "canceled". The action is recorded in the form
+of ComputeWorkspace.srv (same fields as the Goal and the Result; rosbag2 in Jazzy records no
+actions) on ``<action>/request`` and ``<action>/response``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from hexapod_workspace_msgs.action import ComputeWorkspace
+from hexapod_workspace_msgs.msg import WorkspaceRequest, WorkspaceSummary
+from hexapod_workspace_msgs.srv import ComputeWorkspace as ComputeWorkspaceRecord
+from rclpy.action import ActionServer, CancelResponse, GoalResponse
+from sensor_msgs.msg import PointCloud2
+from std_srvs.srv import Trigger
+
+from hexapod_workspace.core.resolution import WorkspaceKind
+from hexapod_workspace.errors import InputError, UnreachableReferenceError
+from hexapod_workspace.logs import messages
+
+from .conversions import position_from_point, to_message
+from .jobs import JobQueue, Ticket, completion
+from .parameters import RAYS_RANGE
+from .worker import CanceledError, WorkspaceJob
+
+__all__ = ["WorkspaceServer"]
+
+
+@dataclass(frozen=True)
+class _Failed:
+    """A workspace request refused before it reaches the worker."""
+
+    reason: str
+    n_rays: int = 0
+
+
+class WorkspaceServer:
+    """The node's workspace interfaces; ``name(key)`` gives the node-relative names."""
+
+    def __init__(self, node: Any, name: Callable[[str], str]) -> None:
+        self._node = node
+        self.jobs = JobQueue(node.worker, self._finish_job, self._fail_job)
+        cloud = {
+            kind: node.recorded_publisher(PointCloud2, name(topic))
+            for kind, topic in (
+                (WorkspaceKind.ORIENTATION, "orientation_workspace"),
+                (WorkspaceKind.PROJECTED_TORSION_ZERO, "projected_workspace"),
+            )
+        }
+        cloud[WorkspaceKind.PROJECTED_EXACT] = cloud[WorkspaceKind.PROJECTED_TORSION_ZERO]
+        self._cloud_publishers = cloud
+        self._summary_publisher = node.recorded_publisher(
+            WorkspaceSummary, name("workspace_summary")
+        )
+        node.recorded_service(
+            Trigger, name("compute_orientation_workspace"), self._on_compute_orientation
+        )
+        node.recorded_service(
+            Trigger, name("compute_projected_workspace"), self._on_compute_projected
+        )
+        self._requests = node.recorded_subscription(
+            WorkspaceRequest, name("workspace_request"), self._on_workspace_request
+        )
+        self._action_topics = node.record_service_channels(
+            ComputeWorkspaceRecord, name("compute_workspace")
+        )
+        self._goal_tickets: dict[bytes, Ticket] = {}
+        self._action = ActionServer(
+            node,
+            ComputeWorkspace,
+            name("compute_workspace"),
+            execute_callback=self._execute_goal,
+            goal_callback=lambda goal: GoalResponse.ACCEPT,
+            cancel_callback=self._cancel_goal,
+            callback_group=node.job_group,
+        )
+
+    def stop(self) -> None:
+        """Cancel the queued and running jobs and end the queue's thread."""
+        self.jobs.stop()
+
+    def job(self, request: WorkspaceRequest) -> WorkspaceJob | _Failed:
+        """The job of a request with the node's parameters filled in, or why it is refused."""
+        settings = self._node.state.settings
+        kind, position = int(request.kind), position_from_point(request.position)
+        if WorkspaceKind.of(kind) is None:
+            return _Failed(
+                f"kind: expected 0 (orientation), 1 (torsion_zero) or 2 (exact), got {kind}"
+            )
+        if not np.all(np.isfinite(position)):
+            return _Failed(f"position: expected finite values, got {position.tolist()}")
+        for name in ("psi_step", "tolerance"):
+            value = float(getattr(request, name))
+            if not np.isfinite(value) or value < 0.0:
+                return _Failed(
+                    f"{name}: expected a finite value >= 0 (0 = node parameter), got {value}"
+                )
+        default_rays = settings.n_rays if kind == WorkspaceKind.ORIENTATION else settings.n_phi
+        rays = int(request.n_rays) or default_rays
+        if not RAYS_RANGE[0] <= rays <= RAYS_RANGE[1]:
+            return _Failed(f"n_rays: expected {RAYS_RANGE[0]}..{RAYS_RANGE[1]}, got {rays}", rays)
+        return WorkspaceJob(
+            manipulator=self._node.state.manipulator,
+            kind=kind,
+            position=position,
+            n_rays=rays,
+            psi_step=float(request.psi_step) or settings.psi_step,
+            tolerance=float(request.tolerance) or settings.tolerance,
+            stamp_ns=self._node._now_ns(),
+            frame_id=self._node.state.manipulator.frame_id,
+            request_id=request.request_id,
+        )
+
+    def _submit(self, request: WorkspaceRequest, **callbacks: Any) -> Ticket | None:
+        """Queue the job of ``request``; a refused request publishes its failure (None)."""
+        job = self.job(request)
+        if isinstance(job, _Failed):
+            self._publish_failure(job.reason, request, n_rays=job.n_rays)
+            return None
+        return self.jobs.submit(Ticket(job, **callbacks))
+
+    def _finish_job(self, job: WorkspaceJob, fields: Any) -> tuple[Any, Any]:
+        """Job thread: the worker's fields -> published (and recorded) summary and cloud."""
+        summary_fields, cloud_fields = fields
+        cloud = to_message(PointCloud2, cloud_fields)
+        summary = to_message(WorkspaceSummary, summary_fields)
+        self._node.publish(self._cloud_publishers[job.kind], cloud)
+        self._node.publish(self._summary_publisher, summary)
+        self._node.get_logger().info(summary.message)
+        return summary, cloud
+
+    def _fail_job(self, job: WorkspaceJob, error: BaseException) -> tuple[Any, Any]:
+        """Job thread: a failed or canceled job -> published failure summary (and cloud)."""
+        if isinstance(error, CanceledError):
+            reason = "canceled"
+        elif isinstance(error, (InputError, UnreachableReferenceError)):
+            reason = str(error)
+        else:
+            reason = self._node.internal_error(error)
+        return self._publish_failure(
+            reason,
+            job,
+            n_rays=job.n_rays,
+            tolerance=job.tolerance,
+            empty_cloud=isinstance(error, UnreachableReferenceError),
+        )
+
+    def _publish_failure(
+        self,
+        reason: str,
+        origin: WorkspaceRequest | WorkspaceJob,
+        *,
+        n_rays: int = 0,
+        tolerance: float = float("nan"),
+        empty_cloud: bool = False,
+    ) -> tuple[Any, Any]:
+        """Publish (and return) the summary of a failed computation and an empty cloud.
+
+        ``empty_cloud``: the workspace is empty (unreachable reference): the cloud is published
+        too, so that viewers do not keep showing a stale boundary.
+        """
+        if isinstance(origin, WorkspaceJob):
+            position, stamp_ns, kind = origin.position, origin.stamp_ns, origin.kind
+        else:
+            position, stamp_ns = position_from_point(origin.position), self._node._now_ns()
+            kind = WorkspaceKind.of(origin.kind) or WorkspaceKind.ORIENTATION
+        frame_id = self._node.state.manipulator.frame_id
+        fields = messages.summary_fields(
+            None,
+            message=reason,
+            reference_reachable=not empty_cloud,
+            n_rays=n_rays,
+            tolerance=tolerance,
+            stamp_ns=stamp_ns,
+            frame_id=frame_id,
+            request_id=origin.request_id,
+            kind=kind,
+            position=np.nan_to_num(position),
+        )
+        summary = to_message(WorkspaceSummary, fields)
+        empty = messages.pointcloud_fields(np.zeros((0, 6)), frame_id=frame_id, stamp_ns=stamp_ns)
+        cloud = to_message(PointCloud2, empty)
+        if empty_cloud:
+            self._node.publish(self._cloud_publishers[kind], cloud)
+        self._node.publish(self._summary_publisher, summary)
+        self._node.get_logger().warning(f"workspace request failed: {reason}")
+        return summary, cloud
+
+    def _on_workspace_request(self, request: WorkspaceRequest) -> None:
+        self._node.recorder.write(self._requests.topic_name, request)
+        self._submit(request)
+
+    async def _trigger(self, kind: WorkspaceKind) -> Trigger.Response:
+        request = WorkspaceRequest(kind=int(kind))
+        position = self._node.state.manipulator.position
+        request.position.x, request.position.y, request.position.z = map(float, position)
+        summary, _ = await self._workspace(request)
+        return Trigger.Response(success=summary.success, message=summary.message)
+
+    async def _on_compute_orientation(self, request: Any, response: Any) -> Trigger.Response:
+        return await self._trigger(WorkspaceKind.ORIENTATION)
+
+    async def _on_compute_projected(self, request: Any, response: Any) -> Trigger.Response:
+        return await self._trigger(
+            WorkspaceKind.projected(self._node.state.settings.projected_method)
+        )
+
+    async def _workspace(
+        self,
+        request: WorkspaceRequest,
+        register: Callable[[Ticket], object] | None = None,
+        **callbacks: Any,
+    ) -> tuple[Any, Any]:
+        """Queue ``request``, await its (summary, cloud) without holding the executor; a
+        refused request answers at once. ``register(ticket)`` runs before the first wait."""
+        job = self.job(request)
+        if isinstance(job, _Failed):
+            return self._publish_failure(job.reason, request, n_rays=job.n_rays)
+        future, complete = completion(self._node)
+        ticket = self.jobs.submit(
+            Ticket(job, on_done=lambda done: complete(done.outcome), **callbacks)
+        )
+        if register is not None:
+            register(ticket)
+        return await future
+
+    # ------------------------------------------------------------------ action
+    def _cancel_goal(self, goal_handle: Any) -> CancelResponse:
+        ticket = self._goal_tickets.get(bytes(goal_handle.goal_id.uuid))
+        if ticket is not None:
+            self.jobs.cancel(ticket)
+        return CancelResponse.ACCEPT
+
+    async def _execute_goal(self, goal_handle: Any) -> ComputeWorkspace.Result:
+        request = goal_handle.request.request
+        request_topic, response_topic = self._action_topics
+        self._node.recorder.write(request_topic, ComputeWorkspaceRecord.Request(request=request))
+        key = bytes(goal_handle.goal_id.uuid)
+
+        def feedback(progress: float, stage: str) -> None:
+            goal_handle.publish_feedback(ComputeWorkspace.Feedback(progress=progress, stage=stage))
+
+        if goal_handle.is_cancel_requested:
+            summary, cloud = self._publish_failure("canceled", request)
+        else:
+            feedback(0.0, "queued")
+            summary, cloud = await self._workspace(
+                request,
+                lambda ticket: self._goal_tickets.__setitem__(key, ticket),
+                on_progress=feedback,
+            )
+        self._goal_tickets.pop(key, None)
+        fields = messages.compute_workspace_response_fields(
+            None,
+            stamp_ns=0,
+            frame_id="",
+            summary=summary,
+            boundary=cloud,
+        )
+        result = to_message(ComputeWorkspace.Result, fields)
+        self._node.recorder.write(
+            response_topic, to_message(ComputeWorkspaceRecord.Response, fields)
+        )
+        if summary.success:
+            goal_handle.succeed()
+        elif goal_handle.is_cancel_requested:
+            goal_handle.canceled()
+        else:
+            goal_handle.abort()
+        return result

@@ -1,0 +1,280 @@
+"""The node's parameter rules and request checks, in this process (rclpy, no other process).
+
+As rclpy's own tests do (test_node.py), the node is built with ``parameter_overrides`` and its
+methods are called directly: every refusal must name the parameter (or the request field) and
+the value, and a refused update must leave the node's model as it was. The same rules seen
+through the parameter services over DDS are in test_ros_node.py.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from ros_support import require_ros
+
+require_ros()
+
+from hexapod_workspace_msgs.msg import CommandedPose, TiltTorsion, WorkspaceRequest  # noqa: E402
+from hexapod_workspace_msgs.srv import CheckPoses  # noqa: E402
+from rclpy.parameter import Parameter  # noqa: E402
+
+from hexapod_workspace import Manipulator, check  # noqa: E402
+from hexapod_workspace._resources import example_config_path  # noqa: E402
+from hexapod_workspace.errors import ConfigError  # noqa: E402
+from hexapod_workspace.ros.node import WorkspaceNode  # noqa: E402
+from hexapod_workspace.ros.parameters import command_line_override_names  # noqa: E402
+
+
+def make_node(context, **overrides) -> WorkspaceNode:
+    parameters = [Parameter("recording.enabled", value=False)]
+    parameters += [Parameter(name, value=value) for name, value in overrides.items()]
+    return WorkspaceNode(context=context, parameter_overrides=parameters)
+
+
+@pytest.fixture(scope="module")
+def node(ros_context):
+    node = make_node(ros_context, **{"resolution.n_rays": 36})
+    try:
+        yield node
+    finally:
+        node.destroy_node()
+
+
+@pytest.mark.parametrize(
+    ("name", "value", "named"),
+    [
+        ("resolution.n_rays", "many", ["resolution.n_rays", "'many'", "integer"]),
+        ("limits.leg_diameter", 1, ["limits.leg_diameter", "1", "double"]),
+        ("resolution.n_rays", 2, ["resolution.n_rays", "2"]),
+        ("resolution.tolerance", 1.0, ["resolution.tolerance", "1.0"]),
+        ("limits.leg_diamter", 0.05, ["limits.leg_diamter", "0.05", "no such parameter"]),
+        ("frame_id", "tool", ["frame_id", "'tool'", "read-only"]),
+        ("check.max_poses", 5, ["check.max_poses", "5", "read-only"]),
+        ("limits.leg_length_min", [2.0], ["limits.leg_length_min", "2"]),
+        ("resolution.projected_method", "fastest", ["resolution.projected_method", "fastest"]),
+        ("geometry.base_joints", [0.0, 1.0], ["geometry.base_joints"]),
+    ],
+    ids=[
+        "str-for-int",
+        "int-for-float",
+        "range-int",
+        "range-float",
+        "unknown",
+        "read-only",
+        "read-only-int",
+        "model",
+        "method",
+        "shape",
+    ],
+)
+def test_a_refused_update_names_parameter_and_value_and_keeps_the_model(node, name, value, named):
+    before = node.state
+    (result,) = node.set_parameters([Parameter(name, value=value)])
+    assert not result.successful
+    for text in named:
+        assert text in result.reason, result.reason
+    assert node.state is before
+    # the atomic form refuses the whole set for the one bad value
+    atomic = node.set_parameters_atomically(
+        [Parameter("resolution.n_phi", value=90), Parameter(name, value=value)]
+    )
+    assert not atomic.successful and name in atomic.reason
+    assert node.get_parameter("resolution.n_phi").value == before.settings.n_phi
+
+
+def test_an_accepted_update_changes_the_state(node):
+    (result,) = node.set_parameters([Parameter("limits.leg_length_max", value=[1.4])])
+    assert result.successful, result.reason
+    assert np.allclose(node.state.manipulator.leg_length_max, 1.4)
+    (result,) = node.set_parameters([Parameter("limits.leg_length_max", value=[1.45])])
+    assert result.successful, result.reason
+
+
+def test_rclpy_parameters_stay_settable(node):
+    (result,) = node.set_parameters([Parameter("use_sim_time", value=False)])
+    assert result.successful, result.reason
+
+
+@pytest.mark.parametrize(
+    ("overrides", "named"),
+    [
+        ({"limits.leg_length_min": [2.0]}, "limits.leg_length_min"),
+        ({"limits.leg_diameter": 0}, "limits.leg_diameter"),
+        ({"resolution.projected_method": "fastest"}, "resolution.projected_method"),
+        ({"check.max_command_age": -1.0}, "check.max_command_age"),
+    ],
+    ids=["model", "int-type", "method", "negative-age"],
+)
+def test_invalid_overrides_refuse_to_start(ros_context, overrides, named):
+    with pytest.raises(ConfigError) as raised:
+        make_node(ros_context, **overrides)
+    assert named in str(raised.value)
+
+
+def test_override_names_from_the_command_line(tmp_path):
+    params = tmp_path / "p.yaml"
+    params.write_text(
+        "hexapod_workspace:\n  ros__parameters:\n    limits:\n      leg_diamter: 0.05\n"
+        "other_node:\n  ros__parameters:\n    x: 1\n"
+        "/**:\n  ros__parameters:\n    frame_id: base\n"
+    )
+    argv = ["node", "--ros-args", "-p", "resolution.n_rays:=12", "--params-file", str(params)]
+    names = command_line_override_names(argv, "hexapod_workspace")
+    assert sorted(names) == ["frame_id", "limits.leg_diamter", "resolution.n_rays"]
+
+
+# ---------------------------------------------------------------------------- request checks
+
+
+def check_request(angles, position=(0.0, 0.0, -1.3)) -> CheckPoses.Request:
+    request = CheckPoses.Request()
+    request.position.x, request.position.y, request.position.z = position
+    request.orientations = [TiltTorsion(phi=p, theta=t, psi=s) for p, t, s in angles]
+    return request
+
+
+@pytest.mark.parametrize(
+    ("angles", "position", "reason"),
+    [
+        ([], (0.0, 0.0, -1.3), "at least one"),
+        ([(0.0, math.nan, 0.0)], (0.0, 0.0, -1.3), "finite"),
+        ([(0.0, 0.1, 0.0)], (0.0, math.inf, -1.3), "position"),
+    ],
+    ids=["empty", "nan-angle", "inf-position"],
+)
+def test_check_poses_refusals(node, angles, position, reason):
+    response = node._on_check_poses(check_request(angles, position), CheckPoses.Response())
+    assert not response.success and reason in response.message
+    assert len(response.results) == 0
+
+
+def test_check_poses_matches_the_core(node):
+    rng = np.random.default_rng(4)
+    angles = np.column_stack(
+        (rng.uniform(-np.pi, np.pi, 50), rng.uniform(0, 0.8, 50), rng.uniform(-0.4, 0.4, 50))
+    )
+    response = node._on_check_poses(check_request(angles.tolist()), CheckPoses.Response())
+    expected = check(node.state.manipulator, angles, (0.0, 0.0, -1.3))
+    assert [r.reachable for r in response.results] == expected.reachable.tolist()
+
+
+def workspace_request(**fields) -> WorkspaceRequest:
+    request = WorkspaceRequest(kind=fields.pop("kind", WorkspaceRequest.PROJECTED_TORSION_ZERO))
+    request.position.z = -1.3
+    for name, value in fields.items():
+        setattr(request, name, value)
+    return request
+
+
+@pytest.mark.parametrize(
+    ("fields", "reason"),
+    [
+        ({"kind": 7}, "kind: expected 0 (orientation), 1 (torsion_zero) or 2 (exact), got 7"),
+        ({"n_rays": 2}, "n_rays: expected 3..7200, got 2"),
+        ({"tolerance": -1.0}, "tolerance: expected a finite value >= 0"),
+        ({"psi_step": math.inf}, "psi_step: expected a finite value >= 0"),
+    ],
+)
+def test_workspace_request_refusals_name_the_field_and_value(node, fields, reason):
+    refused = node.workspaces.job(workspace_request(**fields))
+    assert reason in refused.reason
+
+
+def test_a_valid_request_gets_the_node_resolution(node):
+    job = node.workspaces.job(workspace_request(kind=WorkspaceRequest.ORIENTATION))
+    assert job.n_rays == 36
+    assert job.tolerance == node.state.settings.tolerance
+
+
+def test_commands_in_a_batch_are_answered_one_each_in_order(node):
+    """One batch with valid, invalid and stale commands: one result each, in order."""
+    published: list = []
+    stream = node._commands
+    publisher = stream._publisher
+    stream._publisher = type("Collect", (), {"publish": published.append, "topic_name": "/x"})()
+    try:
+        commands = []
+        for k, theta in enumerate([0.1, math.nan, 0.2, 0.3]):
+            command = CommandedPose(request_id=f"b{k}")
+            command.position.z = -1.3 if k != 3 else -1.25
+            command.orientation.theta = theta
+            commands.append(command)
+        stale = CommandedPose(request_id="stale")
+        stale.position.z = -1.3
+        stale.header.stamp.sec = 1  # 1970: far older than check.max_command_age
+        stream.answer([*commands, stale])
+    finally:
+        stream._publisher = publisher
+    assert [r.request_id for r in published] == ["b0", "b1", "b2", "b3", "stale"]
+    assert [r.success for r in published] == [True, False, True, True, False]
+    assert "theta" in published[1].message or "finite" in published[1].message
+    assert published[4].message.startswith("overloaded")
+    model = Manipulator.from_params_file(example_config_path())
+    expected = check(model, [[0.0, 0.2, 0.0]], (0.0, 0.0, -1.3))
+    assert published[2].check.reachable == bool(expected.reachable[0])
+
+
+def test_an_extension_attaches_with_one_call(ros_context):
+    """What ros/paths.py or ros/atlas_action.py do: ``attach(node)`` wires a recorded service
+    with the node's groups and reads the node's state."""
+    from std_srvs.srv import Trigger
+
+    seen = []
+
+    def attach(node) -> None:
+        def ping(request, response):
+            return Trigger.Response(success=True, message=node.state.manipulator.frame_id)
+
+        seen.append(node.recorded_service(Trigger, "~/ping", ping, node.check_group))
+
+    node = WorkspaceNode(
+        context=ros_context,
+        parameter_overrides=[Parameter("recording.enabled", value=False)],
+        extensions=[attach],
+    )
+    try:
+        (service,) = seen
+        assert node.resolve_service_name(service.srv_name) == "/hexapod_workspace/ping"
+        assert node.jobs is node.workspaces.jobs and node.recorder is not None
+    finally:
+        node.destroy_node()
+
+
+def test_a_blocking_extension_callback_runs_in_a_thread_while_the_executor_serves(ros_context):
+    """in_thread: a blocking callback (the atlas action's execute) does not stop the
+    single-threaded executor; its coroutine resumes with the callback's value (or error)."""
+    import threading
+
+    from rclpy.executors import SingleThreadedExecutor
+
+    from hexapod_workspace.ros.jobs import in_thread
+
+    node = make_node(ros_context)
+    executor = SingleThreadedExecutor(context=ros_context)
+    executor.add_node(node)
+    release = threading.Event()
+    ticks: list[int] = []
+    node.create_timer(0.01, lambda: ticks.append(1))
+
+    def blocking(value):
+        release.wait(10)
+        if value == "bad":
+            raise ValueError("bad value")
+        return value * 2
+
+    try:
+        good = executor.create_task(in_thread(node, blocking), 21)
+        bad = executor.create_task(in_thread(node, blocking), "bad")
+        for _ in range(30):  # the timer keeps firing while both callbacks block
+            executor.spin_once(timeout_sec=0.05)
+        assert len(ticks) >= 5 and not good.done()
+        release.set()
+        with pytest.raises(ValueError, match="bad value"):  # rclpy re-raises a task's error
+            executor.spin_until_future_complete(bad, timeout_sec=10)
+        executor.spin_until_future_complete(good, timeout_sec=10)
+        assert good.result() == 42
+    finally:
+        executor.shutdown()
+        node.destroy_node()
