@@ -83,8 +83,8 @@ class CommandStream:
         limit = state.settings.max_command_age
         for k in np.flatnonzero(late):
             age = (now_ns - sent_ns[k]) * 1e-9
-            reason = f"overloaded: command {age:.3f} s old when its turn came (limit {limit:g} s)"
-            verdicts[int(k)] = (None, 0, reason)
+            stale = f"overloaded: command {age:.3f} s old when its turn came (limit {limit:g} s)"
+            verdicts[int(k)] = (None, 0, stale)
         stats.commands_overloaded += int(late.sum())
         todo = np.array([k for k in np.flatnonzero(~late) if k not in verdicts], dtype=int)
         if todo.size:

@@ -222,7 +222,7 @@ class WorkspaceNode(Node):
         self.recorder.add_channel(publisher.topic_name, type_name(message_class), qos)
         return publisher
 
-    def record_service_channels(self, service_class: type, name: str) -> tuple[str, str]:
+    def record_service_channels(self, service_class: Any, name: str) -> tuple[str, str]:
         """Register ``<service>/request`` and ``/response`` in the logs; return both topics."""
         request_topic, response_topic = service_topics(self.resolve_service_name(name))
         for topic, part in (
@@ -234,28 +234,26 @@ class WorkspaceNode(Node):
         return request_topic, response_topic
 
     def recorded_service(
-        self, service_class: type, name: str, callback: Callable, group: Any = None
+        self, service_class: Any, name: str, callback: Callable, group: Any = None
     ) -> Any:
         """A service whose requests and responses are recorded (``<name>/request``,
         ``<name>/response``); ``callback(request, response)`` may be a coroutine."""
         request_topic, response_topic = self.record_service_channels(service_class, name)
 
-        if _is_coroutine(callback):
+        async def recorded_async(request: Any, response: Any) -> Any:
+            self.recorder.write(request_topic, request)
+            answer = await callback(request, response)
+            self.recorder.write(response_topic, answer)
+            return answer
 
-            async def recorded(request: Any, response: Any) -> Any:
-                self.recorder.write(request_topic, request)
-                answer = await callback(request, response)
-                self.recorder.write(response_topic, answer)
-                return answer
-        else:
+        def recorded(request: Any, response: Any) -> Any:
+            self.recorder.write(request_topic, request)
+            answer = callback(request, response)
+            self.recorder.write(response_topic, answer)
+            return answer
 
-            def recorded(request: Any, response: Any) -> Any:
-                self.recorder.write(request_topic, request)
-                answer = callback(request, response)
-                self.recorder.write(response_topic, answer)
-                return answer
-
-        return self.create_service(service_class, name, recorded, callback_group=group)
+        handler = recorded_async if _is_coroutine(callback) else recorded
+        return self.create_service(service_class, name, handler, callback_group=group)
 
     def recorded_subscription(
         self, message_class: type, topic: str, callback: Callable, group: Any = None
@@ -311,9 +309,9 @@ class WorkspaceNode(Node):
                     reason += f"{parameter.value!r} refused)"
                     return SetParametersResult(successful=False, reason=reason)
                 continue
-            reason = refusal(self._specs, parameter)
-            if reason is not None:
-                return SetParametersResult(successful=False, reason=reason)
+            refused = refusal(self._specs, parameter)
+            if refused is not None:
+                return SetParametersResult(successful=False, reason=refused)
         return super().set_parameters_atomically(parameter_list)
 
     def _warn_home_pose(self) -> None:

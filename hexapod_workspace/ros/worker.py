@@ -24,8 +24,8 @@ import numpy as np
 
 from hexapod_workspace.core import kernels
 from hexapod_workspace.core.manipulator import Manipulator
-from hexapod_workspace.core.orientation import orientation_workspace
-from hexapod_workspace.core.projected import projected_workspace
+from hexapod_workspace.core.orientation import OrientationWorkspace, orientation_workspace
+from hexapod_workspace.core.projected import ProjectedWorkspace, projected_workspace
 from hexapod_workspace.core.resolution import WorkspaceKind
 from hexapod_workspace.errors import HexapodWorkspaceError
 from hexapod_workspace.logs import messages
@@ -104,6 +104,7 @@ def compute_fields(
         ``InputError``/``ResolutionError`` for a bad request, ``UnreachableReferenceError``
         when the reference orientation is unreachable at the position.
     """
+    workspace: OrientationWorkspace | ProjectedWorkspace
     if job.kind == WorkspaceKind.ORIENTATION:
         workspace = orientation_workspace(
             job.manipulator,

@@ -53,7 +53,7 @@ class WorkspaceServer:
     def __init__(self, node: Any, name: Callable[[str], str]) -> None:
         self._node = node
         self.jobs = JobQueue(node.worker, self._finish_job, self._fail_job)
-        cloud = {
+        cloud: dict[int, Any] = {
             kind: node.recorded_publisher(PointCloud2, name(topic))
             for kind, topic in (
                 (WorkspaceKind.ORIENTATION, "orientation_workspace"),
