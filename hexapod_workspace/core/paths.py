@@ -98,7 +98,10 @@ Where it breaks: the grid. A path whose only feasible torsions lie in intervals 
 ``psi_step`` may get "no plan" although a finer grid finds one; moves are checked at the
 tolerance ``tol`` (bands narrower than it may be missed); the objective is optimal to one level.
 Cost grows with (N − 1)·G·B candidate moves (G grid torsions, B torsion changes allowed per
-move): ``max_dpsi`` keeps B small.
+move): ``max_dpsi`` keeps B small. The programmes over these tables are compiled
+(:mod:`hexapod_workspace.core.planner_kernels`, a few ms per pass over 1,000 waypoints × 72²
+moves, where numpy took ≈ 30 ms); without a torsion limit the full checks of the candidate moves
+(≈ 20 µs each) are then most of the time.
 """
 
 from __future__ import annotations
