@@ -84,6 +84,12 @@ def smoothest(levels0, status, value, source, travel, best: int) -> NDArray[np.i
 class NumpyPlanner(paths._Planner):
     """The planner with the numpy programmes (as before they were compiled)."""
 
+    @property
+    def source(self) -> NDArray[np.int64]:
+        """source[h, b]: the torsion g that reaches h by offset b."""
+        size = self.grid_size
+        return (np.arange(size)[:, None] - self.offsets[None, :]) % size
+
     def _forward(self, optimistic: bool) -> NDArray[np.int32]:
         return forward(
             self.levels[0], self.status, self.value, self.source, self.offsets.size, optimistic

@@ -1155,9 +1155,8 @@ class _Planner:
                 f"a max_dpsi or fewer waypoints"
             )
             raise ResolutionError(msg)
-        # dest[g, b]: target torsion of offset b; source[h, b]: the g that reaches h by b.
+        # dest[g, b]: target torsion of offset b from torsion g.
         self.dest = (np.arange(size)[:, None] + offsets[None, :]) % size
-        self.source = (np.arange(size)[:, None] - offsets[None, :]) % size
         self.travel = np.abs(wrap_angle(offsets * (2.0 * math.pi / size)))  # (B,)
         angles = np.empty((count, size, 3))
         angles[:, :, 0] = directions[:, 0:1]
