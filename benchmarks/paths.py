@@ -11,7 +11,8 @@ tolerance measured as platform rotation or joint travel, as in
 * large moves: random moves of ±0.3 m and tilts up to 30° (most cross the workspace boundary).
 
 Then :func:`hexapod_workspace.plan_torsion` on a 1,000-waypoint off-axis toolpath (the README's
-example shape), without a torsion limit and with ``max_dpsi`` = 5°.
+example shape), without a torsion limit and with ``max_dpsi`` = 5°, timed in the same run with
+the compiled dynamic programmes and with the numpy ones they replaced (the plans must be equal).
 
 Usage: python benchmarks/paths.py [--short N] [--large N] [--waypoints N]
 """
@@ -21,7 +22,9 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import sys
 import time
+from pathlib import Path
 
 # One core: keep any BLAS threads out of the measurement (set before numpy loads).
 for variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
@@ -34,6 +37,9 @@ from hexapod_workspace._resources import example_config_path  # noqa: E402
 from hexapod_workspace.core.constraints import pose_margins  # noqa: E402
 from hexapod_workspace.core.paths import DEFAULT_PATH_TOLERANCE, _Moves  # noqa: E402
 from hexapod_workspace.core.rotations import approach_vector, tt_to_matrix  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "test"))
+from planner_reference import numpy_planner  # noqa: E402
 
 #: Samples per pose_margins call of the dense reference (bounded memory).
 BATCH = 200_000
@@ -136,17 +142,29 @@ def main() -> None:
         [0.2 + 0.02 * np.cos(t), 0.2 + 0.02 * np.sin(t), np.full(count, -0.95)]
     )
     axes = approach_vector(t, np.radians(17.0))
-    print(f"free-torsion toolpath, {count} waypoints off the axis (tool axes on a 17° cone):")
+    print(
+        f"free-torsion toolpath, {count} waypoints off the axis (tool axes on a 17° cone); "
+        f"compiled programmes vs the numpy ones they replaced (test/planner_reference.py):"
+    )
     for label, max_dpsi in (("no torsion limit", None), ("max_dpsi 5 deg", np.radians(5.0))):
-        elapsed, plan = best_of(
-            3,
-            lambda max_dpsi=max_dpsi: plan_torsion(manipulator, positions, axes, max_dpsi=max_dpsi),
+
+        def plan(max_dpsi=max_dpsi):
+            return plan_torsion(manipulator, positions, axes, max_dpsi=max_dpsi)
+
+        elapsed, planned = best_of(3, plan)
+        with numpy_planner():
+            before, expected = best_of(3, plan)
+        same = (
+            planned.ok == expected.ok
+            and planned.objective == expected.objective
+            and (not planned.ok or np.array_equal(planned.psi, expected.psi))
         )
         print(
-            f"  {label:<16}: {elapsed:6.3f} s  plan {'found' if plan.ok else 'NOT found'}, "
-            f"margin {plan.objective:.3f}, {plan.moves_checked} moves checked in full; "
-            f"psi = 0 fails {len(plan.baseline.failed_waypoints)} waypoints; "
-            f"goal 1 s {'met' if elapsed <= 1.0 else 'not met'}"
+            f"  {label:<16}: {elapsed:6.3f} s (numpy programmes {before:6.3f} s, "
+            f"{before / elapsed:4.1f}x)  plan {'found' if planned.ok else 'NOT found'}, "
+            f"margin {planned.objective:.3f}, {planned.moves_checked} moves checked in full; "
+            f"same plan: {same}; psi = 0 fails {len(planned.baseline.failed_waypoints)} "
+            f"waypoints; goal 1 s {'met' if elapsed <= 1.0 else 'not met'}"
         )
 
 

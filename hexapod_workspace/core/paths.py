@@ -98,7 +98,10 @@ Where it breaks: the grid. A path whose only feasible torsions lie in intervals 
 ``psi_step`` may get "no plan" although a finer grid finds one; moves are checked at the
 tolerance ``tol`` (bands narrower than it may be missed); the objective is optimal to one level.
 Cost grows with (N − 1)·G·B candidate moves (G grid torsions, B torsion changes allowed per
-move): ``max_dpsi`` keeps B small.
+move): ``max_dpsi`` keeps B small. The programmes over these tables are compiled
+(:mod:`hexapod_workspace.core.planner_kernels`, a few ms per pass over 1,000 waypoints × 72²
+moves, where numpy took ≈ 30 ms); without a torsion limit the full checks of the candidate moves
+(≈ 20 µs each) are then most of the time.
 """
 
 from __future__ import annotations
@@ -107,12 +110,14 @@ import math
 import time
 from collections import Counter
 from dataclasses import dataclass, field
+from typing import TypedDict
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError, ResolutionError
-from .constraints import CONSTRAINT_NAMES, pose_margins, relative_margins
+from . import planner_kernels
+from .constraints import CONSTRAINT_NAMES, PoseMargins, pose_margins, relative_margins
 from .manipulator import Manipulator
 from .rotations import (
     approach_to_tilt,
@@ -304,12 +309,14 @@ class PathCheck:
     @property
     def failed_waypoints(self) -> list[int]:
         """0-based indices of the unreachable waypoints."""
-        return np.flatnonzero(~self.waypoints.reachable).tolist()
+        failed: list[int] = np.flatnonzero(~self.waypoints.reachable).tolist()
+        return failed
 
     @property
     def failed_segments(self) -> list[int]:
         """0-based indices of the moves that cannot run (move k joins waypoints k and k + 1)."""
-        return np.flatnonzero(~self.segments.ok).tolist()
+        failed: list[int] = np.flatnonzero(~self.segments.ok).tolist()
+        return failed
 
 
 @dataclass(frozen=True)
@@ -484,7 +491,8 @@ def _unit_rows(
         msg = f"{name}: expected finite non-zero values, waypoint {row} is {array[row].tolist()}"
         raise InputError(msg)
     scaled = array / scale[:, None]
-    return scaled / np.linalg.norm(scaled, axis=1, keepdims=True)
+    unit: NDArray[np.float64] = scaled / np.linalg.norm(scaled, axis=1, keepdims=True)
+    return unit
 
 
 def _validate_interpolation(interpolation: str) -> str:
@@ -595,7 +603,8 @@ class _Certifier:
 
     def margins(
         self, rotations: NDArray[np.float64], positions: NDArray[np.float64]
-    ):  # -> PoseMargins
+    ) -> PoseMargins:
+        """The margins of n poses: rotations (n, 3, 3), positions (n, 3) in m."""
         return pose_margins(self.manipulator, rotations, positions)
 
     def lower_bounds(
@@ -621,7 +630,9 @@ class _Certifier:
             turn = np.where(floor > 0.0, travel / np.where(floor > 0.0, floor, 1.0), np.inf)
             lipschitz_travel[1] = turn
             lipschitz_travel[2] = omega * width + turn
-            low = np.minimum(np.minimum(start, end), 0.5 * (start + end - lipschitz_travel))
+            low: NDArray[np.float64] = np.minimum(
+                np.minimum(start, end), 0.5 * (start + end - lipschitz_travel)
+            )
         low[0] = low_length
         return low
 
@@ -630,7 +641,19 @@ class _Certifier:
         if margins.shape[1] == 0:
             return np.zeros(0)
         values = relative_margins(self.manipulator, margins).min(axis=0)
-        return np.where(np.isnan(values), -np.inf, values)
+        smallest: NDArray[np.float64] = np.where(np.isnan(values), -np.inf, values)
+        return smallest
+
+
+class _Samples(TypedDict):
+    """Sample table of :func:`_check_moves`: one column per evaluated pose (the K start ends,
+    the K far ends, then the interior samples in the order evaluated)."""
+
+    s: NDArray[np.float64]  # (n,) parameter along its move
+    move: NDArray[np.int64]  # (n,) index of its move
+    margins: NDArray[np.float64]  # (4, n)
+    legs: NDArray[np.int64]  # (4, n) limiting leg per constraint, 0-based
+    pairs: NDArray[np.int64]  # (n, 2) closest leg pair, 0-based
 
 
 @dataclass
@@ -644,7 +667,7 @@ class _MoveCheck:
     min_s: NDArray[np.float64]
     min_index: NDArray[np.int64]
     bound: NDArray[np.float64]
-    samples: dict  # sample table: s, move, margins (4, n), legs (4, n), pairs (n, 2), angles
+    samples: _Samples
     evaluations: int
 
 
@@ -655,13 +678,16 @@ def _check_moves(
     end: NDArray[np.float64],
     tolerance: float,
     max_sample_angle: float,
-    start_pose: tuple | None = None,
-    end_pose: tuple | None = None,
+    start_pose: tuple[NDArray[np.int64], NDArray[np.int64]] | None = None,
+    end_pose: tuple[NDArray[np.int64], NDArray[np.int64]] | None = None,
+    locate_minimum: bool = True,
 ) -> _MoveCheck:
     """Certified check of K moves given their end margins (4, K), vectorised over moves.
 
     ``start_pose``/``end_pose`` are optional (legs (4, K), pairs (K, 2)) of the ends, kept in
-    the sample table so that limiting legs at the ends can be reported.
+    the sample table so that limiting legs at the ends can be reported. Without
+    ``locate_minimum`` (the planner) only the smallest sampled margin is computed, not where it
+    is (``min_index`` −1, ``min_s`` NaN): the same values, without sorting the sample table.
     """
     count = start.shape[1]
     with np.errstate(divide="ignore"):
@@ -738,7 +764,7 @@ def _check_moves(
     else:  # pragma: no cover - MAX_ROUNDS halvings reach any tolerance >= 1e-9 first
         msg = "segment check did not converge"
         raise RuntimeError(msg)
-    samples = {
+    samples: _Samples = {
         "s": np.concatenate(table_s),
         "move": np.concatenate(table_move),
         "margins": np.concatenate(table_margins, axis=1),
@@ -748,9 +774,18 @@ def _check_moves(
     # Minimum over the samples of [0, first violation] and over the final interval bounds.
     relative = certifier.relative(samples["margins"])
     inside = samples["s"] <= np.minimum(first_bad, 1.0)[samples["move"]]
-    order = np.lexsort((relative, ~inside, samples["move"]))  # per move: inside first, smallest
-    first_of_move = np.searchsorted(samples["move"][order], ids)
-    min_index = order[first_of_move]
+    if locate_minimum:
+        # Per move: inside first, smallest (every move has its start, s = 0, inside).
+        order = np.lexsort((relative, ~inside, samples["move"]))
+        first_of_move = np.searchsorted(samples["move"][order], ids)
+        min_index = order[first_of_move]
+        min_value = relative[min_index]
+        min_s = samples["s"][min_index]
+    else:
+        min_value = np.full(count, np.inf)
+        np.minimum.at(min_value, samples["move"][inside], relative[inside])
+        min_index = np.full(count, -1, dtype=np.int64)
+        min_s = np.full(count, np.nan)
     bound = np.full(count, np.inf)
     if final_move:
         f_move, f_lo = np.concatenate(final_move), np.concatenate(final_lo)
@@ -758,14 +793,13 @@ def _check_moves(
         before = f_lo < first_bad[f_move]
         np.minimum.at(bound, f_move[before], f_bound[before])
     ok = ~np.isfinite(first_bad)
-    min_value = relative[min_index]
     bound = np.minimum(bound, min_value)
     return _MoveCheck(
         ok=ok,
         first_bad=np.where(ok, np.nan, first_bad),
         bad_index=bad_index,
         min_value=min_value,
-        min_s=samples["s"][min_index],
+        min_s=min_s,
         min_index=min_index,
         bound=bound,
         samples=samples,
@@ -776,7 +810,7 @@ def _check_moves(
 # ============================================================================ check_path
 def _waypoint_checks(
     certifier: _Certifier, positions: NDArray[np.float64], rotations: NDArray[np.float64]
-) -> tuple[WaypointChecks, object]:
+) -> tuple[WaypointChecks, PoseMargins]:
     found = certifier.margins(rotations, positions)
     relative = relative_margins(certifier.manipulator, found.margins)
     limiting = np.argmin(np.where(np.isnan(relative), -np.inf, relative), axis=0)
@@ -1047,15 +1081,29 @@ def plan_torsion(
 
 
 #: Level code of "no move" (infeasible or not allowed) in the planner's integer tables.
-_NONE = np.iinfo(np.int32).min
+_NONE = planner_kernels.NONE
 #: Largest level magnitude stored (relative margins beyond ±2^30 levels are clipped).
 _LEVEL_CLIP = 2**30
 #: Pair status in the planner: no move, value known, not yet checked (optimistic value).
-_NO, _KNOWN, _UNKNOWN = 0, 1, 2
+_NO, _KNOWN, _UNKNOWN = planner_kernels.NO, planner_kernels.KNOWN, planner_kernels.UNKNOWN
 #: Moves given the full certified check per batch of the planner.
 CHECK_BATCH = 2000
 #: Largest number of candidate moves (waypoint pairs × torsions × torsion changes) per plan.
 MAX_PLAN_MOVES = 30_000_000
+
+
+def _best_first(through: NDArray[np.int32], count: int) -> NDArray[np.int64]:
+    """Indices of the ``count`` largest values, largest first, ties in index order: exactly
+    ``np.argsort(-through, kind="stable")[:count]``, in O(n) plus a sort of ``count`` values."""
+    size = through.shape[0]
+    if size <= count:
+        return np.argsort(-through.astype(np.int64), kind="stable")
+    threshold = np.partition(through, size - count)[size - count]  # the count-th largest
+    above = np.flatnonzero(through > threshold)
+    ties = np.flatnonzero(through == threshold)[: count - above.size]
+    chosen = np.union1d(above, ties)  # sorted: index order
+    order = np.argsort(-through[chosen].astype(np.int64), kind="stable")
+    return chosen[order].astype(np.int64)
 
 
 class _Planner:
@@ -1107,9 +1155,8 @@ class _Planner:
                 f"a max_dpsi or fewer waypoints"
             )
             raise ResolutionError(msg)
-        # dest[g, b]: target torsion of offset b; source[h, b]: the g that reaches h by b.
+        # dest[g, b]: target torsion of offset b from torsion g.
         self.dest = (np.arange(size)[:, None] + offsets[None, :]) % size
-        self.source = (np.arange(size)[:, None] - offsets[None, :]) % size
         self.travel = np.abs(wrap_angle(offsets * (2.0 * math.pi / size)))  # (B,)
         angles = np.empty((count, size, 3))
         angles[:, :, 0] = directions[:, 0:1]
@@ -1182,30 +1229,21 @@ class _Planner:
 
     # ---------------------------------------------------------------- programmes
     def _forward(self, optimistic: bool) -> NDArray[np.int32]:
-        """Bottleneck value (N, G) of the best path from waypoint 0 to each state."""
+        """Bottleneck value (N, G) of the best path from waypoint 0 to each state (compiled:
+        :func:`planner_kernels.forward`)."""
         reach = np.empty(self.levels.shape, dtype=np.int32)
-        reach[0] = self.levels[0]
-        usable = (self.status != _NO) if optimistic else (self.status == _KNOWN)
-        values = np.where(usable, self.value, _NONE)
-        gather = (self.source * self.offsets.size + np.arange(self.offsets.size)).ravel()
-        through = np.empty(values.shape[1:], dtype=np.int32)
-        for k in range(self.status.shape[0]):
-            np.minimum(reach[k][:, None], values[k], out=through)  # (G, B) by source g
-            reach[k + 1] = np.take(through, gather).reshape(through.shape).max(axis=1)
+        planner_kernels.forward(
+            self.levels[0], self.status, self.value, self.dest, optimistic, reach
+        )
         return reach
 
     def _backward(self) -> NDArray[np.int32]:
         """Optimistic bottleneck value (N, G) of the best path from each state to the end."""
         back = np.empty(self.levels.shape, dtype=np.int32)
-        back[-1] = self.levels[-1]
-        values = np.where(self.status != _NO, self.value, _NONE)
-        dest = self.dest.ravel()
-        for k in range(self.status.shape[0] - 1, -1, -1):
-            ahead = np.take(back[k + 1], dest).reshape(self.dest.shape)
-            back[k] = np.minimum(values[k], ahead).max(axis=1)
+        planner_kernels.backward(self.levels, self.status, self.value, self.dest, back)
         return back
 
-    def _check(self, k: NDArray, g: NDArray, b: NDArray) -> None:
+    def _check(self, k: NDArray[np.int64], g: NDArray[np.int64], b: NDArray[np.int64]) -> None:
         """Full certified check of moves (k, g, b), sampled as :func:`check_path` samples them
         (so a plan's re-check reproduces these bounds); updates status, value and stopped."""
         h = self.dest[g, b]
@@ -1217,6 +1255,7 @@ class _Planner:
             self.margins[:, k + 1, h],
             self.tolerance,
             DEFAULT_MAX_SAMPLE_ANGLE,
+            locate_minimum=False,
         )
         self.moves_checked += k.size
         self.status[k, g, b] = np.where(raw.ok, _KNOWN, _NO)
@@ -1234,16 +1273,18 @@ class _Planner:
             best = int(self._forward(optimistic=False)[-1].max())
             # Optimistic bottleneck of the best path through each move (recomputed after every
             # batch: the checks lower it, and that is what prunes the remaining moves).
-            forward = self._forward(optimistic=True)
-            backward = self._backward()
-            through = np.minimum(forward[:-1, :, None], self.value)
-            np.minimum(through, backward[1:][:, self.dest], out=through)
-            relevant = (self.status == _UNKNOWN) & (through > best)
-            k, g, b = np.nonzero(relevant)
+            k, g, b, through = planner_kernels.candidates(
+                self._forward(optimistic=True),
+                self._backward(),
+                self.status,
+                self.value,
+                self.dest,
+                best,
+            )
             if k.size == 0:
                 break
             if k.size > CHECK_BATCH:
-                top = np.argsort(-through[k, g, b], kind="stable")[:CHECK_BATCH]
+                top = _best_first(through, CHECK_BATCH)
                 k, g, b = k[top], g[top], b[top]
             self._check(k, g, b)
         if best == _NONE:
@@ -1253,26 +1294,13 @@ class _Planner:
     def _smoothest(self, best: int) -> NDArray[np.float64]:
         """Among the known moves whose level reaches the objective: the largest sum of move
         levels, then the least torsion travel Σ|Δψ|; ψ (N,), rad."""
-        size = self.grid_size
-        columns = np.arange(self.offsets.size)
         # cost = −Σ levels · scale + Σ|Δψ|: scale exceeds any total travel (N·π), so the sum of
         # levels decides and the travel only breaks ties (exact in float64 for these sizes).
         scale = float(self.status.shape[0] + 1) * 4.0
-        cost = np.where(self.levels[0] >= best, 0.0, np.inf)
-        back = []
-        usable = (self.status == _KNOWN) & (self.value >= best)
-        step_cost = np.where(usable, -self.value.astype(np.float64) * scale, np.inf)
-        for k in range(self.status.shape[0]):
-            total = (cost[:, None] + step_cost[k] + self.travel)[self.source, columns]
-            choice = np.argmin(total, axis=1)  # offset index per target h
-            cost = total[np.arange(size), choice]
-            back.append(self.source[np.arange(size), choice])
-        index = int(np.argmin(cost))
-        path = [index]
-        for source in reversed(back):
-            index = int(source[index])
-            path.append(index)
-        return self.grid[np.array(path[::-1])]
+        path = planner_kernels.smoothest(
+            self.levels[0], self.status, self.value, self.dest, self.travel, best, scale
+        )
+        return self.grid[path]
 
     def _breakpoint(self) -> BreakPoint:
         """The first waypoint that no torsion reaches from the start, with the reasons."""
