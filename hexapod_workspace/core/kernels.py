@@ -31,6 +31,7 @@ import os
 import sys
 import tempfile
 import time
+import weakref
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
@@ -153,8 +154,12 @@ SAFETY = 1.0 - 1e-9
 KIND_TT, KIND_CYLINDRICAL = 0, 1
 
 
+#: Packed models by ``id`` of their manipulator (see :func:`model_vector`).
+_MODELS: dict[int, NDArray[np.float64]] = {}
+
+
 def model_vector(manipulator: Manipulator) -> NDArray[np.float64]:
-    """The packed model of a manipulator (cached on the immutable manipulator object).
+    """The packed model of a manipulator (cached per manipulator object, for its lifetime).
 
     Parameters
     ----------
@@ -165,7 +170,8 @@ def model_vector(manipulator: Manipulator) -> NDArray[np.float64]:
     ndarray, shape (MODEL_SIZE,)
         Read-only; layout given by the offsets of this module.
     """
-    cached: NDArray[np.float64] | None = manipulator.__dict__.get("_kernel_model")
+    key = id(manipulator)
+    cached = _MODELS.get(key)
     if cached is not None:
         return cached
     model = np.zeros(MODEL_SIZE)
@@ -203,7 +209,11 @@ def model_vector(manipulator: Manipulator) -> NDArray[np.float64]:
     ]
     model[ORDER : ORDER + 15] = np.argsort(home_distance, kind="stable")
     model.setflags(write=False)
-    manipulator.__dict__["_kernel_model"] = model
+    # The manipulator is frozen: nothing is written into it. The entry lives as long as the
+    # object (its id is not reused before the finalizer has removed the entry).
+    if key not in _MODELS:
+        _MODELS[key] = model
+        weakref.finalize(manipulator, _MODELS.pop, key, None)
     return model
 
 
@@ -1271,8 +1281,12 @@ def warm_up() -> float:
     return time.perf_counter() - started
 
 
+_CORE_PACKAGE = __name__.rpartition(".")[0] + "."
+
+
 class _CompileAnnouncer(numba.core.event.Listener):  # type: ignore[misc]  # numba: no stubs
-    """Calls ``announce`` once, when the first kernel of this module starts compiling."""
+    """Calls ``announce`` once, when the first kernel of the core (this module's or the torsion
+    planner's) starts compiling."""
 
     def __init__(self, announce: Callable[[str], object]) -> None:
         self.announce = announce
@@ -1281,7 +1295,8 @@ class _CompileAnnouncer(numba.core.event.Listener):  # type: ignore[misc]  # num
     def on_start(self, event: numba.core.event.Event) -> None:
         dispatcher = (event.data or {}).get("dispatcher")
         function = getattr(dispatcher, "py_func", None)
-        if self.announced or getattr(function, "__module__", None) != __name__:
+        module = str(getattr(function, "__module__", ""))
+        if self.announced or not module.startswith(_CORE_PACKAGE):  # ours: kernels, planner
             return
         self.announced = True
         where = CACHE_DIRECTORY if CACHE_DIRECTORY is not None else "nowhere writable: not cached"

@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import inspect
 import sys
+import time
 from collections.abc import Callable, Iterable
 from typing import Any
 
@@ -64,7 +65,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-from hexapod_workspace.core import kernels
+from hexapod_workspace.core import kernels, planner_kernels
 from hexapod_workspace.core.constraints import check
 from hexapod_workspace.errors import ConfigError, InputError
 from hexapod_workspace.logs import (
@@ -135,8 +136,12 @@ def _result_qos(depth: int = 1) -> QoSProfile:
 
 def _warm_up() -> float:
     """Compile (first run) or load the core's kernels before the node reports ready, so that
-    the first pose check is as fast as the others; returns the seconds taken."""
-    return kernels.warm_up()
+    the first pose check and the first planned path are as fast as the others; returns the
+    seconds taken."""
+    started = time.perf_counter()
+    kernels.warm_up()
+    planner_kernels.warm_up()  # ~/check_path with free torsion
+    return time.perf_counter() - started
 
 
 class WorkspaceNode(Node):
