@@ -26,6 +26,7 @@ from pathlib import Path
 
 import xarray as xr
 
+from ..core import kernels
 from ..core.atlas import AtlasGrid, AtlasOptions, dexterous_mask, positions_capability
 from ..core.manipulator import Manipulator
 from ..errors import AtlasError, InputError
@@ -165,6 +166,9 @@ class _OnDask:
             msg = f"the Dask scheduler has no workers (waited {connect_timeout:g} s)"
             raise AtlasError(msg) from error
         self.workers = len(self.client.scheduler_info().get("workers", {}))
+        # Each worker process loads (or, on a fresh cache, compiles) the kernels once, all at
+        # the same time, instead of inside its first chunk.
+        self.client.run(kernels.warm_up)
 
     def run(self, jobs, finished) -> None:
         from distributed import as_completed
