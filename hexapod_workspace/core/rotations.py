@@ -139,10 +139,19 @@ def zyz_to_matrix(zyz: ArrayLike) -> NDArray[np.float64]:
 def _zyz_matrix(
     alpha: NDArray[np.float64], beta: NDArray[np.float64], gamma: NDArray[np.float64]
 ) -> NDArray[np.float64]:
-    ca, sa = np.cos(alpha), np.sin(alpha)
-    cb, sb = np.cos(beta), np.sin(beta)
-    cg, sg = np.cos(gamma), np.sin(gamma)
-    matrix = np.empty((*np.shape(alpha), 3, 3))
+    return _zyz_matrix_from_trig(
+        (np.cos(alpha), np.sin(alpha)), (np.cos(beta), np.sin(beta)), (np.cos(gamma), np.sin(gamma))
+    )
+
+
+def _zyz_matrix_from_trig(
+    alpha: tuple[NDArray[np.float64], NDArray[np.float64]],
+    beta: tuple[NDArray[np.float64], NDArray[np.float64]],
+    gamma: tuple[NDArray[np.float64], NDArray[np.float64]],
+) -> NDArray[np.float64]:
+    """Rz(α)·Ry(β)·Rz(γ) from the (cos, sin) pairs of its three angles; shape (..., 3, 3)."""
+    (ca, sa), (cb, sb), (cg, sg) = alpha, beta, gamma
+    matrix = np.empty((*np.shape(ca), 3, 3))
     matrix[..., 0, 0] = ca * cb * cg - sa * sg
     matrix[..., 0, 1] = -ca * cb * sg - sa * cg
     matrix[..., 0, 2] = ca * sb
@@ -215,17 +224,7 @@ def tt_to_matrix(angles: ArrayLike) -> NDArray[np.float64]:
     cb, sb = np.cos(theta), np.sin(theta)
     cg = cs * cp + ss * sp
     sg = ss * cp - cs * sp
-    matrix = np.empty((*np.shape(phi), 3, 3))
-    matrix[..., 0, 0] = cp * cb * cg - sp * sg
-    matrix[..., 0, 1] = -cp * cb * sg - sp * cg
-    matrix[..., 0, 2] = cp * sb
-    matrix[..., 1, 0] = sp * cb * cg + cp * sg
-    matrix[..., 1, 1] = -sp * cb * sg + cp * cg
-    matrix[..., 1, 2] = sp * sb
-    matrix[..., 2, 0] = -sb * cg
-    matrix[..., 2, 1] = sb * sg
-    matrix[..., 2, 2] = cb
-    return matrix
+    return _zyz_matrix_from_trig((cp, sp), (cb, sb), (cg, sg))
 
 
 def matrix_to_tt(matrix: ArrayLike) -> NDArray[np.float64]:
