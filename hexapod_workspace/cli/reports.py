@@ -11,7 +11,7 @@ import json
 import math
 import time
 from collections.abc import Sequence
-from typing import IO, Any
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -20,8 +20,9 @@ from ..core.constraints import CONSTRAINT_NAMES, CheckResult
 from ..core.orientation import OrientationWorkspace, TorsionRange
 from ..core.projected import ProjectedWorkspace
 from ..core.resolution import WorkspaceKind
-from ..logs.paths import path_call_line, path_call_report
-from ..logs.summary import LogSummary, PoseCheckCall, WorkspaceRecord
+
+if TYPE_CHECKING:  # the log reports only: `check` need not load the logs layer
+    from ..logs.summary import LogSummary, PoseCheckCall, WorkspaceRecord
 
 __all__ = [
     "check_json",
@@ -364,6 +365,8 @@ def _check_json(index: int, call: PoseCheckCall, start_ns: int) -> dict[str, Any
 
 
 def log_report(summary: LogSummary) -> dict[str, Any]:
+    from ..logs.paths import path_call_report
+
     contents = summary.contents
     start = contents.start_ns or 0
     reach = summary.reachability
@@ -416,6 +419,8 @@ def jsonable(value: Any) -> Any:
 
 
 def log_report_text(report: dict[str, Any], out: IO[str]) -> None:
+    from ..logs.paths import path_call_line
+
     if report["damaged"]:
         state = (
             "finished, but damaged: read as far as intact"
