@@ -20,6 +20,7 @@ from typing import IO, Any
 
 import numpy as np
 
+from ..core import kernels
 from ..core.manipulator import Manipulator
 from ..core.orientation import orientation_workspace
 from ..core.projected import projected_workspace
@@ -89,6 +90,8 @@ def run_demo(
     from ..logs.record import record_results
     from .plotting import plot_orientation, plot_projected
     from .progress import ProgressBar
+
+    kernels.warm_up()  # compiled (first run after install) before anything is timed
 
     if out_dir.exists() and not out_dir.is_dir():
         msg = f"--out: {out_dir} exists and is not a folder"

@@ -279,11 +279,13 @@ def pose_margins(
     PoseMargins
     """
     rotations = np.ascontiguousarray(_rotation_batch(rotations))
+    if not rotations.flags.writeable:  # one compiled specialisation: writable arrays
+        rotations = rotations.copy()
     count = rotations.shape[0]
     positions = _positions(position, count)
     if positions.strides[0] == 0:  # one position for every pose
         positions = positions[:1]
-    positions = np.ascontiguousarray(positions)
+    positions = np.array(positions, order="C")  # a writable copy (broadcasts are read-only)
     margins = np.empty((4, count))
     legs = np.empty((4, count), dtype=np.int64)
     pairs = np.empty((count, 2), dtype=np.int64)
@@ -401,6 +403,11 @@ def check(
         if candidate.shape != (3,) or not np.all(np.isfinite(candidate)):
             _require_finite_angles(angles)  # bad angles are reported before a bad position
     position = validate_position(manipulator, position)  # 3 finite values, |p| bounded
+    # numba compiles one specialisation per read-only flag; the kernels are warmed up for
+    # writable arrays (a read-only input, e.g. a frozen Manipulator's position, is copied).
+    position = position if position.flags.writeable else position.copy()
+    if not angles.flags.writeable:
+        angles = angles.copy()
 
     margins = np.empty((4, count))
     ints = np.empty((6, count), dtype=np.int64)

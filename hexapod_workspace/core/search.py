@@ -90,13 +90,17 @@ class RaySearchResult:
 
 
 def _vectors(values: ArrayLike, count: int) -> NDArray[np.float64]:
-    """(count, 3) contiguous float64 from (3,) or (count, 3)."""
-    return np.ascontiguousarray(np.broadcast_to(np.asarray(values, dtype=np.float64), (count, 3)))
+    """(count, 3) contiguous, writable float64 from (3,) or (count, 3).
+
+    Always a writable copy: numba compiles one specialisation per read-only flag, and the
+    kernels are warmed up (compiled ahead) for writable arrays only.
+    """
+    return np.array(np.broadcast_to(np.asarray(values, dtype=np.float64), (count, 3)), order="C")
 
 
 def _scalars(values: ArrayLike, count: int) -> NDArray[np.float64]:
-    """(count,) contiguous float64 from a scalar or (count,)."""
-    return np.ascontiguousarray(np.broadcast_to(np.asarray(values, dtype=np.float64), (count,)))
+    """(count,) contiguous, writable float64 from a scalar or (count,) (see :func:`_vectors`)."""
+    return np.array(np.broadcast_to(np.asarray(values, dtype=np.float64), (count,)), order="C")
 
 
 class RaySearch:
@@ -115,7 +119,7 @@ class RaySearch:
         self, manipulator: Manipulator, position: NDArray[np.float64], min_step: float = 1e-3
     ) -> None:
         self.manipulator = manipulator
-        self.position = np.ascontiguousarray(position, dtype=np.float64)
+        self.position = np.array(position, dtype=np.float64)  # writable: see _vectors
         self.min_step = float(min_step)
         self.model = kernels.model_vector(manipulator)
         self.evaluations = 0
@@ -123,6 +127,8 @@ class RaySearch:
     def margins(self, angles: NDArray[np.float64]) -> NDArray[np.float64]:
         """The four margins of poses (n, 3) at the search position; shape (4, n)."""
         angles = np.ascontiguousarray(angles, dtype=np.float64)
+        if not angles.flags.writeable:  # one compiled specialisation: writable arrays
+            angles = angles.copy()
         count = angles.shape[0]
         margins = np.empty((4, count))
         kernels.check_angles(
