@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -156,6 +157,20 @@ def test_bad_input_exit_2_with_one_line(tmp_path, capsys, header, rows, match):
     stderr = capsys.readouterr().err.strip().splitlines()
     assert len(stderr) == 1 and stderr[0].startswith("hexapod-workspace: error:")
     assert match in stderr[0]
+
+
+def test_degrees_beyond_float_resolution_keep_their_principal_value(tmp_path):
+    # 1e20 + 180 rounds to 1e20 in floating point: reducing "(d + 180) mod 360 - 180" would land
+    # 180° away. fmod(d, 360) is exact, so the expected row is the exact principal value.
+    principal = math.fmod(1e20, 360.0)
+    principal = principal - 360.0 if principal > 180.0 else principal
+    rows = np.array([[0.0, 0.0, -1.3, 1e20, 20.0, 10.0], [0.0, 0.0, -1.3, principal, 20.0, 10.0]])
+    source = write_csv(tmp_path / "huge.csv", "x,y,z,phi_deg,theta_deg,psi_deg", rows)
+    out = io.StringIO()
+    main(["check-path", str(source), "--json"], out=out)
+    first, second = json.loads(out.getvalue())["waypoints"]
+    assert first["margins"] == pytest.approx(second["margins"], abs=1e-12)
+    assert first["reachable"] == second["reachable"]
 
 
 def test_huge_angles_are_their_principal_values(tmp_path):

@@ -32,10 +32,12 @@ from ..core.paths import (
     TorsionPlan,
     check_path,
     plan_torsion,
+    reported_parts,
 )
-from ..core.rotations import matrix_to_quaternion, tt_to_matrix
+from ..core.rotations import degrees_to_radians, matrix_to_quaternion, tt_to_matrix
 from ..errors import InputError
-from .inputs import PLOT_FORMATS, load_manipulator, output_file
+from .commands import PROG
+from .inputs import PLOT_FORMATS, finite, is_number, load_manipulator, output_file
 
 if TYPE_CHECKING:
     from matplotlib.projections.polar import PolarAxes
@@ -53,7 +55,6 @@ __all__ = [
     "record_path",
 ]
 
-PROG = "hexapod-workspace"
 _POSITION = ("x", "y", "z")
 _ANGLES = ("phi_deg", "theta_deg", "psi_deg")
 _AXIS = ("i", "j", "k")
@@ -109,7 +110,7 @@ def read_path_file(path: str | Path) -> PathFile:
         raise InputError(msg) from error
     names = [cell.strip().lower() for cell in header.split(",")]
     expected = "a header x,y,z,phi_deg,theta_deg,psi_deg or x,y,z,i,j,k"
-    if not header or any(_is_number(name) for name in names):
+    if not header or any(is_number(name) for name in names):
         msg = f"path file {path}: expected {expected} as the first row"
         raise InputError(msg)
     unknown = [n for n in names if n not in (*_POSITION, *_ANGLES, *_AXIS)]
@@ -156,30 +157,9 @@ def read_path_file(path: str | Path) -> PathFile:
     return PathFile(positions, None, np.column_stack([column[n] for n in _AXIS]))
 
 
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
-
-
-def _principal_degrees(degrees: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Degrees reduced to (−180, 180] exactly (fmod), before any conversion or combination."""
-    return np.remainder(degrees + 180.0, 360.0) - 180.0
-
-
 # ---------------------------------------------------------------------------- JSON
 def _number(value: float) -> float | None:
     return float(value) if math.isfinite(value) else None
-
-
-def _reported(result: PathCheck | TorsionPlan) -> tuple[PathCheck, TorsionPlan | None]:
-    """The path a result reports (a plan that is ok: its path; otherwise the ψ = 0 baseline),
-    and the plan (None for a path check)."""
-    if isinstance(result, TorsionPlan):
-        return (result.path if result.ok and result.path is not None else result.baseline), result
-    return result, None
 
 
 def _no_plan_reason(plan: TorsionPlan) -> str:
@@ -203,7 +183,7 @@ def path_to_json(
     degrees : ndarray, shape (N, 3), optional
         The fixed orientations as the user wrote them (reported as given).
     """
-    path, plan = _reported(result)
+    path, plan = reported_parts(result)
     waypoints, segments = path.waypoints, path.segments
     angles_deg = np.degrees(waypoints.angles) if degrees is None else degrees
     violated = waypoints.violated
@@ -381,7 +361,7 @@ def plot_path(
 
     from ..core.projected import projected_workspace
 
-    checked, plan = _reported(result)
+    checked, plan = reported_parts(result)
     waypoints = checked.waypoints
     count = len(waypoints)
     index = np.arange(count)
@@ -543,12 +523,14 @@ def cmd_check_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> i
     tolerance = (
         DEFAULT_PATH_TOLERANCE
         if options.tol_deg is None
-        else _radians(options.tol_deg, "--tol-deg")
+        else _degrees_flag(options.tol_deg, "--tol-deg")
     )
     max_dpsi = (
-        None if options.max_dpsi_deg is None else _radians(options.max_dpsi_deg, "--max-dpsi-deg")
+        None
+        if options.max_dpsi_deg is None
+        else _degrees_flag(options.max_dpsi_deg, "--max-dpsi-deg")
     )
-    psi_step = _radians(options.psi_step_deg, "--psi-step-deg")
+    psi_step = _degrees_flag(options.psi_step_deg, "--psi-step-deg")
     result: PathCheck | TorsionPlan
     if waypoints.axes is not None:  # free torsion
         result = plan_torsion(
@@ -564,8 +546,7 @@ def cmd_check_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> i
         orientation = np.column_stack([result.directions, np.zeros(len(waypoints.positions))])
     else:
         assert waypoints.degrees is not None  # read_path_file gives axes or angles
-        degrees = _principal_degrees(waypoints.degrees)
-        orientation = np.radians(degrees)
+        orientation = degrees_to_radians(waypoints.degrees)  # exact for any finite degrees
         result = check_path(
             manipulator,
             waypoints.positions,
@@ -608,11 +589,9 @@ def cmd_check_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> i
     return 1
 
 
-def _radians(value: float, option: str) -> float:
-    if not math.isfinite(value):
-        msg = f"{option}: expected a finite number of degrees, got {value}"
-        raise InputError(msg)
-    return math.radians(value)
+def _degrees_flag(value: float, flag: str) -> float:
+    """A finite number of degrees from ``flag``, in rad (the core checks its range)."""
+    return math.radians(float(finite([value], flag, "degrees")[0]))
 
 
 CHECK_PATH_HELP = (

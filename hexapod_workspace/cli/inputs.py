@@ -218,7 +218,7 @@ def read_poses_file(path: str | Path) -> NDArray[np.float64]:
         if not stripped or stripped.startswith("#"):
             continue
         cells = _split(stripped)
-        header = all(_HEADER_CELL.match(c) and not _is_number(c) for c in cells if c)
+        header = all(_HEADER_CELL.match(c) and not is_number(c) for c in cells if c)
         if not numbers and header:
             continue  # the header line: a first line of names only
         numbers.append(number)
@@ -238,7 +238,7 @@ def read_poses_file(path: str | Path) -> NDArray[np.float64]:
         poses = np.array(flat, dtype=np.float64).reshape(-1, 3)
     except ValueError:
         for number, cells in zip(numbers, cells_of, strict=True):
-            bad = next((c for c in cells if not _is_number(c)), None)
+            bad = next((c for c in cells if not is_number(c)), None)
             if bad is not None:
                 hint = " (use a decimal point)" if re.fullmatch(r"-?\d+,\d+", bad) else ""
                 msg = f"poses file {name}, line {number}: {bad!r} is not a number{hint}"
@@ -255,7 +255,8 @@ def read_poses_file(path: str | Path) -> NDArray[np.float64]:
     return poses
 
 
-def _is_number(cell: str) -> bool:
+def is_number(cell: str) -> bool:
+    """Whether a CSV cell reads as a number (so a first line of names is a header)."""
     try:
         float(cell)
     except ValueError:

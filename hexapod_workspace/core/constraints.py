@@ -50,6 +50,7 @@ __all__ = [
     "pose_margins",
     "relative_margins",
     "segment_distance",
+    "violated_names",
 ]
 
 #: The constraint names, in the order of :attr:`PoseMargins.margins` rows.
@@ -337,12 +338,24 @@ class CheckResult:
     @property
     def violated(self) -> list[list[str]]:
         """Per pose, the names of the violated constraints (in :data:`CONSTRAINT_NAMES` order)."""
-        negative = np.stack([self.margins[name] < 0.0 for name in CONSTRAINT_NAMES], axis=1)
-        masks = (negative.astype(np.int64) @ (1 << np.arange(len(CONSTRAINT_NAMES)))).tolist()
-        names = [
-            [name for k, name in enumerate(CONSTRAINT_NAMES) if mask >> k & 1] for mask in range(16)
-        ]
-        return [list(names[mask]) for mask in masks]
+        return violated_names(np.stack([self.margins[name] for name in CONSTRAINT_NAMES]))
+
+
+def violated_names(margins: NDArray[np.float64]) -> list[list[str]]:
+    """Names of the negative margins per column of ``margins``, shape (4, N); NaN is violated.
+
+    Returns
+    -------
+    list of N lists of str
+        In :data:`CONSTRAINT_NAMES` order.
+    """
+    negative = ~(np.asarray(margins) >= 0.0)
+    masks = (negative.T.astype(np.int64) @ (1 << np.arange(len(CONSTRAINT_NAMES)))).tolist()
+    names = [
+        [name for k, name in enumerate(CONSTRAINT_NAMES) if mask >> k & 1]
+        for mask in range(1 << len(CONSTRAINT_NAMES))
+    ]
+    return [list(names[mask]) for mask in masks]
 
 
 def relative_margins(manipulator: Manipulator, margins: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -117,7 +117,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError, ResolutionError
 from . import planner_kernels
-from .constraints import CONSTRAINT_NAMES, PoseMargins, pose_margins, relative_margins
+from .constraints import (
+    CONSTRAINT_NAMES,
+    PoseMargins,
+    pose_margins,
+    relative_margins,
+    violated_names,
+)
 from .manipulator import Manipulator
 from .rotations import (
     approach_to_tilt,
@@ -143,6 +149,7 @@ __all__ = [
     "check_path",
     "check_waypoints",
     "plan_torsion",
+    "reported_parts",
 ]
 
 #: Interpolations between waypoints (see the module documentation).
@@ -394,13 +401,17 @@ class TorsionPlan:
     positions: NDArray[np.float64] = field(repr=False)
     directions: NDArray[np.float64] = field(repr=False)
 
+    @property
+    def reported(self) -> PathCheck:
+        """The path this plan reports: the planned one when ok, otherwise the ψ = 0 baseline."""
+        return self.path if self.ok and self.path is not None else self.baseline
 
-def violated_names(margins: NDArray[np.float64]) -> list[list[str]]:
-    """Names of the negative margins per column of ``margins`` (4, N); NaN counts as violated."""
-    negative = ~(margins >= 0.0)
-    masks = (negative.T.astype(np.int64) @ (1 << np.arange(len(CONSTRAINT_NAMES)))).tolist()
-    names = [[n for k, n in enumerate(CONSTRAINT_NAMES) if mask >> k & 1] for mask in range(16)]
-    return [list(names[mask]) for mask in masks]
+
+def reported_parts(result: PathCheck | TorsionPlan) -> tuple[PathCheck, TorsionPlan | None]:
+    """The path a result reports (:attr:`TorsionPlan.reported` for a plan) and the plan, if any."""
+    if isinstance(result, TorsionPlan):
+        return result.reported, result
+    return result, None
 
 
 # ============================================================================ inputs

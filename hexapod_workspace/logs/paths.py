@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core.paths import INTERPOLATIONS, PathCheck, SegmentChecks, TorsionPlan
+from ..core.paths import INTERPOLATIONS, PathCheck, SegmentChecks, TorsionPlan, reported_parts
 from ..core.rotations import matrix_to_quaternion, tt_to_matrix
 from . import messages
 
@@ -147,13 +147,6 @@ def segment_check_fields(segments: SegmentChecks, index: int = 0) -> dict[str, A
     return segment_checks_fields(single)[0]
 
 
-def _result_parts(result: PathCheck | TorsionPlan) -> tuple[PathCheck, TorsionPlan | None]:
-    if isinstance(result, TorsionPlan):
-        # A plan that is ok carries its path; otherwise the ψ = 0 baseline is reported.
-        return (result.path if result.ok and result.path is not None else result.baseline), result
-    return result, None
-
-
 def check_path_response_fields(
     result: PathCheck | TorsionPlan, *, pairs: bool = True, message: str | None = None
 ) -> dict[str, Any]:
@@ -169,7 +162,7 @@ def check_path_response_fields(
     message : str, optional
         Default: a one-line verdict (see :func:`path_verdict`).
     """
-    path, plan = _result_parts(result)
+    path, plan = reported_parts(result)
     waypoints = path.waypoints
     rotations = tt_to_matrix(waypoints.angles)
     baseline = plan.baseline if plan is not None else None
@@ -204,7 +197,7 @@ def failed_check_path_response_fields(reason: str) -> dict[str, Any]:
 
 def path_verdict(result: PathCheck | TorsionPlan) -> str:
     """One line: whether the path runs, else where it fails (or where no torsion continues)."""
-    path, plan = _result_parts(result)
+    path, plan = reported_parts(result)
     if plan is not None and not plan.ok and plan.breakpoint is not None:
         return f"no torsion plan: {plan.breakpoint.reason}"
     count, moves = len(path.waypoints), len(path.segments)
