@@ -31,6 +31,7 @@ import tempfile
 import threading
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -41,15 +42,18 @@ NODE_EXECUTABLE = (
 GOAL_MS = 2.0
 NODE = "/hexapod_workspace"
 FLOOR = "/latency_floor/check_poses"
-#: The reference measured in the same run: the cheapest rclpy server of the same service type
-#: (single-threaded executor, constant answer, no check), in its own process.
-FLOOR_SERVER = f"""
+
+
+def floor_server_source(service: str, node_name: str) -> str:
+    """The reference measured in the same run: the cheapest rclpy server of the same service
+    type (single-threaded executor, constant answer, no check), run as ``python -c SOURCE``."""
+    return f"""
 import rclpy
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from hexapod_workspace_msgs.srv import CheckPoses
 rclpy.init()
-node = rclpy.create_node("latency_floor")
-node.create_service(CheckPoses, "{FLOOR}", lambda request, response: CheckPoses.Response(
+node = rclpy.create_node("{node_name}")
+node.create_service(CheckPoses, "{service}", lambda request, response: CheckPoses.Response(
     success=True, message="1/1 reachable"))
 executor = SingleThreadedExecutor()
 executor.add_node(node)
@@ -61,6 +65,42 @@ finally:
     node.destroy_node()
     rclpy.try_shutdown()
 """
+
+
+FLOOR_SERVER = floor_server_source(FLOOR, "latency_floor")
+
+
+def check_requests(count: int = 1000, seed: int = 1) -> tuple[Any, Any, np.ndarray]:
+    """CheckPoses requests at (0, 0, -1.3) m: one pose, and ``count`` seeded random poses
+    (returned too, shape (count, 3), rad, for the in-process core in the same run)."""
+    from hexapod_workspace_msgs.msg import TiltTorsion
+    from hexapod_workspace_msgs.srv import CheckPoses
+
+    one = CheckPoses.Request(orientations=[TiltTorsion(phi=0.3, theta=0.2, psi=0.1)])
+    one.position.z = -1.3
+    rng = np.random.default_rng(seed)
+    angles = np.column_stack(
+        (
+            rng.uniform(-math.pi, math.pi, count),
+            rng.uniform(0.0, 0.8, count),
+            rng.uniform(-0.5, 0.5, count),
+        )
+    )
+    batch = CheckPoses.Request(
+        orientations=[TiltTorsion(phi=p, theta=t, psi=s) for p, t, s in angles.tolist()]
+    )
+    batch.position.z = -1.3
+    return one, batch, angles
+
+
+def timed_call(client: Any, request: Any) -> float:
+    """Seconds one successful CheckPoses call takes (RuntimeError when it fails)."""
+    start = time.perf_counter()
+    response = client.call(request, timeout_sec=60.0)
+    elapsed = time.perf_counter() - start
+    if response is None or not response.success:
+        raise RuntimeError(f"check_poses failed: {response}")
+    return elapsed
 
 
 def percentiles(samples_s: list[float]) -> tuple[float, float]:
@@ -130,7 +170,7 @@ def main(argv: list[str] | None = None) -> int:
 def run(args: argparse.Namespace, domain: int) -> int:
     import rclpy
     from hexapod_workspace_msgs.action import ComputeWorkspace
-    from hexapod_workspace_msgs.msg import TiltTorsion, WorkspaceRequest
+    from hexapod_workspace_msgs.msg import WorkspaceRequest
     from hexapod_workspace_msgs.srv import CheckPoses
     from rclpy.action import ActionClient
     from rclpy.executors import SingleThreadedExecutor
@@ -157,28 +197,10 @@ def run(args: argparse.Namespace, domain: int) -> int:
             print("services not discovered within 60 s", file=sys.stderr)
             return 2
 
-        def timed(request, client=checks) -> float:
-            start = time.perf_counter()
-            response = client.call(request, timeout_sec=60.0)
-            elapsed = time.perf_counter() - start
-            if response is None or not response.success:
-                raise RuntimeError(f"check_poses failed: {response}")
-            return elapsed
+        one, batch, angles = check_requests()
 
-        one = CheckPoses.Request(orientations=[TiltTorsion(phi=0.3, theta=0.2, psi=0.1)])
-        one.position.z = -1.3
-        rng = np.random.default_rng(1)
-        angles = np.column_stack(
-            (
-                rng.uniform(-math.pi, math.pi, 1000),
-                rng.uniform(0.0, 0.8, 1000),
-                rng.uniform(-0.5, 0.5, 1000),
-            )
-        )
-        batch = CheckPoses.Request(
-            orientations=[TiltTorsion(phi=p, theta=t, psi=s) for p, t, s in angles.tolist()]
-        )
-        batch.position.z = -1.3
+        def timed(request: Any, client: Any = checks) -> float:
+            return timed_call(client, request)
 
         for _ in range(50):  # warm-up (discovery of the reply path, first allocations)
             timed(one)

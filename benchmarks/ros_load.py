@@ -35,6 +35,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from ros_latency import check_requests, floor_server_source, timed_call  # same folder
 
 REPO = Path(__file__).resolve().parents[1]
 NODE_EXECUTABLE = (
@@ -42,24 +43,7 @@ NODE_EXECUTABLE = (
 )
 NODE = "/hexapod_workspace"
 FLOOR = "/load_floor/check_poses"
-FLOOR_SERVER = f"""
-import rclpy
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
-from hexapod_workspace_msgs.srv import CheckPoses
-rclpy.init()
-node = rclpy.create_node("load_floor")
-node.create_service(CheckPoses, "{FLOOR}", lambda request, response: CheckPoses.Response(
-    success=True, message="1/1 reachable"))
-executor = SingleThreadedExecutor()
-executor.add_node(node)
-try:
-    executor.spin()
-except (KeyboardInterrupt, ExternalShutdownException):
-    pass
-finally:
-    node.destroy_node()
-    rclpy.try_shutdown()
-"""
+FLOOR_SERVER = floor_server_source(FLOOR, "load_floor")
 #: Goals of issue 10.
 GOAL_P99_MS = 10.0
 GOAL_FLOOR_RATIO = 1.3
@@ -249,7 +233,6 @@ def wait_ready(process: subprocess.Popen) -> None:
 def idle_phase(samples: int) -> dict:
     """1-pose calls interleaved with the floor, and 1000-pose calls against the core."""
     import rclpy
-    from hexapod_workspace_msgs.msg import TiltTorsion
     from hexapod_workspace_msgs.srv import CheckPoses
     from rclpy.executors import SingleThreadedExecutor
 
@@ -268,36 +251,16 @@ def idle_phase(samples: int) -> dict:
             if not client.wait_for_service(timeout_sec=60):
                 raise RuntimeError("services not discovered within 60 s")
 
-        def timed(request, client) -> float:
-            start = time.perf_counter()
-            response = client.call(request, timeout_sec=60.0)
-            elapsed = time.perf_counter() - start
-            if response is None or not response.success:
-                raise RuntimeError(f"check_poses failed: {response}")
-            return elapsed
-
-        one = CheckPoses.Request(orientations=[TiltTorsion(phi=0.3, theta=0.2, psi=0.1)])
-        one.position.z = -1.3
-        rng = np.random.default_rng(1)
-        angles = np.column_stack(
-            (
-                rng.uniform(-math.pi, math.pi, 1000),
-                rng.uniform(0.0, 0.8, 1000),
-                rng.uniform(-0.5, 0.5, 1000),
-            )
-        )
-        batch = CheckPoses.Request(
-            orientations=[TiltTorsion(phi=p, theta=t, psi=s) for p, t, s in angles.tolist()]
-        )
-        batch.position.z = -1.3
+        one, batch, angles = check_requests()
+        timed = timed_call  # timed(client, request)
         for _ in range(30):
-            timed(one, checks)
-            timed(one, floor)
+            timed(checks, one)
+            timed(floor, one)
         node_one, floor_one = [], []
         for _ in range(samples):
-            node_one.append(timed(one, checks))
-            floor_one.append(timed(one, floor))
-        batched = [timed(batch, checks) for _ in range(max(10, samples // 10))]
+            node_one.append(timed(checks, one))
+            floor_one.append(timed(floor, one))
+        batched = [timed(checks, batch) for _ in range(max(10, samples // 10))]
         manipulator = Manipulator.from_params_file(example_config_path())
         core = []
         for _ in range(len(batched)):
