@@ -38,6 +38,7 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -45,7 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ConfigError, InputError
 from .manipulator import Manipulator, _describe, _frozen, _numbers, _vector3
-from .params import flatten
+from .params import flatten, load_params_file
 from .rotations import tt_to_matrix
 
 __all__ = [
@@ -54,6 +55,7 @@ __all__ = [
     "Tool",
     "WorkFrame",
     "cell_from_mapping",
+    "cell_from_params_file",
     "platform_pose",
     "tool_model",
     "tool_pose",
@@ -267,6 +269,23 @@ def cell_from_mapping(parameters: Mapping[str, Any]) -> CellFrames:
         msg = f"{name}: expected values >= 0 (0 = unlimited), got {_describe(speeds.tolist())}"
         raise ConfigError(msg)
     return CellFrames(tool, work, tools, _frozen(np.broadcast_to(speeds, (6,)).copy()))
+
+
+def cell_from_params_file(path: str | Path) -> CellFrames:
+    """:func:`cell_from_mapping` of a ROS 2 parameters file (the one the CLI reads).
+
+    Raises
+    ------
+    ConfigError
+        Unreadable file, or a cell parameter :func:`cell_from_mapping` refuses (prefixed with
+        the file name).
+    """
+    parameters = load_params_file(path)
+    try:
+        return cell_from_mapping(parameters)
+    except ConfigError as error:
+        msg = f"parameters file {path}: {error}"
+        raise ConfigError(msg) from error
 
 
 def tool_model(manipulator: Manipulator, tool: Tool) -> Manipulator:

@@ -18,7 +18,14 @@ from numpy.typing import NDArray
 
 from ..errors import ConfigError, GeometryError
 from .constraints import check
-from .params import CELL_PARAMETERS, NODE_PARAMETERS, ROS_PARAMETERS, flatten, load_params_file, unknown_parameter
+from .params import (
+    CELL_PARAMETERS,
+    NODE_PARAMETERS,
+    ROS_PARAMETERS,
+    flatten,
+    load_params_file,
+    unknown_parameter,
+)
 from .resolution import MAX_POSITION_NORM
 
 __all__ = ["PARAMETER_DEFAULTS", "HomePoseWarning", "Manipulator"]
