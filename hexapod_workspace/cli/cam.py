@@ -61,7 +61,7 @@ from ..core.paths import (
     reported_parts,
 )
 from ..core.rotations import degrees_to_radians, matrix_to_tt, tt_to_matrix
-from ..core.speeds import actuator_rates, feed_limits
+from ..core.speeds import UPS, actuator_rates, feed_limits
 from .check_path import (
     _degrees_flag,
     _text,
@@ -385,6 +385,7 @@ def _speed_summary(documents: list[dict[str, Any]], limits: NDArray[np.float64])
                 )
             without += segment["duration_s"] is None
     return {
+        "actuator_unit": UPS.unit,
         "actuator_speed_max": limits.tolist(),
         "limited": bool(np.any(limits > 0.0)),
         "moves_to_slow_down": slow,
@@ -469,5 +470,6 @@ def _speed_text(report: dict[str, Any], out: IO[str]) -> None:
         )
         out.write(
             f"  part {move['part']} move {move['segment']}: actuator speed up to "
-            f"{move['actuator_speed_peak']:.4g}/s, slow down to {limit}\n"
+            f"{move['actuator_speed_peak']:.4g} {speed['actuator_unit']}/s (limit "
+            f"{max(speed['actuator_speed_max']):g}), slow down to {limit}\n"
         )

@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._resources import example_config_path
-from ..core.frames import CellFrames, cell_from_params_file, work_to_base
+from ..core.frames import CellFrames, Tool, cell_from_params_file, tool_model, work_to_base
 from ..core.manipulator import Manipulator
 from ..core.paths import DEFAULT_PATH_TOLERANCE
 from ..core.reach import AXES, DEFAULT_T_MAX, DEFAULT_T_MAX_ROTATION, Reach, axis_limits, reach
@@ -77,6 +77,12 @@ def _common(parser: argparse.ArgumentParser, frames: tuple[str, ...]) -> None:
         choices=frames,
         default="base",
         help="frame of --position, --pose and the direction or axes (default: base)",
+    )
+    parser.add_argument(
+        "--tool",
+        type=int,
+        metavar="N",
+        help="the tool of the tool table tools.T<N> (default: tool.*)",
     )
     parser.add_argument(
         "--tol-deg",
@@ -131,14 +137,18 @@ def _pose(
 ) -> tuple[
     Manipulator,
     CellFrames,
+    Tool,
     NDArray[np.float64],
     NDArray[np.float64],
     NDArray[np.float64],
     float,
 ]:
-    """Model (tool frame), cell, rotation and position in the base frame, frame rotation, tol."""
-    manipulator = load_manipulator(options.config, None, err)
+    """Model (tool frame), cell, tool, rotation and position in the base frame, frame rotation,
+    tolerance."""
+    platform = load_manipulator(options.config, None, err, with_tool=False)
     cell = cell_from_params_file(options.config or example_config_path())
+    tool = cell.tool if options.tool is None else cell.select(options.tool)
+    manipulator = tool_model(platform, tool)
     position = (
         manipulator.position
         if options.position is None
@@ -158,15 +168,15 @@ def _pose(
         if options.tol_deg is None
         else math.radians(float(finite([options.tol_deg], "--tol-deg", "degrees")[0]))
     )
-    return manipulator, cell, rotation, position, frame_rotation, tolerance
+    return manipulator, cell, tool, rotation, position, frame_rotation, tolerance
 
 
-def _frames_json(options: argparse.Namespace, cell: CellFrames) -> dict[str, Any]:
+def _frames_json(options: argparse.Namespace, cell: CellFrames, tool: Tool) -> dict[str, Any]:
     return {
         "frame": options.frame,
         "position": None if options.position is None else list(options.position),
         "pose_deg": list(options.pose),
-        "tool": tool_json(cell.tool),
+        "tool": tool_json(tool),
         "work_frame": work_json(cell.work),
     }
 
@@ -189,7 +199,7 @@ def _unreachable(result: Reach, err: IO[str]) -> int:
 
 def cmd_reach(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
     """``reach``: the largest steps along ±direction from the pose."""
-    manipulator, cell, rotation, position, frame_rotation, tolerance = _pose(options, err)
+    manipulator, cell, tool, rotation, position, frame_rotation, tolerance = _pose(options, err)
     direction = finite(options.direction, "--direction", "m and rad")
     t_max = float(finite([options.t_max], "--t-max", "units of t")[0])
     result = reach(
@@ -207,7 +217,7 @@ def cmd_reach(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
         "start_reachable": result.start_reachable,
         "direction": {"translation": direction[:3].tolist(), "rotation": direction[3:].tolist()},
         "tolerance_deg": math.degrees(tolerance),
-        **_frames_json(options, cell),
+        **_frames_json(options, cell, tool),
     }
     if options.json:
         out.write(json.dumps(document, allow_nan=False) + "\n")
@@ -221,7 +231,7 @@ def cmd_reach(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
 
 def cmd_axis_limits(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
     """``axis-limits``: the ± reach along the six axes of a frame."""
-    manipulator, cell, rotation, position, _, tolerance = _pose(options, err)
+    manipulator, cell, tool, rotation, position, _, tolerance = _pose(options, err)
     t_max = float(finite([options.max_translation], "--max-translation", "m")[0])
     rotation_max = float(finite([options.max_rotation_deg], "--max-rotation-deg", "degrees")[0])
     if not 0.0 < rotation_max < 180.0:
@@ -238,7 +248,7 @@ def cmd_axis_limits(options: argparse.Namespace, out: IO[str], err: IO[str]) -> 
         tolerance=tolerance,
     )
     document = {
-        **_frames_json(options, cell),
+        **_frames_json(options, cell, tool),
         "axes": {
             name: _limits_json(limits[name], 1.0 if k < 3 else math.degrees(1.0))
             for k, name in enumerate(AXES)
