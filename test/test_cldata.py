@@ -87,6 +87,12 @@ def test_rapid_applies_to_the_next_motion_only_and_axis_defaults_to_work_z():
     assert np.isnan(program.feeds).all()  # no FEDRAT: no feed
 
 
+def test_unitless_feed_is_per_minute_in_the_current_units():
+    program = parse_cldata("UNITS/INCHES\nFEDRAT/10\nGOTO/0,0,0\nUNITS/MM\nGOTO/25.4,0,0\n")
+    assert program.feeds[1] == pytest.approx(10 * 0.0254 / 60)  # set in in/min, kept
+    np.testing.assert_allclose(program.positions[1], [0.0254, 0, 0])
+
+
 def test_tool_change_splits_the_path():
     program = parse_cldata(
         "LOADTL/1\nGOTO/0,0,0\nGOTO/1,0,0\nLOADTL/2\nGOTO/1,0,5\nFEDRAT/100\nGOTO/2,0,5\n",

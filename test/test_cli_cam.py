@@ -174,6 +174,13 @@ def test_reach_and_axis_limits_json():
         assert set(axis) == {"plus", "minus", "limited_by_plus", "limited_by_minus"}
         assert axis["plus"] >= 0 and axis["minus"] >= 0
     assert document["axes"]["rz"]["plus"] > 10.0  # degrees
+    assert document["tool"]["offset"] == [0.0, 0.0, -0.06]  # tool.*
+    code, out, _ = run_main(
+        "--config", str(CELL), "axis-limits", "--tool", "2", "--json"
+    )  # fmt: skip
+    assert code == 0 and json.loads(out)["tool"]["offset"] == [0.0, 0.0, -0.095]
+    code, _, err = run_main("--config", str(CELL), "axis-limits", "--tool", "3")
+    assert code == 2 and "tool 3: not in the tool table" in one_error_line(err)
     code, out, _ = run_main(
         "--config", str(CELL), "--position", "0", "0", "0.01", "reach", "--frame", "work",
         "--direction", "0", "0", "-1", "0", "0", "0", "--t-max", "0.5", "--json",
