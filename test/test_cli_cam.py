@@ -213,6 +213,14 @@ def test_bad_cl_input_exits_2_in_one_line(tmp_path, text, extra, message):
     assert pytest.importorskip("re").search(message, one_error_line(err))
 
 
+def test_one_goto_for_a_tool_is_refused(tmp_path):
+    path = tmp_path / "short.cl"
+    path.write_text("LOADTL/1\nGOTO/0,0,0\nGOTO/1,0,0\nLOADTL/2\nGOTO/0,0,5\n", encoding="utf-8")
+    code, _, err = run_main("--config", str(CELL), "check-path", str(path))
+    assert code == 2
+    assert "line 5: the only GOTO of tool 2; expected at least 2 GOTO" in one_error_line(err)
+
+
 def test_bad_flags_exit_2(tmp_path):
     csv = tmp_path / "p.csv"
     csv.write_text("x,y,z,i,j,k\n0,0,-1.3,0,0,1\n0.01,0,-1.3,0,0,1\n", encoding="utf-8")

@@ -185,9 +185,11 @@ class _Part:
         rapid: NDArray[np.bool_],
         lines: NDArray[np.int64] | None,
         first: int,
+        written: bool = False,
     ) -> None:
         self.tool, self.positions, self.axes, self.degrees = tool, positions, axes, degrees
         self.feeds, self.rapid, self.lines, self.first = feeds, rapid, lines, first
+        self.written = written  # degrees are the file's own (base frame): echoed as given
 
 
 def _read_parts(
@@ -218,13 +220,13 @@ def _read_parts(
                     start,
                 )
             )
-        if any(stop - start < 2 for start, stop in program.parts):
-            short = next(k for k, (a, b) in enumerate(program.parts) if b - a < 2)
-            msg = (
-                f"CL file {options.file}: part {short} (after a tool change) has one waypoint; "
-                "expected at least 2 GOTO per tool"
-            )
-            raise CliError(msg)
+        for start, stop in program.parts:
+            if stop - start < 2:
+                msg = (
+                    f"CL file {options.file}: line {program.lines[start]}: the only GOTO of "
+                    f"tool {program.tools[start]}; expected at least 2 GOTO (one move) per tool"
+                )
+                raise CliError(msg)
         return parts, list(program.ignored)
     waypoints = read_path_file(options.file)
     count = len(waypoints.positions)
@@ -236,10 +238,22 @@ def _read_parts(
         part = _Part(cell.tool, positions, axes, None, feeds, np.zeros(count, bool), None, 0)
     else:
         assert waypoints.degrees is not None  # read_path_file gives axes or angles
-        local = tt_to_matrix(degrees_to_radians(waypoints.degrees))
-        rotation, _ = work_to_base(local, np.zeros((count, 3)), work)
-        degrees = np.degrees(matrix_to_tt(rotation))
-        part = _Part(cell.tool, positions, None, degrees, feeds, np.zeros(count, bool), None, 0)
+        degrees = waypoints.degrees  # as written: reported as given in the base frame
+        if frame == "work":
+            local = tt_to_matrix(degrees_to_radians(waypoints.degrees))
+            rotation, _ = work_to_base(local, np.zeros((count, 3)), work)
+            degrees = np.degrees(matrix_to_tt(rotation))
+        part = _Part(
+            cell.tool,
+            positions,
+            None,
+            degrees,
+            feeds,
+            np.zeros(count, bool),
+            None,
+            0,
+            written=frame == "base",
+        )
     return [part], []
 
 
@@ -325,7 +339,7 @@ def _check_part(
             tolerance=tolerance,
         )
         baseline = psi_zero_baseline(model, result)
-    document = path_to_json(result, baseline)
+    document = path_to_json(result, baseline, part.degrees if part.written else None)
     checked, _ = reported_parts(result)
     moves = len(checked.segments)
     rapid_feed, rotary_feed = feeds
