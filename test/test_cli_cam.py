@@ -213,6 +213,27 @@ def test_bad_cl_input_exits_2_in_one_line(tmp_path, text, extra, message):
     assert pytest.importorskip("re").search(message, one_error_line(err))
 
 
+def test_rapid_without_a_rapid_feed_has_no_verdict_and_speeds_need_slerp(tmp_path):
+    path = tmp_path / "rapid.cl"
+    path.write_text(
+        "FEDRAT/600\nGOTO/0,0,-1300\nGOTO/10,0,-1300\nRAPID\nGOTO/10,0,-1250\n"
+        "GOTO/0,0,-1250\n",
+        encoding="utf-8",
+    )
+    code, out, _ = run_main("check-path", str(path), "--json")
+    document = json.loads(out)
+    assert code == 0
+    rapid = document["segments"][1]
+    assert rapid["rapid"] and rapid["duration_s"] is None and rapid["speed_ok"] is None
+    assert "no feed" in rapid["speed_note"]
+    assert document["segments"][2]["feed_mm_min"] == pytest.approx(600.0)
+    assert document["speed"]["moves_without_feed"] == 1
+    assert document["speed"]["limited"] is False  # the packaged example has no speed limit
+    assert document["segments"][2]["feed_max_mm_min"] is None
+    code, _, err = run_main("check-path", str(path), "--interpolation", "tilt-torsion")
+    assert code == 2 and "needs --interpolation slerp" in one_error_line(err)
+
+
 def test_one_goto_for_a_tool_is_refused(tmp_path):
     path = tmp_path / "short.cl"
     path.write_text("LOADTL/1\nGOTO/0,0,0\nGOTO/1,0,0\nLOADTL/2\nGOTO/0,0,5\n", encoding="utf-8")
