@@ -216,8 +216,7 @@ def test_bad_cl_input_exits_2_in_one_line(tmp_path, text, extra, message):
 def test_rapid_without_a_rapid_feed_has_no_verdict_and_speeds_need_slerp(tmp_path):
     path = tmp_path / "rapid.cl"
     path.write_text(
-        "FEDRAT/600\nGOTO/0,0,-1300\nGOTO/10,0,-1300\nRAPID\nGOTO/10,0,-1250\n"
-        "GOTO/0,0,-1250\n",
+        "FEDRAT/600\nGOTO/0,0,-1300\nGOTO/10,0,-1300\nRAPID\nGOTO/10,0,-1250\nGOTO/0,0,-1250\n",
         encoding="utf-8",
     )
     code, out, _ = run_main("check-path", str(path), "--json")
