@@ -72,7 +72,8 @@ def test_cl_file_checks_like_the_equivalent_csv(tmp_path):
     assert from_cl["speed"]["moves_without_feed"] == 11
 
 
-def test_worked_example_with_tool_change_and_feeds():
+def test_worked_example_with_tool_change_and_feeds(tmp_path):
+    plot = tmp_path / "speeds.png"
     code, out, err = run_main(
         "--config",
         str(CELL),
@@ -82,8 +83,11 @@ def test_worked_example_with_tool_change_and_feeds():
         "2400",
         "--rotary-feed-deg-min",
         "360",
+        "--plot",
+        str(plot),
         "--json",
     )
+    assert plot.read_bytes().startswith(b"\x89PNG\r\n\x1a\n")
     document = json.loads(out)
     assert document["frame"] == "work" and len(document["parts"]) == 2
     assert [p["tool"]["number"] for p in document["parts"]] == [1, 2]

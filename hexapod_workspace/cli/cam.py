@@ -73,7 +73,7 @@ from .check_path import (
     read_path_file,
 )
 from .commands import PROG
-from .inputs import CliError, finite, load_manipulator
+from .inputs import PLOT_FORMATS, CliError, finite, load_manipulator, output_file
 
 __all__ = [
     "FRAMES",
@@ -410,12 +410,17 @@ def _speed_summary(documents: list[dict[str, Any]], limits: NDArray[np.float64])
 
 def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
     """``check-path`` for CL files, frames and feeds (see the module documentation)."""
-    if options.record is not None or options.plot is not None:
+    if options.record is not None:
         msg = (
-            "check-path: --record and --plot are not available with CL files, --frame or "
-            "feeds yet; check the path without them for a log or a plot"
+            "check-path: --record is not available with CL files, --frame or feeds yet; "
+            "check the path without them for a log"
         )
         raise CliError(msg)
+    plot = (
+        None
+        if options.plot is None
+        else output_file(options.plot, "--plot", force=options.force, suffixes=PLOT_FORMATS)
+    )
     # the platform frame's model: each part's tool model is built from it
     platform = load_manipulator(options.config, None, err, with_tool=False)
     cell = cell_from_params_file(options.config or example_config_path())
@@ -443,9 +448,13 @@ def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str])
         report: dict[str, Any] = {**documents[0], **common, "ok": ok}
     else:
         report = {"ok": ok, **common, "parts": documents}
+    if plot is not None:
+        plot_speeds(documents, speed, plot)
     if options.json:
         out.write(json.dumps(report, allow_nan=False) + "\n")
     else:
+        if plot is not None:
+            out.write(f"  plot: {plot}\n")
         for k, (result, document) in enumerate(zip(results, documents, strict=True)):
             tool = document["tool"]
             name = f"T{tool['number']}" if tool["number"] else "tool.*"
@@ -487,3 +496,125 @@ def _speed_text(report: dict[str, Any], out: IO[str]) -> None:
             f"{move['actuator_speed_peak']:.4g} {speed['actuator_unit']}/s (limit "
             f"{max(speed['actuator_speed_max']):g}), slow down to {limit}\n"
         )
+
+
+def plot_speeds(documents: list[dict[str, Any]], speed: dict[str, Any], path: Path) -> Path:
+    """Per move: the certified peak actuator speed against the limit, and the programmed feed
+    against ``feed_max``; tool changes as vertical lines.
+
+    Parameters
+    ----------
+    documents : list of dict
+        The parts' documents (with the speed keys of :func:`cmd_check_cell_path`).
+    speed : dict
+        The ``speed`` summary.
+    path : Path
+        Image file (.png, .pdf, .svg).
+    """
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Patch
+
+    figure = Figure(figsize=(11.0, 6.0))
+    top, bottom = figure.subplots(2, 1, sharex=True)
+    offset = 0
+    unit = speed["actuator_unit"]
+    used: set[str] = set()
+
+    def once(label: str) -> str | None:
+        """Each legend entry once, from whichever part first has it."""
+        if label in used:
+            return None
+        used.add(label)
+        return label
+
+    for document in documents:
+        segments = document["segments"]
+        index = offset + np.arange(len(segments))
+        peak = np.array(
+            [
+                np.nan if s["actuator_speed_peak"] is None else s["actuator_speed_peak"]
+                for s in segments
+            ]
+        )
+        rapid = np.array([s["rapid"] for s in segments])
+        rotary = np.array(["feed_deg_min" in s for s in segments])
+        top.bar(index, peak, color=np.where(rapid, "tab:orange", "tab:blue"))
+        feed = np.array(
+            [np.nan if s.get("feed_mm_min") is None else s["feed_mm_min"] for s in segments]
+        )
+        feed_max = np.array(
+            [np.nan if s["feed_max_mm_min"] is None else s["feed_max_mm_min"] for s in segments]
+        )
+        bottom.plot(
+            index,
+            feed,
+            "o",
+            color="tab:blue",
+            ms=4,
+            label=once("programmed feed"),
+        )
+        bottom.plot(
+            index,
+            feed_max,
+            "v",
+            color="tab:red",
+            ms=5,
+            label=once("feed_max (certified)"),
+        )
+        if rotary.any():
+            rotary_feed = np.array([s.get("feed_deg_min") or np.nan for s in segments])
+            rotary_max = np.array([s.get("feed_max_deg_min") or np.nan for s in segments])
+            bottom.plot(
+                index,
+                rotary_feed,
+                "s",
+                color="tab:green",
+                ms=4,
+                label=once("rotary feed [deg/min]"),
+            )
+            bottom.plot(
+                index,
+                rotary_max,
+                "^",
+                color="tab:green",
+                ms=5,
+                mfc="none",
+                label=once("rotary feed_max [deg/min]"),
+            )
+        tool = document["tool"]["number"]
+        for axes in (top, bottom):
+            axes.axvline(offset - 0.5, color="gray", lw=0.8, ls=":")
+        top.text(
+            offset - 0.4,
+            0.98,
+            f"T{tool}" if tool else "tool.*",
+            transform=top.get_xaxis_transform(),
+            va="top",
+            fontsize=8,
+        )
+        offset += len(segments)
+    limits = [v for v in speed["actuator_speed_max"] if v > 0]
+    if limits:
+        top.axhline(
+            min(limits), color="tab:red", lw=1.2, ls="--", label=f"limit {min(limits):g} {unit}/s"
+        )
+    handles, _ = top.get_legend_handles_labels()
+    handles += [
+        Patch(color="tab:blue", label="certified peak actuator speed"),
+        Patch(color="tab:orange", label="RAPID move"),
+    ]
+    top.set_ylabel(f"actuator speed [{unit}/s]")
+    top.set_title("Certified peak actuator speed per move (bars) against the limit", fontsize=10)
+    top.legend(handles=handles, fontsize=7, loc="center left")
+    top.grid(alpha=0.3)
+    bottom.set_yscale("log")
+    bottom.set_ylabel("feed [mm/min or deg/min]")
+    bottom.set_xlabel("move (parts in order; dotted lines: tool changes)")
+    bottom.set_title(
+        "Programmed feed and the largest feed within every actuator limit", fontsize=10
+    )
+    bottom.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=4)
+    bottom.grid(alpha=0.3, which="both")
+    figure.tight_layout()
+    figure.savefig(path, dpi=120, bbox_inches="tight")
+    return path
