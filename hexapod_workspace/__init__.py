@@ -9,7 +9,9 @@ Units are SI (m, rad). Orientations are Tilt-and-Torsion angles (φ, θ, ψ) wit
 
 from .atlas import workspace_atlas
 from .core.atlas import AtlasGrid, AtlasOptions
+from .core.cldata import CLProgram, parse_cldata, read_cldata
 from .core.constraints import CONSTRAINT_NAMES, CheckResult, check
+from .core.frames import CellFrames, Tool, WorkFrame, cell_from_mapping, tool_model
 from .core.manipulator import HomePoseWarning, Manipulator
 from .core.orientation import (
     OrientationSlice,
@@ -20,6 +22,8 @@ from .core.orientation import (
 )
 from .core.paths import PathCheck, TorsionPlan, check_path, check_waypoints, plan_torsion
 from .core.projected import ProjectedWorkspace, projected_workspace
+from .core.reach import Reach, axis_limits, reach
+from .core.speeds import actuator_rates, feed_limits
 from .errors import (
     AtlasError,
     ConfigError,
@@ -40,6 +44,8 @@ __all__ = [
     "AtlasError",
     "AtlasGrid",
     "AtlasOptions",
+    "CLProgram",
+    "CellFrames",
     "CheckResult",
     "ConfigError",
     "GeometryError",
@@ -53,17 +59,28 @@ __all__ = [
     "OrientationWorkspace",
     "PathCheck",
     "ProjectedWorkspace",
+    "Reach",
     "RecordingError",
     "ResolutionError",
+    "Tool",
     "TorsionPlan",
     "TorsionRange",
     "UnreachableReferenceError",
+    "WorkFrame",
+    "actuator_rates",
+    "axis_limits",
+    "cell_from_mapping",
     "check",
     "check_path",
     "check_waypoints",
+    "feed_limits",
     "orientation_workspace",
+    "parse_cldata",
     "plan_torsion",
     "projected_workspace",
+    "reach",
+    "read_cldata",
+    "tool_model",
     "torsion_range",
     "workspace_atlas",
 ]

@@ -561,6 +561,7 @@ def cmd_check_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> i
         else psi_zero_baseline(manipulator, result)
     )
     document = path_to_json(result, baseline, degrees)
+    document["frame"] = "base"
     if record is not None:
         from ..logs.paths import check_path_request_fields
 
@@ -603,13 +604,17 @@ CHECK_PATH_DESCRIPTION = (
     "for fixed orientations, or x,y,z,i,j,k for tool axes (the torsion is then planned: "
     "largest smallest margin on a psi grid). Between waypoints the position is linear and "
     "the orientation follows the interpolation; every move is checked with Lipschitz "
-    "bounds, so no violation wider than the tolerance is missed. Positions come from FILE."
+    "bounds, so no violation wider than the tolerance is missed. Positions come from FILE. "
+    "FILE may also be an APT cutter-location file (CLDATA: .cl, .cls, .apt, .ncl, or a file "
+    "with GOTO/ lines): GOTO, FEDRAT, RAPID, UNITS, MULTAX, LOADTL (tool table tools.T<n>), "
+    "in the work frame (work.*); with feeds, every move gets its certified peak actuator "
+    "speed against limits.actuator_speed_max and the largest feed within it."
 )
 
 
 def check_path_arguments(sub: argparse.ArgumentParser) -> None:
     """The ``check-path`` command's own options."""
-    sub.add_argument("file", metavar="FILE", help="path CSV (see above)")
+    sub.add_argument("file", metavar="FILE", help="path CSV or APT CL file (see above)")
     sub.add_argument(
         "--interpolation",
         choices=INTERPOLATIONS,

@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 
 from .._resources import example_config_path
 from ..core import resolution
+from ..core.frames import cell_from_params_file, tool_model
 from ..core.manipulator import Manipulator
 from ..core.rotations import degrees_to_radians
 from ..errors import HexapodWorkspaceError, InputError
@@ -100,16 +101,25 @@ def poses_from_degrees(degrees: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def load_manipulator(
-    config: str | Path | None, position: NDArray[np.float64] | None, err: IO[str]
+    config: str | Path | None,
+    position: NDArray[np.float64] | None,
+    err: IO[str],
+    *,
+    with_tool: bool = True,
 ) -> Manipulator:
     """The manipulator of ``--config`` (default: the packaged example), at ``--position``.
 
-    Warnings of the model (an unreachable home pose) go to ``err`` as one line each.
+    Warnings of the model (an unreachable home pose) go to ``err`` as one line each. With
+    ``tool.offset`` / ``tool.orientation`` in the file, the model answers for the tool frame's
+    poses (:func:`hexapod_workspace.core.frames.tool_model`), unless ``with_tool`` is False
+    (the platform frame's model).
     """
     path = Path(config) if config else example_config_path()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         manipulator = Manipulator.from_params_file(path)
+    if with_tool:
+        manipulator = tool_model(manipulator, cell_from_params_file(path).tool)
     for warning in caught:
         err.write(f"hexapod-workspace: warning: {warning.message}\n")
     if position is None:

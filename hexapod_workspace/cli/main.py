@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from .. import __version__
 from ..core import kernels, resolution
 from ..errors import HexapodWorkspaceError
-from . import atlas, check_path, commands
+from . import atlas, cam, check_path, commands, reach
 from .inputs import (
     PLOT_FORMATS,
     CliError,
@@ -412,8 +412,8 @@ for _command in (
         "check-path",
         check_path.CHECK_PATH_HELP,
         check_path.CHECK_PATH_DESCRIPTION,
-        check_path.check_path_arguments,
-        check_path.cmd_check_path,
+        cam.check_path_any_arguments,
+        cam.cmd_check_path_any,
         uses=("config", "json"),
     ),
     Command(
@@ -423,6 +423,20 @@ for _command in (
         atlas.atlas_arguments,
         atlas.cmd_atlas,
         uses=("config", "json"),
+    ),
+    Command(
+        "reach",
+        reach.REACH_HELP,
+        reach.REACH_DESCRIPTION,
+        reach.reach_arguments,
+        reach.cmd_reach,
+    ),
+    Command(
+        "axis-limits",
+        reach.AXIS_LIMITS_HELP,
+        reach.AXIS_LIMITS_DESCRIPTION,
+        reach.axis_limits_arguments,
+        reach.cmd_axis_limits,
     ),
 ):
     register(_command)

@@ -18,7 +18,14 @@ from numpy.typing import NDArray
 
 from ..errors import ConfigError, GeometryError
 from .constraints import check
-from .params import NODE_PARAMETERS, ROS_PARAMETERS, flatten, load_params_file, unknown_parameter
+from .params import (
+    CELL_PARAMETERS,
+    NODE_PARAMETERS,
+    ROS_PARAMETERS,
+    flatten,
+    load_params_file,
+    unknown_parameter,
+)
 from .resolution import MAX_POSITION_NORM
 
 __all__ = ["PARAMETER_DEFAULTS", "HomePoseWarning", "Manipulator"]
@@ -198,7 +205,9 @@ class Manipulator:
         unknown = sorted(
             name
             for name in flat
-            if name.startswith(_MODEL_GROUPS) and name not in PARAMETER_DEFAULTS
+            if name.startswith(_MODEL_GROUPS)
+            and name not in PARAMETER_DEFAULTS
+            and name not in CELL_PARAMETERS
         )
         if unknown:
             msg = f"{unknown[0]}: unknown parameter (expected one of {_model_names()})"
@@ -332,7 +341,7 @@ class Manipulator:
         """
         parameters = load_params_file(path)
         unknown = unknown_parameter(
-            parameters, (*PARAMETER_DEFAULTS, *NODE_PARAMETERS, *ROS_PARAMETERS)
+            parameters, (*PARAMETER_DEFAULTS, *NODE_PARAMETERS, *CELL_PARAMETERS, *ROS_PARAMETERS)
         )
         if unknown is not None:
             msg = f"parameters file {path}: {unknown}"

@@ -15,6 +15,7 @@ from typing import Any
 from ..errors import ConfigError
 
 __all__ = [
+    "CELL_PARAMETERS",
     "NODE_NAME",
     "NODE_PARAMETERS",
     "ROS_PARAMETERS",
@@ -42,6 +43,17 @@ NODE_PARAMETERS = (
     "recording.enabled",
     "recording.directory",
     "motion.current_pose_topic",
+)
+#: Parameters of the machining cell (tool and work frames, tool table, actuator speeds), read by
+#: :func:`hexapod_workspace.core.frames.cell_from_mapping`; ``tools.`` holds ``tools.T<n>.*``.
+CELL_PARAMETERS = (
+    "tool.offset",
+    "tool.orientation",
+    "work.origin",
+    "work.orientation",
+    "work.frame_id",
+    "tools.",
+    "limits.actuator_speed_max",
 )
 #: Parameters every ROS 2 node has (prefixes end with a dot).
 ROS_PARAMETERS = ("use_sim_time", "start_type_description_service", "qos_overrides.")

@@ -1,0 +1,620 @@
+"""``check-path`` for a machining cell: CL files (APT CLDATA), work/tool frames, feeds against
+actuator speeds.
+
+:func:`cmd_check_path_any` (the ``check-path`` command) runs :func:`cmd_check_cell_path` when
+the file is a CL file (by suffix, or by content: a line starting with ``GOTO/``) or when one of
+``--frame``, ``--feed-mm-min``, ``--rapid-feed-mm-min``, ``--rotary-feed-deg-min`` is given, and
+:func:`hexapod_workspace.cli.check_path.cmd_check_path` otherwise.
+
+Frames. CL coordinates are in the work frame (``work.*``; the default work frame is the base
+frame), CSV coordinates in the base frame; ``--frame base|work`` says otherwise. Results report
+positions and angles in that same frame (top-level ``frame`` key). The tool frame is ``tool.*``
+until a ``LOADTL/n`` selects ``tools.T<n>``; every ``LOADTL`` between moves starts a new *part*
+(the controller stops for the tool change).
+
+JSON. A path of one part has the document of a CSV path plus ``frame``, ``tool``,
+``work_frame``, ``ignored`` and ``speed``; every move (``segments[k]``) gains ``duration_s``,
+``feed_mm_min`` (or ``feed_deg_min`` for a rotation without translation), ``rapid``,
+``actuator_speed_peak`` (certified bound, actuator unit/s, the largest over the actuators),
+``speed_ok`` and ``feed_max_mm_min`` (``feed_max_deg_min`` for a rotation; ``null`` when no
+limit applies); a CL path's waypoints gain ``line``. A path with tool changes has ``ok``,
+``frame``, ``work_frame``, ``ignored``, ``speed`` and ``parts``: one such document per part with
+``first_waypoint``.
+
+Speeds. ``limits.actuator_speed_max`` (one or six values, actuator unit/s, 0 = unlimited). A
+move's feed is the CL file's ``FEDRAT`` (``--feed-mm-min`` before the first one, and for CSV
+files), ``--rapid-feed-mm-min`` for ``RAPID`` moves and ``--rotary-feed-deg-min`` for moves
+without translation; a move without one has no duration and no speed verdict (``null``, and the
+summary counts it). The check covers the actuator speeds along the programmed moves, each at its
+constant feed; corner blending and accelerations are the controller's.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .._resources import example_config_path
+from ..core.cldata import CL_SUFFIXES, CLProgram, looks_like_cldata, read_cldata
+from ..core.frames import (
+    CellFrames,
+    Tool,
+    WorkFrame,
+    cell_from_params_file,
+    tool_model,
+    vectors_to_base,
+    work_to_base,
+)
+from ..core.manipulator import Manipulator
+from ..core.paths import (
+    DEFAULT_PATH_TOLERANCE,
+    PathCheck,
+    TorsionPlan,
+    check_path,
+    plan_torsion,
+    reported_parts,
+)
+from ..core.rotations import degrees_to_radians, matrix_to_tt, tt_to_matrix
+from ..core.speeds import UPS, actuator_rates, feed_limits
+from .check_path import (
+    _degrees_flag,
+    _text,
+    _where,
+    check_path_arguments,
+    cmd_check_path,
+    path_to_json,
+    psi_zero_baseline,
+    read_path_file,
+)
+from .commands import PROG
+from .inputs import PLOT_FORMATS, CliError, finite, load_manipulator, output_file
+
+__all__ = [
+    "FRAMES",
+    "SPEED_COVERAGE",
+    "cell_arguments",
+    "cell_pipeline_applies",
+    "check_path_any_arguments",
+    "cmd_check_cell_path",
+    "cmd_check_path_any",
+    "is_cl_file",
+    "tool_json",
+    "work_json",
+]
+
+#: Frames a position on the command line or in a file may be given in.
+FRAMES = ("base", "work")
+#: What the speed check covers (said in every result).
+SPEED_COVERAGE = (
+    "actuator speeds along the programmed moves, each at its constant feed (certified bound); "
+    "corner blending and accelerations are the controller's"
+)
+_MM_MIN = 1e-3 / 60.0  # m/s per mm/min
+_DEG_MIN = math.radians(1.0) / 60.0  # rad/s per deg/min
+
+
+def is_cl_file(path: str | Path) -> bool:
+    """A CL file by its suffix (.cl, .cls, .apt, .ncl, .aptsource) or its content."""
+    path = Path(path)
+    if path.suffix.lower() in CL_SUFFIXES:
+        return True
+    if path.suffix.lower() == ".csv":
+        return False
+    try:
+        with path.open("r", encoding="utf-8") as handle:
+            head = handle.read(65536)
+    except (OSError, UnicodeDecodeError):
+        return False  # the CSV reader reports it
+    return looks_like_cldata(head)
+
+
+def cell_pipeline_applies(options: argparse.Namespace) -> bool:
+    """Whether ``check-path`` needs this module (a CL file, a frame or a feed given)."""
+    flags = ("frame", "feed_mm_min", "rapid_feed_mm_min", "rotary_feed_deg_min")
+    return is_cl_file(options.file) or any(getattr(options, f, None) is not None for f in flags)
+
+
+def cmd_check_path_any(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
+    """``check-path``: this module's pipeline for CL files, frames and feeds, else the CSV one."""
+    if cell_pipeline_applies(options):
+        return cmd_check_cell_path(options, out, err)
+    return cmd_check_path(options, out, err)
+
+
+def check_path_any_arguments(sub: argparse.ArgumentParser) -> None:
+    """``check-path``'s options: the CSV path's and :func:`cell_arguments`."""
+    check_path_arguments(sub)
+    cell_arguments(sub)
+
+
+def cell_arguments(sub: argparse.ArgumentParser) -> None:
+    """``check-path``'s options for CL files, frames and feeds."""
+    sub.add_argument(
+        "--frame",
+        choices=FRAMES,
+        help="frame of the file's positions and orientations and of the results (default: "
+        "work for CL files, base for CSV)",
+    )
+    sub.add_argument(
+        "--feed-mm-min",
+        type=float,
+        metavar="F",
+        help="feed of the moves without a programmed FEDRAT (CSV: every move), mm/min",
+    )
+    sub.add_argument(
+        "--rapid-feed-mm-min",
+        type=float,
+        metavar="F",
+        help="feed of RAPID moves, mm/min (default: none, so they get no speed verdict)",
+    )
+    sub.add_argument(
+        "--rotary-feed-deg-min",
+        type=float,
+        metavar="F",
+        help="rotation rate of moves without translation, deg/min",
+    )
+
+
+def _positive(value: float | None, flag: str, unit: str) -> float:
+    """NaN when not given, else a finite value > 0."""
+    if value is None:
+        return math.nan
+    number = float(finite([value], flag, unit)[0])
+    if not number > 0.0:
+        msg = f"{flag}: expected a value > 0 ({unit}), got {number:g}"
+        raise CliError(msg)
+    return number
+
+
+class _Part:
+    """One tool's stretch of the path, in the base frame."""
+
+    def __init__(
+        self,
+        tool: Tool,
+        positions: NDArray[np.float64],
+        axes: NDArray[np.float64] | None,
+        degrees: NDArray[np.float64] | None,
+        feeds: NDArray[np.float64],
+        rapid: NDArray[np.bool_],
+        lines: NDArray[np.int64] | None,
+        first: int,
+        written: bool = False,
+    ) -> None:
+        self.tool, self.positions, self.axes, self.degrees = tool, positions, axes, degrees
+        self.feeds, self.rapid, self.lines, self.first = feeds, rapid, lines, first
+        self.written = written  # degrees are the file's own (base frame): echoed as given
+
+
+def _read_parts(
+    options: argparse.Namespace, cell: CellFrames, frame: str, feed: float
+) -> tuple[list[_Part], list[tuple[str, int, int]]]:
+    """The file's parts in the base frame, and the ignored CL statements."""
+    work = cell.work if frame == "work" else WorkFrame()
+    if is_cl_file(options.file):
+        program: CLProgram = read_cldata(options.file, tools=set(cell.tools))
+        positions = work.origin + program.positions @ work.rotation.T
+        axes = vectors_to_base(program.axes, work)
+        feeds = np.where(np.isnan(program.feeds), feed, program.feeds)
+        parts = []
+        for start, stop in program.parts:
+            number = int(program.tools[start])
+            tool = cell.tool if number == 0 else cell.select(number)
+            feeds_part = feeds[start:stop].copy()
+            feeds_part[0] = math.nan
+            parts.append(
+                _Part(
+                    tool,
+                    positions[start:stop],
+                    axes[start:stop],
+                    None,
+                    feeds_part,
+                    program.rapid[start:stop],
+                    program.lines[start:stop],
+                    start,
+                )
+            )
+        for start, stop in program.parts:
+            if stop - start < 2:
+                msg = (
+                    f"CL file {options.file}: line {program.lines[start]}: the only GOTO of "
+                    f"tool {program.tools[start]}; expected at least 2 GOTO (one move) per tool"
+                )
+                raise CliError(msg)
+        return parts, list(program.ignored)
+    waypoints = read_path_file(options.file)
+    count = len(waypoints.positions)
+    feeds = np.full(count, feed)
+    feeds[0] = math.nan
+    positions = work.origin + waypoints.positions @ work.rotation.T
+    if waypoints.axes is not None:
+        axes = vectors_to_base(waypoints.axes, work)
+        part = _Part(cell.tool, positions, axes, None, feeds, np.zeros(count, bool), None, 0)
+    else:
+        assert waypoints.degrees is not None  # read_path_file gives axes or angles
+        degrees = waypoints.degrees  # as written: reported as given in the base frame
+        if frame == "work":
+            local = tt_to_matrix(degrees_to_radians(waypoints.degrees))
+            rotation, _ = work_to_base(local, np.zeros((count, 3)), work)
+            degrees = np.degrees(matrix_to_tt(rotation))
+        part = _Part(
+            cell.tool,
+            positions,
+            None,
+            degrees,
+            feeds,
+            np.zeros(count, bool),
+            None,
+            0,
+            written=frame == "base",
+        )
+    return [part], []
+
+
+def _to_frame(document: dict[str, Any], work: WorkFrame) -> None:
+    """Rewrite a path document's base-frame positions and angles in the work frame."""
+    r_w = work.rotation
+
+    def position(p: list[float]) -> list[float]:
+        local: list[float] = ((np.asarray(p) - work.origin) @ r_w).tolist()
+        return local
+
+    def angles(deg: list[float]) -> list[float]:
+        local = r_w.T @ tt_to_matrix(np.radians(deg))
+        converted: list[float] = np.degrees(matrix_to_tt(local)).tolist()
+        return converted
+
+    for waypoint in document["waypoints"]:
+        waypoint["position"] = position(waypoint["position"])
+        phi, theta, psi = angles([waypoint["phi_deg"], waypoint["theta_deg"], waypoint["psi_deg"]])
+        waypoint.update(phi_deg=phi, theta_deg=theta, psi_deg=psi)
+    for segment in document["segments"]:
+        if segment["position_at_violation"] is not None:
+            segment["position_at_violation"] = position(segment["position_at_violation"])
+            segment["first_violation_pose_deg"] = angles(segment["first_violation_pose_deg"])
+
+
+def tool_json(tool: Tool) -> dict[str, Any]:
+    """A tool in results: number (0: ``tool.*``), offset (m), orientation (deg)."""
+    return {
+        "number": tool.number,
+        "offset": tool.offset.tolist(),
+        "orientation_deg": np.degrees(tool.orientation).tolist(),
+    }
+
+
+def work_json(work: WorkFrame) -> dict[str, Any]:
+    """The work frame in results: frame_id, origin (m), orientation (deg)."""
+    return {
+        "frame_id": work.frame_id,
+        "origin": work.origin.tolist(),
+        "orientation_deg": np.degrees(work.orientation).tolist(),
+    }
+
+
+def _check_part(
+    platform: Manipulator,
+    part: _Part,
+    cell: CellFrames,
+    options: argparse.Namespace,
+    feeds: tuple[float, float],
+) -> tuple[PathCheck | TorsionPlan, dict[str, Any]]:
+    """Check (or plan) one part and add the speed keys to its document."""
+    model = tool_model(platform, part.tool)
+    tolerance = (
+        DEFAULT_PATH_TOLERANCE
+        if options.tol_deg is None
+        else _degrees_flag(options.tol_deg, "--tol-deg")
+    )
+    result: PathCheck | TorsionPlan
+    if part.axes is not None:
+        max_dpsi = (
+            None
+            if options.max_dpsi_deg is None
+            else _degrees_flag(options.max_dpsi_deg, "--max-dpsi-deg")
+        )
+        result = plan_torsion(
+            model,
+            part.positions,
+            part.axes,
+            psi_step=_degrees_flag(options.psi_step_deg, "--psi-step-deg"),
+            max_dpsi=max_dpsi,
+            interpolation=options.interpolation,
+            tolerance=tolerance,
+        )
+        baseline = result.baseline
+    else:
+        assert part.degrees is not None
+        result = check_path(
+            model,
+            part.positions,
+            angles=degrees_to_radians(part.degrees),
+            interpolation=options.interpolation,
+            tolerance=tolerance,
+        )
+        baseline = psi_zero_baseline(model, result)
+    document = path_to_json(result, baseline, part.degrees if part.written else None)
+    checked, _ = reported_parts(result)
+    moves = len(checked.segments)
+    rapid_feed, rotary_feed = feeds
+    feed = np.where(part.rapid[1:], rapid_feed, part.feeds[1:])
+    limits = cell.actuator_speed_max
+    if options.interpolation != "slerp" and np.any(np.isfinite(feed)):
+        msg = "feeds: the speed check needs --interpolation slerp (the controller's moves)"
+        raise CliError(msg)
+    rotations = tt_to_matrix(checked.waypoints.angles)
+    rates = actuator_rates(model, checked.waypoints.positions, rotations, speed_limits=limits)
+    speeds = feed_limits(rates, feed, np.full(moves, rotary_feed), limits)
+    for k, segment in enumerate(document["segments"]):
+        known = bool(np.isfinite(speeds.duration[k]))
+        rotary = bool(speeds.rotary[k])
+        feed_max = float(speeds.feed_max[k])
+        per_minute = feed_max / (_DEG_MIN if rotary else _MM_MIN)
+        segment.update(
+            rapid=bool(part.rapid[k + 1]),
+            duration_s=float(speeds.duration[k]) if known else None,
+            actuator_speed_peak=float(speeds.speed_peak[k]) if known else None,
+            speed_ok=speeds.speed_ok[k],
+            feed_max_mm_min=None if rotary or math.isnan(feed_max) else _finite(per_minute),
+        )
+        if rotary:
+            segment["feed_deg_min"] = rotary_feed / _DEG_MIN if known else None
+            segment["feed_max_deg_min"] = None if math.isnan(feed_max) else _finite(per_minute)
+        else:
+            segment["feed_mm_min"] = float(feed[k]) / _MM_MIN if known else None
+        if not known:
+            segment["speed_note"] = "no feed for this move: no duration, no speed verdict"
+    if part.lines is not None:
+        for k, waypoint in enumerate(document["waypoints"]):
+            waypoint["line"] = int(part.lines[k])
+    document["tool"] = tool_json(part.tool)
+    document["first_waypoint"] = part.first
+    return result, document
+
+
+def _finite(value: float) -> float | None:
+    """JSON has no infinity: a move that moves no limited actuator has no feed limit (null)."""
+    return value if math.isfinite(value) else None
+
+
+def _speed_summary(documents: list[dict[str, Any]], limits: NDArray[np.float64]) -> dict[str, Any]:
+    slow, without = [], 0
+    for document in documents:
+        for segment in document["segments"]:
+            if segment["speed_ok"] is False:
+                slow.append(
+                    {
+                        "part": documents.index(document),
+                        "segment": segment["index"],
+                        "actuator_speed_peak": segment["actuator_speed_peak"],
+                        "feed_max_mm_min": segment["feed_max_mm_min"],
+                        "feed_max_deg_min": segment.get("feed_max_deg_min"),
+                    }
+                )
+            without += segment["duration_s"] is None
+    return {
+        "actuator_unit": UPS.unit,
+        "actuator_speed_max": limits.tolist(),
+        "limited": bool(np.any(limits > 0.0)),
+        "moves_to_slow_down": slow,
+        "moves_without_feed": without,
+        "covers": SPEED_COVERAGE,
+    }
+
+
+def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
+    """``check-path`` for CL files, frames and feeds (see the module documentation)."""
+    if options.record is not None:
+        msg = (
+            "check-path: --record is not available with CL files, --frame or feeds yet; "
+            "check the path without them for a log"
+        )
+        raise CliError(msg)
+    plot = (
+        None
+        if options.plot is None
+        else output_file(options.plot, "--plot", force=options.force, suffixes=PLOT_FORMATS)
+    )
+    # the platform frame's model: each part's tool model is built from it
+    platform = load_manipulator(options.config, None, err, with_tool=False)
+    cell = cell_from_params_file(options.config or example_config_path())
+    frame = options.frame or ("work" if is_cl_file(options.file) else "base")
+    feed = _positive(options.feed_mm_min, "--feed-mm-min", "mm/min") * _MM_MIN
+    rapid = _positive(options.rapid_feed_mm_min, "--rapid-feed-mm-min", "mm/min") * _MM_MIN
+    rotary = _positive(options.rotary_feed_deg_min, "--rotary-feed-deg-min", "deg/min") * _DEG_MIN
+    parts, ignored = _read_parts(options, cell, frame, feed)
+    results, documents = [], []
+    for part in parts:
+        result, document = _check_part(platform, part, cell, options, (rapid, rotary))
+        if frame == "work":
+            _to_frame(document, cell.work)
+        results.append(result)
+        documents.append(document)
+    speed = _speed_summary(documents, cell.actuator_speed_max)
+    ok = all(d["ok"] for d in documents) and not speed["moves_to_slow_down"]
+    common = {
+        "frame": frame,
+        "work_frame": work_json(cell.work),
+        "ignored": [{"statement": n, "first_line": line, "count": c} for n, line, c in ignored],
+        "speed": speed,
+    }
+    if len(documents) == 1:
+        report: dict[str, Any] = {**documents[0], **common, "ok": ok}
+    else:
+        report = {"ok": ok, **common, "parts": documents}
+    if plot is not None:
+        plot_speeds(documents, speed, plot)
+    if options.json:
+        out.write(json.dumps(report, allow_nan=False) + "\n")
+    else:
+        if plot is not None:
+            out.write(f"  plot: {plot}\n")
+        for k, (result, document) in enumerate(zip(results, documents, strict=True)):
+            tool = document["tool"]
+            name = f"T{tool['number']}" if tool["number"] else "tool.*"
+            if len(documents) > 1:
+                out.write(f"part {k} (tool {name}, from waypoint {document['first_waypoint']}):\n")
+            _text(result, document, out)
+        _speed_text(report, out)
+    if ok:
+        return 0
+    problems = [
+        _where(document, result)
+        for result, document in zip(results, documents, strict=True)
+        if not document["ok"]
+    ]
+    if speed["moves_to_slow_down"]:
+        problems.append(f"{len(speed['moves_to_slow_down'])} move(s) must slow down")
+    err.write(f"{PROG}: {'; '.join(problems)}\n")
+    return 1
+
+
+def _speed_text(report: dict[str, Any], out: IO[str]) -> None:
+    speed = report["speed"]
+    if report["ignored"]:
+        names = ", ".join(f"{i['statement']} (line {i['first_line']})" for i in report["ignored"])
+        out.write(f"  ignored CL statements: {names}\n")
+    out.write(f"  frame: {report['frame']}; speeds: {speed['covers']}\n")
+    if not speed["limited"]:
+        out.write("  no actuator speed limit (limits.actuator_speed_max is 0)\n")
+    if speed["moves_without_feed"]:
+        out.write(f"  {speed['moves_without_feed']} move(s) without a feed: no speed verdict\n")
+    for move in speed["moves_to_slow_down"][:10]:
+        limit = (
+            f"{move['feed_max_mm_min']:.0f} mm/min"
+            if move["feed_max_mm_min"] is not None
+            else f"{move['feed_max_deg_min']:.0f} deg/min"
+        )
+        out.write(
+            f"  part {move['part']} move {move['segment']}: actuator speed up to "
+            f"{move['actuator_speed_peak']:.4g} {speed['actuator_unit']}/s (limit "
+            f"{max(speed['actuator_speed_max']):g}), slow down to {limit}\n"
+        )
+
+
+def plot_speeds(documents: list[dict[str, Any]], speed: dict[str, Any], path: Path) -> Path:
+    """Per move: the certified peak actuator speed against the limit, and the programmed feed
+    against ``feed_max``; tool changes as vertical lines.
+
+    Parameters
+    ----------
+    documents : list of dict
+        The parts' documents (with the speed keys of :func:`cmd_check_cell_path`).
+    speed : dict
+        The ``speed`` summary.
+    path : Path
+        Image file (.png, .pdf, .svg).
+    """
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Patch
+
+    figure = Figure(figsize=(11.0, 6.0))
+    top, bottom = figure.subplots(2, 1, sharex=True)
+    offset = 0
+    unit = speed["actuator_unit"]
+    used: set[str] = set()
+
+    def once(label: str) -> str | None:
+        """Each legend entry once, from whichever part first has it."""
+        if label in used:
+            return None
+        used.add(label)
+        return label
+
+    for document in documents:
+        segments = document["segments"]
+        index = offset + np.arange(len(segments))
+        peak = np.array(
+            [
+                np.nan if s["actuator_speed_peak"] is None else s["actuator_speed_peak"]
+                for s in segments
+            ]
+        )
+        rapid = np.array([s["rapid"] for s in segments])
+        rotary = np.array(["feed_deg_min" in s for s in segments])
+        top.bar(index, peak, color=np.where(rapid, "tab:orange", "tab:blue"))
+        feed = np.array(
+            [np.nan if s.get("feed_mm_min") is None else s["feed_mm_min"] for s in segments]
+        )
+        feed_max = np.array(
+            [np.nan if s["feed_max_mm_min"] is None else s["feed_max_mm_min"] for s in segments]
+        )
+        bottom.plot(
+            index,
+            feed,
+            "o",
+            color="tab:blue",
+            ms=4,
+            label=once("programmed feed"),
+        )
+        bottom.plot(
+            index,
+            feed_max,
+            "v",
+            color="tab:red",
+            ms=5,
+            label=once("feed_max (certified)"),
+        )
+        if rotary.any():
+            rotary_feed = np.array([s.get("feed_deg_min") or np.nan for s in segments])
+            rotary_max = np.array([s.get("feed_max_deg_min") or np.nan for s in segments])
+            bottom.plot(
+                index,
+                rotary_feed,
+                "s",
+                color="tab:green",
+                ms=4,
+                label=once("rotary feed [deg/min]"),
+            )
+            bottom.plot(
+                index,
+                rotary_max,
+                "^",
+                color="tab:green",
+                ms=5,
+                mfc="none",
+                label=once("rotary feed_max [deg/min]"),
+            )
+        tool = document["tool"]["number"]
+        for axes in (top, bottom):
+            axes.axvline(offset - 0.5, color="gray", lw=0.8, ls=":")
+        top.text(
+            offset - 0.4,
+            0.98,
+            f"T{tool}" if tool else "tool.*",
+            transform=top.get_xaxis_transform(),
+            va="top",
+            fontsize=8,
+        )
+        offset += len(segments)
+    limits = [v for v in speed["actuator_speed_max"] if v > 0]
+    if limits:
+        top.axhline(
+            min(limits), color="tab:red", lw=1.2, ls="--", label=f"limit {min(limits):g} {unit}/s"
+        )
+    handles, _ = top.get_legend_handles_labels()
+    handles += [
+        Patch(color="tab:blue", label="certified peak actuator speed"),
+        Patch(color="tab:orange", label="RAPID move"),
+    ]
+    top.set_ylabel(f"actuator speed [{unit}/s]")
+    top.set_title("Certified peak actuator speed per move (bars) against the limit", fontsize=10)
+    top.legend(handles=handles, fontsize=7, loc="center left")
+    top.grid(alpha=0.3)
+    bottom.set_yscale("log")
+    bottom.set_ylabel("feed [mm/min or deg/min]")
+    bottom.set_xlabel("move (parts in order; dotted lines: tool changes)")
+    bottom.set_title(
+        "Programmed feed and the largest feed within every actuator limit", fontsize=10
+    )
+    bottom.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=4)
+    bottom.grid(alpha=0.3, which="both")
+    figure.tight_layout()
+    figure.savefig(path, dpi=120, bbox_inches="tight")
+    return path

@@ -1,0 +1,272 @@
+"""``reach`` and ``axis-limits``: how far the tool can move from a pose along a direction or
+along the six axes of a frame (:mod:`hexapod_workspace.core.reach`).
+
+JSON (``--json``):
+
+* ``reach``: ``plus``, ``minus`` (the largest t ≥ 0 in each sense, units of t: the direction is
+  used as given), ``limited_by_plus``, ``limited_by_minus`` (constraint names; empty when the
+  search bound was reached), ``t_max``, ``start_reachable``, ``frame``, ``position`` (m, in the
+  frame), ``pose_deg``, ``direction`` ([DX, DY, DZ] m and [RX, RY, RZ] rad per unit t),
+  ``tolerance_deg``, ``tool``, ``work_frame``.
+* ``axis-limits``: ``{"frame": ..., "axes": {"x": {"plus", "minus", "limited_by_plus",
+  "limited_by_minus"}, "y", "z", "rx", "ry", "rz"}, ...}`` with translations in m and rotations
+  in degrees (magnitudes ≥ 0), about axes through the tool centre point.
+
+Exit codes as for ``check``: 0 the pose is reachable (the limits are given), 1 it is not (both
+reaches 0, the violated constraints on stderr), 2 bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from typing import IO, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .._resources import example_config_path
+from ..core.frames import CellFrames, Tool, cell_from_params_file, tool_model, work_to_base
+from ..core.manipulator import Manipulator
+from ..core.paths import DEFAULT_PATH_TOLERANCE
+from ..core.reach import AXES, DEFAULT_T_MAX, DEFAULT_T_MAX_ROTATION, Reach, axis_limits, reach
+from ..core.rotations import degrees_to_radians, tt_to_matrix
+from .cam import tool_json, work_json
+from .commands import PROG
+from .inputs import CliError, finite, load_manipulator
+
+__all__ = [
+    "AXIS_LIMITS_DESCRIPTION",
+    "AXIS_LIMITS_HELP",
+    "REACH_DESCRIPTION",
+    "REACH_HELP",
+    "axis_limits_arguments",
+    "cmd_axis_limits",
+    "cmd_reach",
+    "reach_arguments",
+]
+
+REACH_HELP = "how far the tool can move from a pose along a direction (certified)"
+REACH_DESCRIPTION = (
+    "From the pose (--position, --pose), the pose moves as p(t) = p + t*(DX, DY, DZ) and "
+    "R(t) = Rot(t*(RX, RY, RZ))*R (a rotation vector in rad about an axis through the tool "
+    "centre point), in the frame given; the largest t >= 0 in each sense before a constraint "
+    "is violated, certified like a move of check-path. Exit 0 reachable pose, 1 unreachable, "
+    "2 bad input."
+)
+AXIS_LIMITS_HELP = "the +/- reach along the six axes of a frame (soft limits at a pose)"
+AXIS_LIMITS_DESCRIPTION = (
+    "Translations along x, y, z (m) and rotations about x, y, z through the tool centre point "
+    "(deg) of the base, work or tool frame, from the pose (--position, --pose). Exit 0 "
+    "reachable pose, 1 unreachable, 2 bad input."
+)
+
+
+def _common(parser: argparse.ArgumentParser, frames: tuple[str, ...]) -> None:
+    parser.add_argument(
+        "--pose",
+        nargs=3,
+        type=float,
+        default=[0.0, 0.0, 0.0],
+        metavar=("PHI", "THETA", "PSI"),
+        help="orientation of the tool, Tilt-and-Torsion angles, degrees (default 0 0 0)",
+    )
+    parser.add_argument(
+        "--frame",
+        choices=frames,
+        default="base",
+        help="frame of --position, --pose and the direction or axes (default: base)",
+    )
+    parser.add_argument(
+        "--tool",
+        type=int,
+        metavar="N",
+        help="the tool of the tool table tools.T<N> (default: tool.*)",
+    )
+    parser.add_argument(
+        "--tol-deg",
+        type=float,
+        metavar="T",
+        help=f"certified tolerance, degrees of platform rotation (default "
+        f"{math.degrees(DEFAULT_PATH_TOLERANCE):g}), as for check-path",
+    )
+
+
+def reach_arguments(parser: argparse.ArgumentParser) -> None:
+    """``reach``'s own options."""
+    _common(parser, ("base", "work"))
+    parser.add_argument(
+        "--direction",
+        nargs=6,
+        type=float,
+        required=True,
+        metavar=("DX", "DY", "DZ", "RX", "RY", "RZ"),
+        help="m and rad per unit t, used as given (not normalised)",
+    )
+    parser.add_argument(
+        "--t-max",
+        type=float,
+        default=DEFAULT_T_MAX,
+        metavar="T",
+        help="search bound for t (default %(default)g; t_max*|(RX, RY, RZ)| < pi)",
+    )
+
+
+def axis_limits_arguments(parser: argparse.ArgumentParser) -> None:
+    """``axis-limits``' own options."""
+    _common(parser, ("base", "work", "tool"))
+    parser.add_argument(
+        "--max-translation",
+        type=float,
+        default=DEFAULT_T_MAX,
+        metavar="M",
+        help="search bound of the translations, m (default %(default)g)",
+    )
+    parser.add_argument(
+        "--max-rotation-deg",
+        type=float,
+        default=math.degrees(DEFAULT_T_MAX_ROTATION),
+        metavar="D",
+        help="search bound of the rotations, degrees, below 180 (default %(default)g)",
+    )
+
+
+def _pose(
+    options: argparse.Namespace, err: IO[str]
+) -> tuple[
+    Manipulator,
+    CellFrames,
+    Tool,
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.float64],
+    float,
+]:
+    """Model (tool frame), cell, tool, rotation and position in the base frame, frame rotation,
+    tolerance."""
+    platform = load_manipulator(options.config, None, err, with_tool=False)
+    cell = cell_from_params_file(options.config or example_config_path())
+    tool = cell.tool if options.tool is None else cell.select(options.tool)
+    manipulator = tool_model(platform, tool)
+    position = (
+        manipulator.position
+        if options.position is None
+        else finite(options.position, "--position", "m")
+    )
+    degrees = finite(options.pose, "--pose", "degrees")
+    rotation = tt_to_matrix(degrees_to_radians(degrees))
+    frame_rotation = np.eye(3)
+    if options.frame == "work":
+        if options.position is None:
+            msg = "--frame work: give --position X Y Z in the work frame"
+            raise CliError(msg)
+        rotation, position = work_to_base(rotation, position, cell.work)
+        frame_rotation = cell.work.rotation
+    tolerance = (
+        DEFAULT_PATH_TOLERANCE
+        if options.tol_deg is None
+        else math.radians(float(finite([options.tol_deg], "--tol-deg", "degrees")[0]))
+    )
+    return manipulator, cell, tool, rotation, position, frame_rotation, tolerance
+
+
+def _frames_json(options: argparse.Namespace, cell: CellFrames, tool: Tool) -> dict[str, Any]:
+    return {
+        "frame": options.frame,
+        "position": None if options.position is None else list(options.position),
+        "pose_deg": list(options.pose),
+        "tool": tool_json(tool),
+        "work_frame": work_json(cell.work),
+    }
+
+
+def _limits_json(result: Reach, scale: float = 1.0) -> dict[str, Any]:
+    return {
+        "plus": result.plus * scale,
+        "minus": result.minus * scale,
+        "limited_by_plus": result.limited_by_plus,
+        "limited_by_minus": result.limited_by_minus,
+    }
+
+
+def _unreachable(result: Reach, err: IO[str]) -> int:
+    if result.start_reachable:
+        return 0
+    err.write(f"{PROG}: the pose is unreachable ({', '.join(result.limited_by_plus)})\n")
+    return 1
+
+
+def cmd_reach(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
+    """``reach``: the largest steps along ±direction from the pose."""
+    manipulator, cell, tool, rotation, position, frame_rotation, tolerance = _pose(options, err)
+    direction = finite(options.direction, "--direction", "m and rad")
+    t_max = float(finite([options.t_max], "--t-max", "units of t")[0])
+    result = reach(
+        manipulator,
+        rotation,
+        position,
+        frame_rotation @ direction[:3],
+        frame_rotation @ direction[3:],
+        t_max=t_max,
+        tolerance=tolerance,
+    )
+    document = {
+        **_limits_json(result),
+        "t_max": result.t_max,
+        "start_reachable": result.start_reachable,
+        "direction": {"translation": direction[:3].tolist(), "rotation": direction[3:].tolist()},
+        "tolerance_deg": math.degrees(tolerance),
+        **_frames_json(options, cell, tool),
+    }
+    if options.json:
+        out.write(json.dumps(document, allow_nan=False) + "\n")
+    else:
+        for sense in ("plus", "minus"):
+            names = document[f"limited_by_{sense}"]
+            why = ", ".join(names) if names else f"search bound t_max = {t_max:g} reached"
+            out.write(f"{sense:>5}: t = {document[sense]:.6g} ({why})\n")
+    return _unreachable(result, err)
+
+
+def cmd_axis_limits(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
+    """``axis-limits``: the ± reach along the six axes of a frame."""
+    manipulator, cell, tool, rotation, position, _, tolerance = _pose(options, err)
+    t_max = float(finite([options.max_translation], "--max-translation", "m")[0])
+    rotation_max = float(finite([options.max_rotation_deg], "--max-rotation-deg", "degrees")[0])
+    if not 0.0 < rotation_max < 180.0:
+        msg = f"--max-rotation-deg: expected a value in (0, 180) degrees, got {rotation_max:g}"
+        raise CliError(msg)
+    limits = axis_limits(
+        manipulator,
+        rotation,
+        position,
+        frame=options.frame,
+        work=cell.work,
+        t_max=t_max,
+        t_max_rotation=math.radians(rotation_max),
+        tolerance=tolerance,
+    )
+    document = {
+        **_frames_json(options, cell, tool),
+        "axes": {
+            name: _limits_json(limits[name], 1.0 if k < 3 else math.degrees(1.0))
+            for k, name in enumerate(AXES)
+        },
+        "max_translation": t_max,
+        "max_rotation_deg": rotation_max,
+        "tolerance_deg": math.degrees(tolerance),
+    }
+    if options.json:
+        out.write(json.dumps(document, allow_nan=False) + "\n")
+    else:
+        out.write(f"axis limits in the {options.frame} frame (translations m, rotations deg)\n")
+        for k, name in enumerate(AXES):
+            axis = document["axes"][name]
+            unit = "m" if k < 3 else "deg"
+            out.write(
+                f"  {name:>2}: -{axis['minus']:.5g} .. +{axis['plus']:.5g} {unit}  "
+                f"(- {', '.join(axis['limited_by_minus']) or 'bound'}; "
+                f"+ {', '.join(axis['limited_by_plus']) or 'bound'})\n"
+            )
+    return _unreachable(limits["x"], err)

@@ -1,0 +1,254 @@
+"""The machining cell through the CLI: CL files, frames and feeds in ``check-path``, the tool
+frame from ``--config``, ``reach`` and ``axis-limits``; bad input exits 2 in one line."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from cli_support import one_error_line, run_main
+
+from hexapod_workspace._resources import example_config_path
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+CELL = EXAMPLES / "cell_gpm.yaml"
+POCKET = EXAMPLES / "pocket_5axis.cl"
+
+
+def cell_config(tmp_path: Path, extra: str, limits: str = "") -> Path:
+    """The packaged example with extra sections under ros__parameters (and limits)."""
+    text = example_config_path().read_text(encoding="utf-8")
+    text = text.replace("  ros__parameters:\n", "  ros__parameters:\n" + extra, 1)
+    if limits:
+        text = text.replace("    limits:\n", "    limits:\n" + limits, 1)
+    path = tmp_path / "cell.yaml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_cl_file_checks_like_the_equivalent_csv(tmp_path):
+    cl = tmp_path / "ring.cl"
+    cl.write_text(
+        "PARTNO/RING $$ off-axis ring, 17 deg cone\nunits/inches\nMULTAX\n"
+        + "".join(
+            f"GOTO / {(0.2 + 0.02 * math.cos(t)) / 0.0254:.10f}, "
+            f"{(0.2 + 0.02 * math.sin(t)) / 0.0254:.10f}, $\n"
+            f"  {-0.95 / 0.0254:.10f}, {math.sin(0.3) * math.cos(t):.10f}, "
+            f"{math.sin(0.3) * math.sin(t):.10f}, {math.cos(0.3):.10f}\n"
+            for t in np.linspace(0.0, 2.0 * math.pi, 12)
+        ),
+        encoding="utf-8",
+    )
+    rows = [
+        [
+            0.2 + 0.02 * math.cos(t),
+            0.2 + 0.02 * math.sin(t),
+            -0.95,
+            math.sin(0.3) * math.cos(t),
+            math.sin(0.3) * math.sin(t),
+            math.cos(0.3),
+        ]
+        for t in np.linspace(0.0, 2.0 * math.pi, 12)
+    ]
+    csv = tmp_path / "ring.csv"
+    np.savetxt(csv, rows, delimiter=",", header="x,y,z,i,j,k", comments="", fmt="%.17g")
+    code_cl, out_cl, _ = run_main("check-path", str(cl), "--json")
+    code_csv, out_csv, _ = run_main("check-path", str(csv), "--json")
+    from_cl, from_csv = json.loads(out_cl), json.loads(out_csv)
+    assert code_cl == code_csv
+    assert from_cl["frame"] == "work" and from_csv["frame"] == "base"  # identity work frame
+    assert from_cl["ignored"] == [{"statement": "PARTNO", "first_line": 1, "count": 1}]
+    for a, b in zip(from_cl["waypoints"], from_csv["waypoints"], strict=True):
+        np.testing.assert_allclose(a["position"], b["position"], atol=1e-9)
+        for key in ("phi_deg", "theta_deg", "psi_deg"):
+            assert a[key] == pytest.approx(b[key], abs=1e-6)
+        assert a["reachable"] == b["reachable"]
+    assert [w["line"] for w in from_cl["waypoints"]][:2] == [4, 6]
+    # no feed anywhere: no durations, no speed verdicts, and the summary says so
+    assert all(s["duration_s"] is None and s["speed_ok"] is None for s in from_cl["segments"])
+    assert from_cl["speed"]["moves_without_feed"] == 11
+
+
+def test_worked_example_with_tool_change_and_feeds(tmp_path):
+    plot = tmp_path / "speeds.png"
+    code, out, err = run_main(
+        "--config",
+        str(CELL),
+        "check-path",
+        str(POCKET),
+        "--rapid-feed-mm-min",
+        "2400",
+        "--rotary-feed-deg-min",
+        "360",
+        "--plot",
+        str(plot),
+        "--json",
+    )
+    assert plot.read_bytes().startswith(b"\x89PNG\r\n\x1a\n")
+    document = json.loads(out)
+    assert document["frame"] == "work" and len(document["parts"]) == 2
+    assert [p["tool"]["number"] for p in document["parts"]] == [1, 2]
+    assert [p["first_waypoint"] for p in document["parts"]] == [0, 17]
+    assert all(p["ok"] for p in document["parts"])  # every pose and move is reachable
+    first = document["parts"][0]["segments"][1]  # 40 mm at 1200 mm/min
+    assert first["feed_mm_min"] == pytest.approx(1200.0)
+    assert first["duration_s"] == pytest.approx(0.040 / (1.2 / 60.0))
+    assert first["speed_ok"] is True and first["feed_max_mm_min"] > 1200.0
+    corner = document["parts"][1]["segments"][3]  # a rotation at a wall corner
+    assert corner["feed_deg_min"] == 360.0 and corner["feed_max_mm_min"] is None
+    assert corner["feed_max_deg_min"] > 360.0
+    slow = document["speed"]["moves_to_slow_down"]
+    assert slow and all(m["feed_max_mm_min"] or m["feed_max_deg_min"] for m in slow)
+    assert code == 1 and "must slow down" in err
+    positions = document["parts"][0]["waypoints"][0]["position"]
+    assert positions == pytest.approx([-0.020, -0.010, 0.025])  # in the work frame, m
+
+
+def test_csv_with_feed_in_the_work_frame(tmp_path):
+    config = cell_config(
+        tmp_path,
+        "    work:\n      origin: [0.2, 0.2, -0.95]\n      orientation: [0.0, 0.0, 0.5]\n",
+        "      actuator_speed_max: [0.05]\n",
+    )
+    csv = tmp_path / "line.csv"
+    csv.write_text(
+        "x,y,z,phi_deg,theta_deg,psi_deg\n0,0,0,0,10,0\n0.02,0,0,0,10,0\n", encoding="utf-8"
+    )
+    code, out, _ = run_main(
+        "--config", str(config), "check-path", str(csv), "--frame", "work",
+        "--feed-mm-min", "600", "--json",
+    )  # fmt: skip
+    document = json.loads(out)
+    assert code == 0 and document["frame"] == "work"
+    assert document["waypoints"][1]["position"] == pytest.approx([0.02, 0.0, 0.0])
+    assert document["waypoints"][1]["theta_deg"] == pytest.approx(10.0)
+    assert document["segments"][0]["duration_s"] == pytest.approx(0.02 / 0.01)
+    # the same path given in the base frame (W turned by ψ = 0.5 rad about z: a local
+    # (0°, 10°, 0°) is Rz(0.5)·Ry(10°) = T&T (0.5 rad, 10°, 0.5 rad)) has the same margins
+    angle = 0.5
+    base_csv = tmp_path / "base.csv"
+    base_csv.write_text(
+        "x,y,z,phi_deg,theta_deg,psi_deg\n"
+        f"0.2,0.2,-0.95,{math.degrees(angle)},10,{math.degrees(angle)}\n"
+        f"{0.2 + 0.02 * math.cos(angle)},{0.2 + 0.02 * math.sin(angle)},-0.95,"
+        f"{math.degrees(angle)},10,{math.degrees(angle)}\n",
+        encoding="utf-8",
+    )
+    _, out_base, _ = run_main("check-path", str(base_csv), "--json")
+    base = json.loads(out_base)
+    for a, b in zip(document["waypoints"], base["waypoints"], strict=True):
+        for name, margin in b["margins"].items():
+            assert a["margins"][name] == pytest.approx(margin, abs=1e-9)
+
+
+def test_tool_offset_in_config_answers_for_the_tool_centre_point(tmp_path):
+    config = cell_config(tmp_path, "    tool:\n      offset: [0.0, 0.0, -0.1]\n")
+    _, with_tool, _ = run_main(
+        "--config", str(config), "--position", "0", "0", "-1.4", "check", "--pose", "0", "5",
+        "0", "--json",
+    )  # fmt: skip
+    _, platform, _ = run_main(
+        "--position", "0", "0", "-1.3", "check", "--pose", "0", "5", "0", "--json"
+    )
+    # a 5° tilt about the tool tip 0.1 m below P moves P sideways: not the same pose
+    assert json.loads(with_tool) != json.loads(platform)
+    _, untilted, _ = run_main(
+        "--config", str(config), "--position", "0", "0", "-1.4", "check", "--pose", "0", "0",
+        "0", "--json",
+    )  # fmt: skip
+    _, reference, _ = run_main(
+        "--position", "0", "0", "-1.3", "check", "--pose", "0", "0", "0", "--json"
+    )
+    a, b = json.loads(untilted), json.loads(reference)
+    assert a["poses"][0]["margins"] == b["poses"][0]["margins"]
+
+
+def test_reach_and_axis_limits_json():
+    code, out, _ = run_main(
+        "--config", str(CELL), "axis-limits", "--frame", "tool", "--pose", "0", "10", "0",
+        "--json",
+    )  # fmt: skip
+    document = json.loads(out)
+    assert code == 0 and document["frame"] == "tool"
+    assert list(document["axes"]) == ["x", "y", "z", "rx", "ry", "rz"]
+    for axis in document["axes"].values():
+        assert set(axis) == {"plus", "minus", "limited_by_plus", "limited_by_minus"}
+        assert axis["plus"] >= 0 and axis["minus"] >= 0
+    assert document["axes"]["rz"]["plus"] > 10.0  # degrees
+    assert document["tool"]["offset"] == [0.0, 0.0, -0.06]  # tool.*
+    code, out, _ = run_main(
+        "--config", str(CELL), "axis-limits", "--tool", "2", "--json"
+    )  # fmt: skip
+    assert code == 0 and json.loads(out)["tool"]["offset"] == [0.0, 0.0, -0.095]
+    code, _, err = run_main("--config", str(CELL), "axis-limits", "--tool", "3")
+    assert code == 2 and "tool 3: not in the tool table" in one_error_line(err)
+    code, out, _ = run_main(
+        "--config", str(CELL), "--position", "0", "0", "0.01", "reach", "--frame", "work",
+        "--direction", "0", "0", "-1", "0", "0", "0", "--t-max", "0.5", "--json",
+    )  # fmt: skip
+    document = json.loads(out)
+    assert code == 0 and 0.0 < document["plus"] < 0.5 and document["limited_by_plus"]
+    assert document["t_max"] == 0.5 and document["frame"] == "work"
+
+
+@pytest.mark.parametrize(
+    ("text", "extra", "message"),
+    [
+        ("GOTO/0,0,0\nGOTO/1,2\n", "", r"line 2: GOTO/1,2: expected 3"),
+        ("UNITS/FEET\nGOTO/0,0,0\n", "", r"line 1: UNITS/FEET: expected UNITS/MM"),
+        ("FEDRAT/-100\nGOTO/0,0,0\n", "", r"line 1: FEDRAT/-100: expected a feed > 0"),
+        ("LOADTL/4\nGOTO/0,0,0\nGOTO/1,0,0\n", "", r"line 1: LOADTL/4: tool 4 is not in"),
+        (
+            "GOTO/0,0,0\nGOTO/1,0,0\n",
+            "    tools:\n      T1:\n        offset: [0.0, .nan, 0.0]\n",
+            r"tools\.T1\.offset: expected finite numbers",
+        ),
+    ],
+)
+def test_bad_cl_input_exits_2_in_one_line(tmp_path, text, extra, message):
+    path = tmp_path / "bad.cl"
+    path.write_text(text, encoding="utf-8")
+    config = cell_config(tmp_path, extra)
+    code, out, err = run_main("--config", str(config), "check-path", str(path), "--json")
+    assert code == 2 and out == ""
+    assert pytest.importorskip("re").search(message, one_error_line(err))
+
+
+def test_rapid_without_a_rapid_feed_has_no_verdict_and_speeds_need_slerp(tmp_path):
+    path = tmp_path / "rapid.cl"
+    path.write_text(
+        "FEDRAT/600\nGOTO/0,0,-1300\nGOTO/10,0,-1300\nRAPID\nGOTO/10,0,-1250\nGOTO/0,0,-1250\n",
+        encoding="utf-8",
+    )
+    code, out, _ = run_main("check-path", str(path), "--json")
+    document = json.loads(out)
+    assert code == 0
+    rapid = document["segments"][1]
+    assert rapid["rapid"] and rapid["duration_s"] is None and rapid["speed_ok"] is None
+    assert "no feed" in rapid["speed_note"]
+    assert document["segments"][2]["feed_mm_min"] == pytest.approx(600.0)
+    assert document["speed"]["moves_without_feed"] == 1
+    assert document["speed"]["limited"] is False  # the packaged example has no speed limit
+    assert document["segments"][2]["feed_max_mm_min"] is None
+    code, _, err = run_main("check-path", str(path), "--interpolation", "tilt-torsion")
+    assert code == 2 and "needs --interpolation slerp" in one_error_line(err)
+
+
+def test_one_goto_for_a_tool_is_refused(tmp_path):
+    path = tmp_path / "short.cl"
+    path.write_text("LOADTL/1\nGOTO/0,0,0\nGOTO/1,0,0\nLOADTL/2\nGOTO/0,0,5\n", encoding="utf-8")
+    code, _, err = run_main("--config", str(CELL), "check-path", str(path))
+    assert code == 2
+    assert "line 5: the only GOTO of tool 2; expected at least 2 GOTO" in one_error_line(err)
+
+
+def test_bad_flags_exit_2(tmp_path):
+    csv = tmp_path / "p.csv"
+    csv.write_text("x,y,z,i,j,k\n0,0,-1.3,0,0,1\n0.01,0,-1.3,0,0,1\n", encoding="utf-8")
+    code, _, err = run_main("check-path", str(csv), "--feed-mm-min", "-5")
+    assert code == 2 and "--feed-mm-min: expected a value > 0" in one_error_line(err)
+    code, _, err = run_main("reach", "--direction", "0", "0", "0", "0", "0", "0")
+    assert code == 2 and "expected a non-zero direction" in one_error_line(err)
