@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.orientation import OrientationWorkspace
 from ..core.projected import ProjectedWorkspace
@@ -29,7 +29,13 @@ if TYPE_CHECKING:
     from matplotlib.projections.polar import PolarAxes
     from mpl_toolkits.mplot3d import Axes3D
 
-__all__ = ["orientation_figure", "plot_orientation", "plot_projected", "projected_figure"]
+__all__ = [
+    "label_rings",
+    "orientation_figure",
+    "plot_orientation",
+    "plot_projected",
+    "projected_figure",
+]
 
 _STYLE: dict[str, dict[str, Any]] = {
     # exact underneath (wider, dashed), torsion_zero on top: both stay visible where they meet
@@ -87,6 +93,42 @@ def _ring_labels(
     return labels
 
 
+def label_rings(axes: Any, curves: Sequence[tuple[ArrayLike, ArrayLike]]) -> None:
+    """Radial axis and ring labels of a polar plot of tilts (deg) against azimuths (deg).
+
+    The axis runs from 0 to a round value at least 10 % above the largest tilt (no curve on the
+    frame); every ring but the frame is labelled, where :func:`_ring_labels` finds room.
+
+    Parameters
+    ----------
+    axes : matplotlib PolarAxes
+    curves : sequence of (phi, theta)
+        What is drawn: azimuths and tilts in degrees, arrays of shape (n,) (curves or points).
+    """
+    ordered = []
+    for phi, theta in curves:
+        phi = np.mod(np.asarray(phi, dtype=float), 360.0)
+        order = np.argsort(phi)
+        ordered.append((phi[order], np.asarray(theta, dtype=float)[order]))
+    largest = max((float(np.max(theta)) for _, theta in ordered if theta.size), default=1.0)
+    step = _nice_step(largest, 5)
+    top = step * math.ceil(largest * 1.1 / step)
+    ticks = np.arange(step, top - step / 2, step)  # none on the frame
+    axes.set_ylim(0.0, top)
+    axes.set_yticks(ticks, [""] * len(ticks))  # the rings; their labels are placed below
+    for (angle, radius, align), tick in zip(_ring_labels(ordered, ticks, top), ticks, strict=True):
+        axes.text(
+            math.radians(angle),
+            radius,
+            f"{tick:g}°",
+            ha="center",
+            va=align,
+            fontsize=8,
+            zorder=5,
+            bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.85, "pad": 0.8},
+        )
+
+
 def plot_projected(
     workspaces: Sequence[ProjectedWorkspace], path: str | Path, *, title: str | None = None
 ) -> Path:
@@ -121,35 +163,17 @@ def projected_figure(workspaces: Sequence[ProjectedWorkspace], *, title: str | N
     figure = Figure(figsize=(6.4, 6.8), layout="constrained")
     axes = cast("PolarAxes", figure.add_subplot(projection="polar"))
     curves = []
-    largest = 0.0
     for workspace in workspaces:
         style = _STYLE.get(workspace.method, {"color": "black", "linestyle": "-"})
         phi = np.append(workspace.phi, workspace.phi[0])
         theta = np.degrees(np.append(workspace.theta, workspace.theta[0]))
-        largest = max(largest, float(theta.max()))
         label = (
             f"{workspace.method}: θ {np.degrees(workspace.tilt_min):.2f}°–"
             f"{np.degrees(workspace.tilt_max):.2f}°, Ω {workspace.solid_angle:.3f} sr"
         )
         axes.plot(phi, theta, label=label, **style)
-        order = np.argsort(np.mod(np.degrees(workspace.phi), 360.0))
-        curves.append((np.mod(np.degrees(workspace.phi), 360.0)[order], theta[:-1][order]))
-    step = _nice_step(largest, 5)
-    top = step * math.ceil(largest * 1.1 / step)
-    ticks = np.arange(step, top - step / 2, step)  # none on the frame
-    axes.set_ylim(0.0, top)
-    axes.set_yticks(ticks, [""] * len(ticks))  # the rings; their labels are placed below
-    for (angle, radius, align), tick in zip(_ring_labels(curves, ticks, top), ticks, strict=True):
-        axes.text(
-            math.radians(angle),
-            radius,
-            f"{tick:g}°",
-            ha="center",
-            va=align,
-            fontsize=8,
-            zorder=5,
-            bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.85, "pad": 0.8},
-        )
+        curves.append((np.degrees(workspace.phi), theta[:-1]))
+    label_rings(axes, curves)
     axes.set_xticks(np.radians(np.arange(0, 360, 45)))
     axes.grid(True, linewidth=0.4)
     axes.set_title(
