@@ -106,6 +106,22 @@ def _assert_close(got, shown, path: str = "") -> None:
         assert got == shown, path
 
 
+def test_the_demo_table_is_what_the_demo_prints(tmp_path):
+    """The README's demo table, times aside (measured, stated with their conditions)."""
+    code, out, err = run_main("demo", "--out", str(tmp_path / "demo"))
+    assert code == 0, err
+
+    def rows(text: str) -> list[list[str]]:
+        return [
+            line.split("|")[1:-2]  # every cell but the times
+            for line in text.splitlines()
+            if line.startswith(("| on_axis |", "| off_axis |"))
+        ]
+
+    assert len(rows(README)) == 2
+    assert rows(README) == rows(out)
+
+
 # ------------------------------------------------------------------------- the node's examples
 def _node_job(kind: int, position, n_rays: int, tolerance: float = resolution.DEFAULT_TOLERANCE):
     job = WorkspaceJob(
