@@ -3,7 +3,8 @@
 #   make ros    colcon build of hexapod_workspace_msgs and hexapod_workspace (full venv)
 #   make lint   ruff (lint + format check) and mypy (config in pyproject.toml, strict on the core)
 #   make test   full venv + colcon build + ruff + Foxglove's npm libraries (npm ci, pinned by
-#               test/foxglove/package-lock.json) + the whole pytest suite over real DDS
+#               test/foxglove/package-lock.json; needs Node.js >= 18 and npm, checked first)
+#               + the whole pytest suite over real DDS
 #   make clean  remove build/ install/ log/ demo_out/ (keeps .venv)
 SHELL := /usr/bin/env bash
 .SHELLFLAGS := -euo pipefail -c
@@ -21,7 +22,7 @@ export HEXAPOD_REQUIRE_ROS := 1
 export HEXAPOD_REQUIRE_FOXGLOVE := 1
 FOXGLOVE := test/foxglove
 
-.PHONY: demo ros test lint venv-base venv-full foxglove clean
+.PHONY: demo ros test lint venv-base venv-full node-check foxglove clean
 
 venv-base:
 	tools/venv.sh base
@@ -41,7 +42,11 @@ lint: venv-full
 	$(VENV)/bin/mypy
 
 # npm ci only when the lock file changed; its output goes to log/npm_ci.out (shown on failure).
-$(FOXGLOVE)/node_modules/.package-lock.json: $(FOXGLOVE)/package.json $(FOXGLOVE)/package-lock.json
+# Node.js >= 18 and npm, checked first by make test: one line when missing or too old.
+node-check:
+	@tools/check_node.sh
+
+$(FOXGLOVE)/node_modules/.package-lock.json: $(FOXGLOVE)/package.json $(FOXGLOVE)/package-lock.json | node-check
 	@mkdir -p log
 	@echo "[tools] npm ci in $(FOXGLOVE) (Foxglove's libraries for the log checks)" >&2
 	@cd $(FOXGLOVE) && npm ci --no-audit --no-fund >$(CURDIR)/log/npm_ci.out 2>&1 \
@@ -50,7 +55,7 @@ $(FOXGLOVE)/node_modules/.package-lock.json: $(FOXGLOVE)/package.json $(FOXGLOVE
 
 foxglove: $(FOXGLOVE)/node_modules/.package-lock.json
 
-test: ros lint foxglove
+test: node-check ros lint foxglove
 	tools/with_ros_env.sh python -m pytest test
 
 clean:

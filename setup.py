@@ -40,7 +40,7 @@ setup(
     long_description=(HERE / "README.md").read_text(encoding="utf-8"),
     long_description_content_type="text/markdown",
     license="Apache-2.0",
-    python_requires=">=3.10",
+    python_requires=">=3.11",
     packages=find_packages(exclude=["test", "test.*", "benchmarks"]),
     package_data={PACKAGE: ["py.typed"]},
     cmdclass={"build_py": BuildPyWithData},

@@ -55,3 +55,30 @@ def one_error_line(err: str) -> str:
     assert len(lines) == 1, err
     assert lines[0].startswith("hexapod-workspace: error: "), err
     return lines[0]
+
+
+def polar_labels_clear(figure, axes) -> set[str]:
+    """Draw ``figure`` and return the ring labels (texts) of polar ``axes``, after asserting
+    that none covers anything plotted there (every line and marker, segments sampled densely),
+    in display coordinates."""
+    import numpy as np
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    renderer = FigureCanvasAgg(figure).get_renderer()
+    figure.draw(renderer)
+    labels = {text.get_text(): text.get_window_extent(renderer) for text in axes.texts}
+    for line in axes.get_lines():
+        phi, theta = (np.asarray(v, dtype=float) for v in line.get_data())
+        if phi.size == 0:
+            continue
+        if line.get_linestyle() in ("None", "", " "):  # markers only: the points themselves
+            points = np.column_stack([phi, theta])
+        else:  # the drawn segments, not only their vertices
+            dense, index = np.linspace(0.0, 1.0, 20 * phi.size), np.linspace(0.0, 1.0, phi.size)
+            points = np.column_stack([np.interp(dense, index, phi), np.interp(dense, index, theta)])
+        shown = axes.transData.transform(points)
+        for text, box in labels.items():
+            inside = (box.x0 <= shown[:, 0]) & (shown[:, 0] <= box.x1)
+            inside &= (box.y0 <= shown[:, 1]) & (shown[:, 1] <= box.y1)
+            assert not np.any(inside), (text, line.get_label())
+    return set(labels)

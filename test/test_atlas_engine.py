@@ -182,7 +182,8 @@ def test_interrupted_run_resumes_with_only_the_missing_chunks(reference, example
     assert partial.attrs["complete"] is False
     assert int(partial[MARKER].values.sum()) == 2
     before = _chunk_files(store)
-    with pytest.raises(AtlasError, match="already exists"):  # no silent overwrite
+    # No silent overwrite; the refusal says what the store holds and what to do.
+    with pytest.raises(AtlasError, match=r"incomplete \(2 of 6 chunks done.*resume=True"):
         workspace_atlas(example, GRID, store=store, options=OPTIONS, workers=0, chunk=CHUNK)
     with _cluster() as cluster:
         run = workspace_atlas(
@@ -331,7 +332,7 @@ def test_cli_existing_store_without_resume_exits_2_and_keeps_it(tmp_path):
     assert first.returncode == 0, first.stderr
     again = run_cli(*job, "--out", str(store), "--workers", "0")
     assert again.returncode == 2 and again.stderr.count("\n") == 1
-    assert "already exists" in again.stderr
+    assert "already exists and is complete (1 of 1 chunks)" in again.stderr
     assert open_atlas(store).attrs["complete"] is True
 
 

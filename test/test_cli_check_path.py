@@ -182,3 +182,20 @@ def test_huge_angles_are_their_principal_values(tmp_path):
     assert main(["check-path", str(source), "--json"], out=out) == 0
     first, second = json.loads(out.getvalue())["waypoints"]
     assert first["margins"] == second["margins"]
+
+
+def test_the_tool_direction_plot_labels_every_ring_clear_of_the_curves(example):
+    """Issue 16 item 18: the polar panel of the README's toolpath figure (tool axes on a 17°
+    cone off the axis) labels every ring, and no label covers a curve or a tool direction."""
+    from cli_support import polar_labels_clear
+
+    from hexapod_workspace import plan_torsion
+    from hexapod_workspace.cli.check_path import path_figure
+
+    positions, _, axes = cone()
+    plan = plan_torsion(example, positions, axes, max_dpsi=np.radians(5.0))
+    figure = path_figure(plan, plan.baseline, example)
+    polar = next(a for a in figure.axes if a.name == "polar")
+    labels = polar_labels_clear(figure, polar)
+    ticks = polar.get_yticks()
+    assert labels == {f"{t:g}°" for t in ticks} and len(labels) >= 3

@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
+import re
+import shlex
+from pathlib import Path
 
 import pytest
 from cli_support import one_error_line, run_main
@@ -216,14 +220,31 @@ def test_help_describes_every_option_and_shows_defaults():
         with contextlib.redirect_stdout(text), pytest.raises(SystemExit):
             parser.parse_args([name, "--help"])
         assert "--json" in text.getvalue()
-    for name, options in {
-        "projected": ["--method", "--n-phi", "--tol-deg"],
-        "orientation": ["--n-rays", "--psi-step-deg", "--tol-deg"],
-    }.items():
-        sub = next(a for a in parser._actions if a.dest == "command").choices[name]
+    # Every option whose absence means a value shows that value in --help: those with an
+    # argparse default show exactly it; those whose None stands for a value computed later
+    # (listed here) say what it is.
+    computed = {
+        "atlas": {"--tol-deg", "--scheduler", "--workers", "--chunk"},
+        "check-path": {"--max-dpsi-deg"},
+        "projected": {"--tol-deg", "--n-phi"},
+        "orientation": {"--tol-deg", "--n-rays", "--psi-step-deg"},
+    }
+    commands = next(a for a in parser._actions if a.dest == "command").choices
+    for name, sub in commands.items():
         for action in sub._actions:
-            if set(action.option_strings) & set(options):
-                assert action.help and "default" in action.help, action.option_strings
+            if not action.option_strings or action.required or action.nargs == 0:
+                continue  # positionals, required options, flags
+            shown = sub._get_formatter()._expand_help(action) if action.help else ""
+            option = f"{name} {action.option_strings[0]}"
+            if action.default == argparse.SUPPRESS:  # global options repeated after the command
+                assert "default" in shown or action.dest == "json", option
+            elif action.default not in (None, []):
+                default = action.default
+                text = f"{default:g}" if isinstance(default, float) else str(default)
+                said = (f"default {text}", f"default: {text}", f"{text}, default")
+                assert any(words in shown for words in said), (option, shown)
+            elif action.option_strings[0] in computed.get(name, set()):
+                assert "default" in shown, option
 
 
 def test_no_progress_bar_when_stderr_is_not_a_terminal():
@@ -231,10 +252,15 @@ def test_no_progress_bar_when_stderr_is_not_a_terminal():
     assert "[#" not in err
 
 
-def test_demo_writes_table_plots_and_a_log_with_real_times(tmp_path):
-    out_dir = tmp_path / "deep" / "demo"  # --out is created with its parents
+def test_demo_writes_table_plots_and_a_log_with_real_times(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    out_dir = Path("deep") / "demo"  # --out is created with its parents
     code, out, err = run_main("demo", "--out", str(out_dir))
     assert code == 0, err
+    # The replay hint names the log as seen from where the demo ran, and works from there.
+    hint = re.search(r"`(hexapod-workspace replay [^`]+)`", out)
+    assert hint and hint.group(1) == "hexapod-workspace replay deep/demo/demo.mcap"
+    assert run_main(*shlex.split(hint.group(1))[1:])[0] == 0
     names = {path.name for path in out_dir.iterdir()}
     assert {
         "results.md",

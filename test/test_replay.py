@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_support import polar_labels_clear
 from recording_support import plain, read_with_mcap_ros2, read_with_rosbags, write_foreign_log
 from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Rosbag2Writer
@@ -440,16 +441,47 @@ print(matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules)
 
 
 def test_projected_plot_radial_axis_clears_the_largest_tilt(tmp_path: Path) -> None:
-    """Item 17: the curves never lie on the frame, and no radial label sits on a curve."""
+    """Item 17: the curves never lie on the frame; issue 16 item 18: every ring is labelled,
+    and no label covers a curve (checked on the drawn figure, in display coordinates), also
+    where the curves hug a ring (on the axis: 38-39.5° against the 40° ring)."""
+    from hexapod_workspace import Manipulator, projected_workspace
     from hexapod_workspace.cli import plotting
 
-    workspaces = [projected_stub(), projected_stub("exact")]
-    largest = max(np.degrees(w.theta).max() for w in workspaces)
-    step = plotting._nice_step(largest, 5)
-    top = step * math.ceil(largest * 1.1 / step)
-    assert top >= 1.1 * largest
-    ticks = np.arange(step, top - step / 2, step)
-    curves = [(np.mod(np.degrees(w.phi), 360.0), np.degrees(w.theta)) for w in workspaces]
-    angle = plotting._label_angle(curves, ticks)
-    assert angle % 45.0 == 22.5
-    assert plotting.plot_projected(workspaces, tmp_path / "p.png").stat().st_size > 10_000
+    example = Manipulator.example()
+    cases = {
+        "stubs": [projected_stub(), projected_stub("exact")],
+        "on the axis": [
+            projected_workspace(example, [0, 0, -1.3], n_phi=72),
+            projected_workspace(example, [0, 0, -1.3], n_phi=72, method="exact"),
+        ],
+    }
+    for case, workspaces in cases.items():
+        largest = max(np.degrees(w.theta).max() for w in workspaces)
+        step = plotting._nice_step(largest, 5)
+        top = step * math.ceil(largest * 1.1 / step)
+        assert top >= 1.1 * largest
+        ticks = np.arange(step, top - step / 2, step)
+        figure = plotting.projected_figure(workspaces)
+        (axes,) = figure.axes
+        assert polar_labels_clear(figure, axes) == {f"{t:g}°" for t in ticks}, case
+    assert plotting.plot_projected(cases["on the axis"], tmp_path / "p.png").stat().st_size > 10_000
+
+
+def test_orientation_plot_labels_of_the_two_panels_stay_apart() -> None:
+    """Issue 16 item 18: the 3-D panel's ψ label and the top view's θ sin φ label do not touch
+    (measured on the drawn figure, on and off the axis)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from hexapod_workspace import Manipulator, orientation_workspace
+    from hexapod_workspace.cli import plotting
+
+    example = Manipulator.example()
+    for position in ([0, 0, -1.3], [0.2, 0.2, -0.95]):
+        workspace = orientation_workspace(example, position, n_rays=36, psi_step=np.radians(5))
+        figure = plotting.orientation_figure(workspace)
+        renderer = FigureCanvasAgg(figure).get_renderer()
+        figure.draw(renderer)
+        surface, top = figure.axes[:2]
+        psi_label = surface.zaxis.label.get_window_extent(renderer)
+        tilt_label = top.yaxis.label.get_window_extent(renderer)
+        assert psi_label.x1 + 10 < tilt_label.x0, (position, psi_label, tilt_label)

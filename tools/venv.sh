@@ -6,7 +6,9 @@
 #                        + the atlas extra (Dask, xarray, Zarr)
 #
 # Idempotent: each level records a hash of its requirement files and packaging metadata in the
-# venv and is skipped when nothing changed. Needs only python3 (and the package index).
+# venv and is skipped when nothing changed. Needs only Python >= 3.11 ($PYTHON, default python3)
+# and the package index; an older interpreter stops it with one line naming the cause, before
+# pip runs.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
@@ -19,9 +21,12 @@ case "$level" in
 esac
 
 if [[ ! -x "$VENV/bin/python" ]]; then
+  require_python "$PYTHON"
   log "creating $VENV"
   "$PYTHON" -m venv "$VENV"
 fi
+
+require_python "$VENV/bin/python"  # an older venv made by another interpreter
 
 stamp="$VENV/.stamp-$level"
 want="$(files_hash "${reqs[@]}" "$ROOT/setup.py" "$ROOT/setup.cfg" "$ROOT/pyproject.toml" \

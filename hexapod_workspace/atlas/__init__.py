@@ -8,6 +8,8 @@ per-position computation is numpy-only and lives in :mod:`hexapod_workspace.core
 
 from __future__ import annotations
 
+import shlex
+import sys
 from typing import TYPE_CHECKING, Any
 
 from ..errors import MissingExtraError
@@ -17,10 +19,22 @@ if TYPE_CHECKING:
     from ..core.manipulator import Manipulator
     from .engine import AtlasRun
 
-__all__ = ["INSTALL_HINT", "require_extra", "workspace_atlas"]
+__all__ = ["EXTRA_REQUIREMENTS", "install_hint", "require_extra", "workspace_atlas"]
 
-INSTALL_HINT = "pip install hexapod_workspace[atlas]"
+#: The ``atlas`` extra of setup.py, requirement by requirement (a test keeps the two equal).
+EXTRA_REQUIREMENTS = ("dask[distributed]>=2024.12", "xarray>=2025.1", "zarr>=3.0")
 _MODULES = ("dask", "distributed", "xarray", "zarr")
+
+
+def install_hint() -> str:
+    """A command that installs the extra into the running interpreter, wherever the package came
+    from (the package is not on the package index, so ``pip install hexapod_workspace[atlas]``
+    cannot work): ``/path/to/python -m pip install 'dask[distributed]>=2024.12' ...``."""
+    command = [sys.executable or "python3", "-m", "pip", "install", *EXTRA_REQUIREMENTS]
+    return (
+        " ".join(shlex.quote(word) for word in command)
+        + " (in a clone of the repository also: pip install '.[atlas]')"
+    )
 
 
 def require_extra() -> None:
@@ -34,7 +48,7 @@ def require_extra() -> None:
     if missing:
         msg = (
             f"the workspace atlas needs the 'atlas' extra ({', '.join(missing)} missing): "
-            f"{INSTALL_HINT}"
+            f"{install_hint()}"
         )
         raise MissingExtraError(msg)
 

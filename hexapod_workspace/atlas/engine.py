@@ -19,6 +19,7 @@ from __future__ import annotations
 import logging
 import os
 import shutil
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -261,13 +262,14 @@ def run_atlas(
     if workers is not None and (workers < 0 or (scheduler and workers)):
         msg = f"workers: expected >= 0 and no scheduler address, got {workers}"
         raise InputError(msg)
+    if workers != 0 and _reimported_by_a_worker():
+        raise AtlasError(_GUARD_HINT)  # before the store is touched
     layout = ChunkLayout.for_grid(grid, chunk)
     attrs = store_attrs(manipulator, grid, options, layout)
     created = False
     if path.exists():
         if not resume:
-            msg = f"store {path} already exists (--resume completes it; or remove it)"
-            raise AtlasError(msg)
+            raise AtlasError(_existing_store(path, layout))
         check_resumable(path, attrs)
     else:
         create_store(path, grid, options, layout, attrs)
@@ -301,6 +303,14 @@ def run_atlas(
         if created:  # nothing was computed: leave no empty store behind
             shutil.rmtree(path, ignore_errors=True)
         raise
+    except Exception as error:  # the local cluster did not start (e.g. "Nanny failed to start")
+        if created:
+            shutil.rmtree(path, ignore_errors=True)
+        reason = " ".join(str(error).split()) or type(error).__name__
+        msg = f"the local Dask cluster did not start ({type(error).__name__}: {reason})"
+        if _main_is_a_script():
+            msg += f"; {_GUARD_HINT}"
+        raise AtlasError(msg) from error
     worker_count = getattr(engine, "workers", 0)
     try:
         if jobs:
@@ -319,6 +329,48 @@ def run_atlas(
         chunks_total=layout.total,
         chunks_computed=computed["chunks"],
         positions_computed=computed["positions"],
+    )
+
+
+#: Why a script that starts a local cluster fails without the main guard, and what to do.
+_GUARD_HINT = (
+    "Dask's worker processes re-import the script that starts a local cluster, so a script "
+    'must call workspace_atlas under `if __name__ == "__main__":` (or pass workers=0)'
+)
+
+
+def _reimported_by_a_worker() -> bool:
+    """True in a worker process that is importing the user's script as ``__mp_main__`` (what
+    multiprocessing's spawn does): starting a cluster there would fail, so refuse at once."""
+    # In the process that ran the script, sys.modules["__mp_main__"] is "__main__" itself.
+    main = sys.modules.get("__mp_main__")  # spawn runs the script under this name
+    return getattr(main, "__name__", "") == "__mp_main__"
+
+
+def _main_is_a_script() -> bool:
+    """True when ``__main__`` is a file the worker processes re-import (not a REPL, not -c)."""
+    return bool(getattr(sys.modules.get("__main__"), "__file__", None))
+
+
+def _existing_store(path: Path, layout: ChunkLayout) -> str:
+    """The refusal for an existing store without ``resume``: what it holds and what to do."""
+    try:
+        done = len(done_chunks(path))
+    except Exception:  # not a store of ours, or its metadata is damaged
+        return (
+            f"store {path} already exists and is not a readable atlas store: remove it "
+            "(or choose another store)"
+        )
+    if done >= layout.total:
+        return (
+            f"store {path} already exists and is complete ({done} of {layout.total} chunks): "
+            "open it with hexapod_workspace.atlas.store.open_atlas (resume=True, --resume "
+            "returns it without computing), or remove it to compute it again"
+        )
+    return (
+        f"store {path} already exists and is incomplete ({done} of {layout.total} chunks "
+        "done, an interrupted run): resume=True (CLI --resume) computes only the missing "
+        "chunks; or remove it to start again"
     )
 
 

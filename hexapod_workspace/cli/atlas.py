@@ -84,7 +84,10 @@ def atlas_arguments(sub: argparse.ArgumentParser) -> None:
         help="also require the torsion range at zero tilt to cover [LO, HI] degrees",
     )
     sub.add_argument(
-        "--scheduler", metavar="ADDR", help="existing Dask scheduler (tcp://host:port)"
+        "--scheduler",
+        metavar="ADDR",
+        help="existing Dask scheduler (tcp://host:port; default: $DASK_SCHEDULER_ADDRESS when "
+        "set, else a local cluster)",
     )
     sub.add_argument(
         "--workers",
@@ -94,8 +97,20 @@ def atlas_arguments(sub: argparse.ArgumentParser) -> None:
     )
     sub.add_argument("--resume", action="store_true", help="complete an interrupted --out store")
     sub.add_argument("--plot", metavar="DIR", help="write heat maps and a 3-D view into DIR")
-    sub.add_argument("--n-phi", type=int, default=72, metavar="N", help="azimuths per position")
-    sub.add_argument("--tol-deg", type=float, metavar="T", help="boundary tolerance, degrees")
+    sub.add_argument(
+        "--n-phi",
+        type=int,
+        default=72,
+        metavar="N",
+        help="azimuths per position (default %(default)s)",
+    )
+    sub.add_argument(
+        "--tol-deg",
+        type=float,
+        metavar="T",
+        help=f"boundary tolerance, degrees (default {math.degrees(ATLAS_TOLERANCE):.3g}, "
+        f"i.e. {ATLAS_TOLERANCE:g} rad)",
+    )
     sub.add_argument(
         "--chunk",
         type=int,

@@ -1,11 +1,12 @@
 """Figures of a workspace atlas (matplotlib, Agg backend), angles in degrees, lengths in m.
 
 * :func:`plot_tilt_slices`: one heat map of the tilt capability per z slice (x, y in m) with
-  the contour of every required tilt θ_req; positions where the reference orientation is
-  unreachable are left blank (hatched), never drawn as zero.
-* :func:`plot_dexterous_3d`: a 3-D view of the dexterous workspace (grid cells whose tilt
-  capability is at least θ_req), one colour per θ_req, with the reachable region as a frame of
-  reference.
+  the outline of the grid cells that reach every required tilt θ_req (the cells the dexterous
+  volume counts, a single cell as a square) and their count; positions where the reference
+  orientation is unreachable are left blank (hatched), never drawn as zero.
+* :func:`plot_dexterous_3d`: a 3-D section view of the dexterous workspace (grid cells whose
+  tilt capability is at least θ_req, opaque, one colour per θ_req, inside the reachable cells
+  in grey), the half y < 0 removed so the nested sets show side by side.
 """
 
 from __future__ import annotations
@@ -35,10 +36,35 @@ def _slices(count: int) -> list[int]:
     return sorted({round(k) for k in np.linspace(0, count - 1, MAX_SLICES)})
 
 
+def _cell_outline(
+    inside: np.ndarray, x: np.ndarray, y: np.ndarray, half: float
+) -> list[list[tuple[float, float]]]:
+    """Edges (line segments, m) between the grid cells of ``inside`` (rows y, columns x) and
+    the others or the border: the exact outline of the set the dexterous volume counts, one
+    square per cell at most (an interpolated contour would shrink a single cell to a dot)."""
+    rows, columns = inside.shape
+    padded = np.zeros((rows + 2, columns + 2), dtype=bool)
+    padded[1:-1, 1:-1] = inside
+    segments = []
+    for i, j in zip(*np.nonzero(inside), strict=True):
+        cx, cy = float(x[j]), float(y[i])
+        left, right, low, high = cx - half, cx + half, cy - half, cy + half
+        if not padded[i + 1, j]:
+            segments.append([(left, low), (left, high)])
+        if not padded[i + 1, j + 2]:
+            segments.append([(right, low), (right, high)])
+        if not padded[i, j + 1]:
+            segments.append([(left, low), (right, low)])
+        if not padded[i + 2, j + 1]:
+            segments.append([(left, high), (right, high)])
+    return segments
+
+
 def plot_tilt_slices(
     dataset: Any, grid: AtlasGrid, tilts_deg: Sequence[float], path: str | Path
 ) -> Path:
     """Heat maps of ``tilt_capability`` per z slice with the θ_req contours; returns the PNG."""
+    from matplotlib.collections import LineCollection
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch, Rectangle
@@ -80,15 +106,18 @@ def plot_tilt_slices(
             interpolation="nearest",
             zorder=1,
         )
-        if x.size > 1 and y.size > 1:
-            filled = np.where(np.isfinite(values), values, -1.0)  # unreachable: below any level
+        counts = []
+        with np.errstate(invalid="ignore"):
             for level, color in zip(tilts_deg, _LEVEL_COLORS, strict=False):
-                if filled.max() >= level > filled.min():
-                    lines = axis.contour(
-                        x, y, filled, levels=[level], colors=[color], linewidths=1.6, zorder=2
+                inside = values >= level  # NaN (unreachable) is never inside
+                segments = _cell_outline(inside, x, y, half)
+                if segments:
+                    axis.add_collection(
+                        LineCollection(segments, colors=color, linewidths=1.8, zorder=2)
                     )
-                    axis.clabel(lines, fmt=f"{level:g}°", fontsize=7)
-        axis.set_title(f"z = {z[k]:.3f} m", fontsize=10)
+                counts.append(f"≥ {level:g}°: {int(inside.sum())}")
+        cells = f"\ncells {', '.join(counts)}" if counts else ""
+        axis.set_title(f"z = {z[k]:.3f} m{cells}", fontsize=9)
         axis.set_aspect("equal")
     for axis in axes.flat[len(chosen) :]:
         axis.set_visible(False)
@@ -103,11 +132,15 @@ def plot_tilt_slices(
         Patch(facecolor="0.85", hatch="//", edgecolor="0.6", label="reference unreachable")
     ]
     handles += [
-        Line2D([], [], color=color, linewidth=1.6, label=f"θ_req = {level:g}°")
+        Line2D([], [], color=color, linewidth=1.8, label=f"cells with tilt capability ≥ {level:g}°")
         for level, color in zip(tilts_deg, _LEVEL_COLORS, strict=False)
     ]
     figure.legend(handles=handles, loc="outside lower center", ncols=len(handles), fontsize=8)
-    figure.suptitle("Tilt capability (largest cone of tool directions all attainable) per z slice")
+    figure.suptitle(
+        "Tilt capability (largest cone of tool directions all attainable) per z slice; the "
+        "outlines enclose the grid cells the dexterous volume counts (a lone square: one cell)",
+        fontsize=10,
+    )
     path = Path(path)
     figure.savefig(path, dpi=110, facecolor="white")
     return path
@@ -116,7 +149,12 @@ def plot_tilt_slices(
 def plot_dexterous_3d(
     dataset: Any, grid: AtlasGrid, tilts_deg: Sequence[float], path: str | Path
 ) -> Path:
-    """3-D view of the dexterous workspace per θ_req (grid cells as voxels); returns the PNG."""
+    """Section view of the dexterous workspace per θ_req (grid cells as voxels); returns the PNG.
+
+    The cells are opaque and nested: reachable (grey), then one colour per θ_req. The half
+    y < 0 is removed, so the viewer looks at the section through the axis (the y = 0 row of
+    cells) and sees the nested sets side by side; the box is fitted to the reachable cells.
+    """
     import matplotlib as mpl
     from matplotlib.figure import Figure
     from matplotlib.patches import Patch
@@ -126,57 +164,62 @@ def plot_dexterous_3d(
     step = grid.step or 1.0
     edges = [np.append(axis - 0.5 * step, axis[-1] + 0.5 * step) for axis in grid.box_axes]
     xe, ye, ze = np.meshgrid(*edges, indexing="ij")
-    figure = Figure(figsize=(7.5, 6.8))
+    figure = Figure(figsize=(7.8, 5.6), layout="constrained")
     axis = cast("Axes3D", figure.add_subplot(projection="3d"))
     colors = mpl.colormaps["plasma"](np.linspace(0.15, 0.85, max(1, len(tilts_deg))))
-    handles = []
     levels = sorted(tilts_deg)
-    # Cut away the quadrant facing the viewer (x > 0, y < 0) so that inner shells show.
-    xs, ys, _ = np.meshgrid(*grid.box_axes, indexing="ij")
-    kept = ~((xs > 0.25 * step) & (ys < -0.25 * step))
+    _, ys, _ = np.meshgrid(*grid.box_axes, indexing="ij")
+    kept = ys > -0.25 * step  # the half facing the viewer removed: a section through the axis
+    shells = []  # (cells, face colour, legend label), outermost first
     with np.errstate(invalid="ignore"):
-        for index, level in enumerate(levels):
-            inside = (capability >= level) & kept
-            if index + 1 < len(levels):
-                inside &= ~(capability >= levels[index + 1])  # nested: draw each shell once
-            if inside.any():
-                axis.voxels(
-                    xe,
-                    ye,
-                    ze,
-                    inside,
-                    facecolors=(*colors[index][:3], 0.55),
-                    edgecolor=(0, 0, 0, 0.15),
-                    linewidth=0.3,
-                )
-            volume = float((capability >= level).sum()) * step**3
-            label = f"tilt capability ≥ {level:g}°: {volume:.4f} m³"
-            handles.append(Patch(facecolor=colors[index], alpha=0.55, label=label))
-    lowest = levels[0] if levels else np.inf
-    with np.errstate(invalid="ignore"):
-        outline = reachable & ~(capability >= lowest) & kept
-    if outline.any():
-        axis.voxels(
-            xe,
-            ye,
-            ze,
-            outline,
-            facecolors=(0.6, 0.6, 0.6, 0.06),
-            edgecolor=(0.4, 0.4, 0.4, 0.08),
-            linewidth=0.2,
-        )
+        lowest = levels[0] if levels else np.inf
         below = f", tilt capability < {lowest:g}°" if levels else ""
-        handles.append(Patch(facecolor=(0.6, 0.6, 0.6, 0.3), label=f"reference reachable{below}"))
+        shells.append(
+            (
+                reachable & ~(capability >= lowest),
+                (0.78, 0.78, 0.78, 1.0),
+                f"reference reachable{below}",
+            )
+        )
+        for index, level in enumerate(levels):
+            inside = capability >= level
+            volume = float(inside.sum()) * step**3
+            if index + 1 < len(levels):
+                inside &= ~(capability >= levels[index + 1])  # nested: each cell drawn once
+            shells.append(
+                (
+                    inside,
+                    (*colors[index][:3], 1.0),
+                    f"tilt capability ≥ {level:g}°: {volume:.4f} m³",
+                )
+            )
+    handles = []
+    for cells, color, label in shells:
+        if (cells & kept).any():
+            axis.voxels(
+                xe, ye, ze, cells & kept, facecolors=color, edgecolor=(0, 0, 0, 0.25), linewidth=0.3
+            )
+        handles.append(Patch(facecolor=color, edgecolor=(0, 0, 0, 0.4), label=label))
+    # The box around the reachable cells (kept half), not the whole requested grid.
+    shown = reachable & kept
+    if shown.any():
+        occupied = np.nonzero(shown)
+        bounds = [
+            (float(edge[k.min()]), float(edge[k.max() + 1]))
+            for edge, k in zip(edges, occupied, strict=True)
+        ]
+        limits = (axis.set_xlim, axis.set_ylim, axis.set_zlim)
+        for setter, (low, high) in zip(limits, bounds, strict=True):
+            setter(low, high)
+        axis.set_box_aspect([high - low for low, high in bounds], zoom=0.95)
     axis.set_xlabel("x [m]")
     axis.set_ylabel("y [m]")
     axis.set_zlabel("z [m]")
-    spans = [e[-1] - e[0] for e in edges]
-    axis.set_box_aspect(spans)
-    axis.view_init(elev=22, azim=-60)
-    axis.legend(handles=handles, loc="upper left", fontsize=8)
-    axis.set_title(
-        f"Dexterous workspace: grid cells of {step * 1e3:g} mm, front quadrant (x > 0, y < 0) "
-        "cut away",
+    axis.view_init(elev=18, azim=-62)
+    figure.legend(handles=handles, loc="outside lower center", fontsize=8, ncols=1)
+    figure.suptitle(
+        f"Dexterous workspace in grid cells of {step * 1e3:g} mm: section through the axis "
+        "(the half y < 0 removed)",
         fontsize=10,
     )
     path = Path(path)

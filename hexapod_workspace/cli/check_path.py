@@ -357,9 +357,20 @@ def plot_path(
     path : str or Path
         PNG file.
     """
+    figure = path_figure(result, baseline, manipulator)
+    path = Path(path)
+    figure.savefig(path, dpi=120, bbox_inches="tight")
+    return path
+
+
+def path_figure(
+    result: PathCheck | TorsionPlan, baseline: PathCheck, manipulator: Manipulator
+) -> Any:
+    """The figure of :func:`plot_path` (a :class:`matplotlib.figure.Figure`), not saved."""
     from matplotlib.figure import Figure
 
     from ..core.projected import projected_workspace
+    from .plotting import label_rings
 
     checked, plan = reported_parts(result)
     waypoints = checked.waypoints
@@ -423,11 +434,13 @@ def plot_path(
     polar = cast("PolarAxes", figure.add_subplot(grid[:, 1], projection="polar"))
     center = waypoints.positions.mean(axis=0)
     at_center = manipulator.with_position(center)
+    drawn = []  # (phi deg, theta deg) of everything on the polar plot, for the ring labels
     for method, color, style in (("torsion_zero", "tab:red", "--"), ("exact", "tab:green", "-")):
         try:
             workspace = projected_workspace(at_center, method=method, n_phi=180, tolerance=1e-4)
         except Exception:  # an empty workspace at the mean position: nothing to draw
             continue
+        drawn.append((np.degrees(workspace.phi), np.degrees(workspace.theta)))
         polar.plot(
             np.append(workspace.phi, workspace.phi[0]),
             np.degrees(np.append(workspace.theta, workspace.theta[0])),
@@ -445,8 +458,9 @@ def plot_path(
         polar.plot(
             phi[failed], theta[failed], "x", color="tab:red", ms=4, label="unreachable with ψ ≡ 0"
         )
+    drawn.append((np.degrees(phi), theta))
+    label_rings(polar, drawn)  # every ring labelled, no label over a curve or a direction
     spread = np.ptp(waypoints.positions, axis=0).max()
-    polar.set_rlabel_position(112.5)
     polar.set_title(
         "Tool directions: tilt θ [deg] vs azimuth φ\nworkspace at the mean position "
         f"({center[0]:.3f}, {center[1]:.3f}, {center[2]:.3f}) m; path spans {spread * 1e3:.0f} mm",
@@ -454,9 +468,7 @@ def plot_path(
     )
     polar.legend(loc="lower center", bbox_to_anchor=(0.5, -0.24), fontsize=7)
     figure.tight_layout()
-    path = Path(path)
-    figure.savefig(path, dpi=120, bbox_inches="tight")
-    return path
+    return figure
 
 
 # ---------------------------------------------------------------------------- record

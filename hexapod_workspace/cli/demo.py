@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import math
+import shlex
 import time
 from pathlib import Path
 from typing import IO, Any
@@ -157,7 +158,8 @@ def run_demo(
         out_dir / "demo.mcap", recorded, frame_id=manipulator.frame_id, stamps_ns=stamps
     )
     (out_dir / "results.json").write_text(json.dumps(rows, indent=1) + "\n", encoding="utf-8")
-    table = reports.demo_table(rows, log.name)
+    # The log as the user can name it from where the demo ran (--out as given: demo_out/demo.mcap).
+    table = reports.demo_table(rows, shlex.quote(str(out_dir / log.name)))
     (out_dir / "results.md").write_text(table, encoding="utf-8")
     if as_json:
         out.write(json.dumps({"out": str(out_dir), "cases": rows, "log": log.name}) + "\n")

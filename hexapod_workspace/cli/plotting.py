@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.orientation import OrientationWorkspace
 from ..core.projected import ProjectedWorkspace
@@ -29,7 +29,13 @@ if TYPE_CHECKING:
     from matplotlib.projections.polar import PolarAxes
     from mpl_toolkits.mplot3d import Axes3D
 
-__all__ = ["plot_orientation", "plot_projected"]
+__all__ = [
+    "label_rings",
+    "orientation_figure",
+    "plot_orientation",
+    "plot_projected",
+    "projected_figure",
+]
 
 _STYLE: dict[str, dict[str, Any]] = {
     # exact underneath (wider, dashed), torsion_zero on top: both stay visible where they meet
@@ -59,12 +65,68 @@ def _curve_distances(
     return np.min(np.abs(ticks[:, None] - radii[None, :]), axis=1)
 
 
-def _label_angle(curves: Sequence[tuple[NDArray, NDArray]], ticks: NDArray) -> float:
-    """The azimuth (deg) at which radial tick labels sit farthest from every curve (between
-    the 45° spokes, so they never meet the azimuth labels either)."""
-    candidates = np.arange(22.5, 360.0, 45.0)
-    clearance = [float(np.min(_curve_distances(curves, ticks, float(a)))) for a in candidates]
-    return float(candidates[int(np.argmax(clearance))])
+#: Azimuths (deg) where ring labels may sit: between the 45° spokes, away from the φ labels.
+_LABEL_ANGLES = np.arange(22.5, 360.0, 45.0)
+
+
+def _ring_labels(
+    curves: Sequence[tuple[NDArray, NDArray]], ticks: NDArray, top: float
+) -> list[tuple[float, float, str]]:
+    """Where to write each ring's label: (azimuth deg, radius deg, vertical alignment).
+
+    Every ring is labelled. All labels sit on the one spoke where they are farthest from the
+    curves; a label that would still sit on a curve there (curves hugging a ring, e.g. 38-39.5°
+    against the 40° ring) moves just off the ring, to the side away from the curves, so the
+    reader sees which ring is which without text over a curve.
+    """
+    clearance = [float(np.min(_curve_distances(curves, ticks, float(a)))) for a in _LABEL_ANGLES]
+    angle = float(_LABEL_ANGLES[int(np.argmax(clearance))])
+    radii = np.array([np.interp(angle, phi, theta, period=360.0) for phi, theta in curves])
+    labels = []
+    for tick, distance in zip(ticks, _curve_distances(curves, ticks, angle), strict=True):
+        if distance >= 0.035 * top:
+            labels.append((angle, float(tick), "center"))
+        elif np.all(radii <= tick):  # curves inside the ring: label outside it
+            labels.append((angle, float(tick) + 0.02 * top, "bottom"))
+        else:
+            labels.append((angle, float(tick) - 0.02 * top, "top"))
+    return labels
+
+
+def label_rings(axes: Any, curves: Sequence[tuple[ArrayLike, ArrayLike]]) -> None:
+    """Radial axis and ring labels of a polar plot of tilts (deg) against azimuths (deg).
+
+    The axis runs from 0 to a round value at least 10 % above the largest tilt (no curve on the
+    frame); every ring but the frame is labelled, where :func:`_ring_labels` finds room.
+
+    Parameters
+    ----------
+    axes : matplotlib PolarAxes
+    curves : sequence of (phi, theta)
+        What is drawn: azimuths and tilts in degrees, arrays of shape (n,) (curves or points).
+    """
+    ordered = []
+    for phi, theta in curves:
+        phi = np.mod(np.asarray(phi, dtype=float), 360.0)
+        order = np.argsort(phi)
+        ordered.append((phi[order], np.asarray(theta, dtype=float)[order]))
+    largest = max((float(np.max(theta)) for _, theta in ordered if theta.size), default=1.0)
+    step = _nice_step(largest, 5)
+    top = step * math.ceil(largest * 1.1 / step)
+    ticks = np.arange(step, top - step / 2, step)  # none on the frame
+    axes.set_ylim(0.0, top)
+    axes.set_yticks(ticks, [""] * len(ticks))  # the rings; their labels are placed below
+    for (angle, radius, align), tick in zip(_ring_labels(ordered, ticks, top), ticks, strict=True):
+        axes.text(
+            math.radians(angle),
+            radius,
+            f"{tick:g}°",
+            ha="center",
+            va=align,
+            fontsize=8,
+            zorder=5,
+            bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.85, "pad": 0.8},
+        )
 
 
 def plot_projected(
@@ -73,7 +135,8 @@ def plot_projected(
     """Polar plot of the projected orientation workspace(s), θ against φ in degrees.
 
     The radial axis runs from 0 to a round value above the largest tilt, so no curve lies on
-    the frame; the radial labels sit at the azimuth where they are farthest from the curves.
+    the frame; every ring is labelled, at the azimuth where the labels are farthest from the
+    curves, and a label that would sit on a curve moves just off its ring (:func:`_ring_labels`).
 
     Parameters
     ----------
@@ -88,36 +151,29 @@ def plot_projected(
     pathlib.Path
         ``path``.
     """
+    path = Path(path)
+    projected_figure(workspaces, title=title).savefig(path, dpi=120)
+    return path
+
+
+def projected_figure(workspaces: Sequence[ProjectedWorkspace], *, title: str | None = None) -> Any:
+    """The figure of :func:`plot_projected` (a :class:`matplotlib.figure.Figure`), not saved."""
     from matplotlib.figure import Figure
 
     figure = Figure(figsize=(6.4, 6.8), layout="constrained")
     axes = cast("PolarAxes", figure.add_subplot(projection="polar"))
     curves = []
-    largest = 0.0
     for workspace in workspaces:
         style = _STYLE.get(workspace.method, {"color": "black", "linestyle": "-"})
         phi = np.append(workspace.phi, workspace.phi[0])
         theta = np.degrees(np.append(workspace.theta, workspace.theta[0]))
-        largest = max(largest, float(theta.max()))
         label = (
             f"{workspace.method}: θ {np.degrees(workspace.tilt_min):.2f}°–"
             f"{np.degrees(workspace.tilt_max):.2f}°, Ω {workspace.solid_angle:.3f} sr"
         )
         axes.plot(phi, theta, label=label, **style)
-        order = np.argsort(np.mod(np.degrees(workspace.phi), 360.0))
-        curves.append((np.mod(np.degrees(workspace.phi), 360.0)[order], theta[:-1][order]))
-    step = _nice_step(largest, 5)
-    top = step * math.ceil(largest * 1.1 / step)
-    ticks = np.arange(step, top - step / 2, step)  # none on the frame
-    axes.set_ylim(0.0, top)
-    axes.set_yticks(ticks, [f"{t:g}°" for t in ticks], fontsize=8)
-    angle = _label_angle(curves, ticks)
-    axes.set_rlabel_position(angle)
-    # A label that would still sit on a curve is left out (its ring stays).
-    crowded = _curve_distances(curves, ticks, angle) < 0.035 * top
-    for tick_label, hidden in zip(axes.get_yticklabels(), crowded, strict=True):
-        tick_label.set_visible(not hidden)
-        tick_label.set_bbox({"facecolor": "white", "edgecolor": "none", "alpha": 0.8, "pad": 1.0})
+        curves.append((np.degrees(workspace.phi), theta[:-1]))
+    label_rings(axes, curves)
     axes.set_xticks(np.radians(np.arange(0, 360, 45)))
     axes.grid(True, linewidth=0.4)
     axes.set_title(
@@ -127,9 +183,7 @@ def plot_projected(
         fontsize=10,
     )
     figure.legend(loc="outside lower center", fontsize=8)
-    path = Path(path)
-    figure.savefig(path, dpi=120)
-    return path
+    return figure
 
 
 def _closed(ring: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -157,6 +211,13 @@ def plot_orientation(
     pathlib.Path
         ``path``.
     """
+    path = Path(path)
+    orientation_figure(workspace, title=title).savefig(path, dpi=110)
+    return path
+
+
+def orientation_figure(workspace: OrientationWorkspace, *, title: str | None = None) -> Any:
+    """The figure of :func:`plot_orientation` (a :class:`matplotlib.figure.Figure`), not saved."""
     from matplotlib import colormaps
     from matplotlib.cm import ScalarMappable
     from matplotlib.collections import LineCollection
@@ -166,6 +227,9 @@ def plot_orientation(
     from mpl_toolkits.mplot3d import Axes3D  # noqa: F401  (registers the 3d projection)
 
     figure = Figure(figsize=(13.5, 5.8), layout="constrained")
+    # wspace: the 3-D panel's ψ label stands out to its right, past what the layout measures;
+    # the gap keeps it clear of the top view's θ sin φ label.
+    figure.get_layout_engine().set(wspace=0.12)  # type: ignore[call-arg, union-attr]
     grid = figure.add_gridspec(1, 2, width_ratios=(1.0, 1.0))
     surface_axes = cast("Axes3D", figure.add_subplot(grid[0, 0], projection="3d"))
     top_axes = figure.add_subplot(grid[0, 1])
@@ -249,6 +313,4 @@ def plot_orientation(
         f"volume {workspace.volume:.4f} rad³",
         fontsize=11,
     )
-    path = Path(path)
-    figure.savefig(path, dpi=110)
-    return path
+    return figure

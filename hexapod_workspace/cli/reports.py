@@ -260,7 +260,8 @@ def orientation_text(workspace: OrientationWorkspace, out: IO[str]) -> None:
     areas = [piece.area() for piece in workspace.slices]
     middle = min(range(len(workspace.slices)), key=lambda k: abs(workspace.slices[k].psi))
     zero = workspace.slices[middle]
-    cx, cy = np.degrees(zero.center)
+    # rounded as printed, + 0.0: a centre 1e-17 below the axis prints 0.000, not -0.000
+    cx, cy = (round(float(v), 3) + 0.0 for v in np.degrees(zero.center))
     out.write(
         f"orientation workspace at ({x:.4f}, {y:.4f}, {z:.4f}) m\n"
         f"  {len(workspace.slices)} slices of {workspace.n_rays} rays, "
