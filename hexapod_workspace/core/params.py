@@ -41,6 +41,9 @@ NODE_PARAMETERS = (
     "check.max_command_age",
     "recording.enabled",
     "recording.directory",
+    "recording.max_file_mb",
+    "recording.max_file_duration",
+    "recording.max_total_mb",
     "motion.current_pose_topic",
 )
 #: Parameters every ROS 2 node has (prefixes end with a dot).

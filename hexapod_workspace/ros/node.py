@@ -212,15 +212,21 @@ class WorkspaceNode(Node):
         self.create_timer(1.0, self._publish_diagnostics)
         # ~/check_path, Pose inputs and the current-pose parameter (hexapod_workspace.ros.paths)
         self.paths = attach_paths(self, lambda: self.state.manipulator, self.recorder)
+        extensions = list(extensions)
         for attach in extensions:
             attach(self)
-        if self.state.settings.recording_enabled:
-            self.recorder.open(self.state.settings.recording_directory)
+        settings = self.state.settings
+        if settings.recording_enabled:
+            self.recorder.open(settings.recording_directory, settings.recording_rotation)
         self.worker.start()  # it warms its own kernels up meanwhile
         self.get_logger().info(f"core kernels ready in {_warm_up():.1f} s")
+        atlas = ", compute_atlas (action)" if _attach_atlas in extensions else ""
+        current = self.paths.subscription
         self.get_logger().info(
-            f"ready: {self.get_fully_qualified_name()} serving check_poses, compute_workspace "
-            f"(action), compute_orientation_workspace, compute_projected_workspace"
+            f"ready: {self.get_fully_qualified_name()} serving check_poses, check_path, "
+            f"compute_workspace (action){atlas}, compute_orientation_workspace, "
+            "compute_projected_workspace; listening on commanded_pose, workspace_request"
+            + (f", {current.topic_name} (current pose)" if current is not None else "")
         )
 
     # ------------------------------------------------------------------ wiring helpers
@@ -357,7 +363,9 @@ class WorkspaceNode(Node):
         self.get_logger().info(f"parameters updated: {', '.join(names)}")
         if state.settings.recording_enabled != previous.settings.recording_enabled:
             if state.settings.recording_enabled:
-                self.recorder.open(state.settings.recording_directory)
+                self.recorder.open(
+                    state.settings.recording_directory, state.settings.recording_rotation
+                )
             else:
                 self.recorder.close()
 
@@ -426,9 +434,14 @@ class WorkspaceNode(Node):
         self.worker.close()
 
     def destroy_node(self) -> None:
-        """Stop the jobs and the worker, finish the MCAP log, then destroy the node."""
+        """Stop the jobs and the worker, finish the MCAP log (logging where it went), then
+        destroy the node."""
         self.stop_worker()
+        path = self.recorder.status().path
         self.recorder.shutdown()
+        self.get_logger().info(
+            f"stopped; the log is {path}" if path else "stopped (recording was off)"
+        )
         super().destroy_node()
 
 

@@ -36,6 +36,8 @@ from hexapod_workspace.core.manipulator import PARAMETER_DEFAULTS, Manipulator
 from hexapod_workspace.core.validation import require_usable
 from hexapod_workspace.errors import ConfigError
 
+from .recorder import Rotation
+
 __all__ = [
     "MODEL_DESCRIPTIONS",
     "MODEL_GROUPS",
@@ -199,6 +201,30 @@ def parameter_specs() -> dict[str, Spec]:
             "Record every request and result to an MCAP log (rosbag2 form); false stops.",
         ),
         Spec(
+            "recording.max_file_mb",
+            100.0,
+            "Split the log (finish it, go on in a new one, as rosbag2's --max-bag-size) once "
+            "its messages reach this many MB; 0 = no size split.",
+            read_only=True,
+            float_range=(0.0, 1e6),
+        ),
+        Spec(
+            "recording.max_file_duration",
+            3600.0,
+            "Split the log once it is this many s old (at its next message, as rosbag2's "
+            "--max-bag-duration); 0 = no age split.",
+            read_only=True,
+            float_range=(0.0, 1e9),
+        ),
+        Spec(
+            "recording.max_total_mb",
+            1000.0,
+            "Keep the folder's hexapod_workspace_*.mcap logs (earlier runs included) under this "
+            "many MB by removing the oldest when a log starts; 0 = keep every log.",
+            read_only=True,
+            float_range=(0.0, 1e9),
+        ),
+        Spec(
             "recording.directory",
             "",
             "Folder of the MCAP logs (one per run, named by start time); empty = "
@@ -222,6 +248,7 @@ class Settings:
     max_command_age: float
     recording_enabled: bool
     recording_directory: Path
+    recording_rotation: Rotation
 
 
 @dataclass(frozen=True)
@@ -326,6 +353,11 @@ def state_from(values: dict[str, Any]) -> State:
         max_command_age=age,
         recording_enabled=bool(values["recording.enabled"]),
         recording_directory=folder,
+        recording_rotation=Rotation(
+            max_file_bytes=int(float(values["recording.max_file_mb"]) * 1e6),
+            max_file_seconds=float(values["recording.max_file_duration"]),
+            max_total_bytes=int(float(values["recording.max_total_mb"]) * 1e6),
+        ),
     )
     return State(manipulator, settings)
 

@@ -32,7 +32,15 @@ def test_node_stops_cleanly_on_signal(ros_client, tmp_path, sig):
         output = node.output()
     assert status == 0, output
     assert "Traceback" not in output, output
-    assert list((tmp_path / "logs").glob("*.mcap")), "the run's log is missing"
+    (log,) = (tmp_path / "logs").glob("*.mcap")
+    # issue 16, item 17: what the node serves, and where its log went when it stopped
+    (ready,) = [line for line in output.splitlines() if "ready: /hexapod_workspace" in line]
+    for name in ("check_poses", "check_path", "compute_workspace", "compute_atlas"):
+        assert name in ready, ready
+    assert "commanded_pose" in ready and "workspace_request" in ready, ready
+    assert f"log finished: {log}" in output and f"stopped; the log is {log}" in output, output
+    # no spurious update at start (an extension declaring its own parameter)
+    assert "parameters updated" not in output, output
 
 
 def test_node_stops_cleanly_while_goals_compute_and_queue(ros_client, tmp_path):
