@@ -218,6 +218,12 @@ def test_poses_file_with_header_in_input_order(tmp_path, example):
         ("phi_deg,theta_deg,psi_deg\n", "no poses"),
         ("1,2,x\n", "line 1: 'x' is not a number"),
         ("1,5;2;3\n", "'1,5' is not a number (use a decimal point)"),
+        # issue 16, item 2: header names are read, never guessed
+        ("tilt,phi_deg,psi_deg\n1,2,3\n", "line 1: unknown column 'tilt' (expected phi_deg or"),
+        ("phi,theta,psi\n1,2,3\n", "line 1: column 'phi' names no unit (expected phi_deg or"),
+        ("phi_grad,theta_deg,psi_deg\n1,2,3\n", "column 'phi_grad' has unit 'grad', not taken"),
+        ("# c\nphi_deg,phi_rad,psi_deg\n1,2,3\n", "line 2: phi given twice"),
+        ("phi_deg,theta_deg\n1,2\n", "line 1: no column for psi"),
     ],
 )
 def test_bad_poses_file_exit_2(tmp_path, content, reason):
@@ -225,6 +231,24 @@ def test_bad_poses_file_exit_2(tmp_path, content, reason):
     assert (code, out) == (2, "")
     assert reason in one_error_line(err)
     assert "usecols" not in err
+
+
+@pytest.mark.parametrize(
+    ("header", "row"),
+    [
+        ("theta_deg,phi_deg,psi_deg", "60,0,0"),  # the issue's file: read as phi = 60 before
+        ("psi_deg;theta_deg;phi_deg", "0;60;0"),
+        ("phi_rad,theta_rad,psi_rad", f"0,{math.radians(60.0)!r},0"),  # read as degrees before
+        ("THETA_RAD psi_deg phi_deg", f"{math.radians(60.0)!r} 0 0"),
+    ],
+)
+def test_poses_file_columns_are_read_by_name_and_unit(tmp_path, example, header, row):
+    """Issue 16, item 2: theta = 60 deg is unreachable whatever the column order or unit."""
+    code, out, err = poses_run(tmp_path, f"{header}\n{row}\n")
+    (pose,) = json.loads(out)["poses"]
+    assert [pose["phi_deg"], pose["theta_deg"], pose["psi_deg"]] == pytest.approx([0, 60, 0])
+    assert not check(example, np.radians([[0.0, 60.0, 0.0]])).reachable[0]
+    assert (code, pose["reachable"]) == (1, False), err
 
 
 def test_poses_file_first_numeric_row_is_data_and_separators(tmp_path):
@@ -288,3 +312,33 @@ def test_check_record_then_replay(tmp_path):
     assert code == 0, err
     assert "/hexapod_workspace/check_poses/request" in out
     assert "1/2 reachable" in out
+
+
+@pytest.mark.parametrize(
+    ("changes", "hint"),
+    [
+        # issue 16, item 16: leg limits in millimetres (it was a warning and "unreachable")
+        ({"limits.leg_length_min": [800.0], "limits.leg_length_max": [1450.0]}, "limits"),
+        ("geometry-mm", "geometry"),
+    ],
+    ids=["limits-in-mm", "geometry-in-mm"],
+)
+def test_a_model_in_millimetres_is_refused_with_the_unit_hint(tmp_path, example, changes, hint):
+    parameters = example.to_parameters()
+    if changes == "geometry-mm":
+        changes = {
+            name: [1000.0 * v for v in parameters[name]]
+            for name in ("geometry.base_joints", "geometry.platform_joints")
+        } | {"geometry.home_position": [0.0, 0.0, -1300.0], "pose.position": [0.0, 0.0, -1300.0]}
+    parameters.update(changes)
+    config = tmp_path / "mm.yaml"
+    config.write_text(
+        "hexapod_workspace:\n  ros__parameters:\n"
+        + "".join(f"    {name}: {value!r}\n" for name, value in parameters.items())
+    )
+    code, out, err = run_main("--config", str(config), "check", "--pose", "0", "0", "0")
+    assert (code, out) == (2, "")
+    line = one_error_line(err)
+    assert f"parameters file {config}:" in line
+    assert "home pose" in line and "unreachable" in line
+    assert f"{hint}" in line and "millimetres" in line and "divided by 1000" in line

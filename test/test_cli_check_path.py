@@ -199,3 +199,61 @@ def test_the_tool_direction_plot_labels_every_ring_clear_of_the_curves(example):
     labels = polar_labels_clear(figure, polar)
     ticks = polar.get_yticks()
     assert labels == {f"{t:g}°" for t in ticks} and len(labels) >= 3
+
+
+def check_path_json(source: Path) -> tuple[int, dict]:
+    out = io.StringIO()
+    code = main(["check-path", str(source), "--json"], out=out)
+    return code, json.loads(out.getvalue())
+
+
+def test_columns_in_radians_and_millimetres_give_the_same_verdicts(tmp_path):
+    """Issue 16, item 2: every file reader takes the units its header names."""
+    positions, t, _ = cone()
+    angles = np.column_stack([np.degrees(t), np.full(40, 17.0), np.zeros(40)])
+    degrees = write_csv(
+        tmp_path / "deg.csv",
+        "x,y,z,phi_deg,theta_deg,psi_deg",
+        np.column_stack([positions, angles]),
+    )
+    other = write_csv(
+        tmp_path / "rad.csv",
+        "theta_rad,x_mm,y_m,z,psi_deg,phi_rad",
+        np.column_stack(
+            [np.radians(angles[:, 1]), positions[:, 0] * 1e3, positions[:, 1:], angles[:, 2], t]
+        ),
+    )
+    code, expected = check_path_json(degrees)
+    assert (code, expected["ok"]) == (1, False)  # psi = 0 fails somewhere on this cone
+    code_other, got = check_path_json(other)
+    assert code_other == code
+    assert [w["reachable"] for w in got["waypoints"]] == [
+        w["reachable"] for w in expected["waypoints"]
+    ]
+    for mine, theirs in zip(got["waypoints"], expected["waypoints"], strict=True):
+        assert mine["theta_deg"] == pytest.approx(theirs["theta_deg"], abs=1e-9)
+        assert mine["position"] == pytest.approx(theirs["position"], abs=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("content", "match"),
+    [
+        # issue 16, item 15: the file line (comments and the header count), not numpy's text
+        (
+            "# path\nx,y,z,i,j,k\n0,0,-1.3,0,0,1\n\n0,0,-1.3\n",
+            "line 5: expected 6 values x,y,z,i,j,k, got 3: '0,0,-1.3'",
+        ),
+        ("x,y,z,i,j,k\n0,0,-1.3,0,0,1\n0,0,-1.3,0,zero,1\n", "line 3: 'zero' is not a number"),
+        ("x,y,z,i,j,k\n0,0,-1.3,0,0,1\n0,0,-1.3,0,nan,1\n", "line 3: expected finite numbers"),
+        ("x_in,y,z,i,j,k\n0,0,-1.3,0,0,1\n0,0,-1.3,0,0,1\n", "column 'x_in' has unit 'in'"),
+        ("x,y,z,phi,theta_deg,psi_deg\n0,0,-1.3,0,0,0\n" * 1, "column 'phi' names no unit"),
+    ],
+    ids=["short-line", "not-a-number", "nan", "unit", "no-unit"],
+)
+def test_line_errors_name_the_file_line(tmp_path, capsys, content, match):
+    source = tmp_path / "bad.csv"
+    source.write_text(content, encoding="utf-8")
+    assert main(["check-path", str(source), "--json"], out=io.StringIO()) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert match in line and f"path file {source}" in line
+    assert "usecols" not in line and "row" not in line.replace("first row", "")

@@ -17,12 +17,14 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import time
 from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
 
-from ..core.atlas import AtlasGrid, AtlasOptions, dexterous_mask
+from ..core.atlas import AtlasGrid, AtlasOptions, dexterous_mask, positions_capability
+from ..core.manipulator import Manipulator
 from ..errors import InputError
 from .inputs import CliError, finite, load_manipulator, tolerance_flag
 from .progress import ProgressBar
@@ -30,19 +32,21 @@ from .progress import ProgressBar
 __all__ = [
     "ATLAS_DESCRIPTION",
     "ATLAS_HELP",
+    "ESTIMATE_SAMPLES",
     "MAX_POSITIONS",
     "atlas_arguments",
     "atlas_summary",
     "cmd_atlas",
 ]
 
-#: Positions above which the command asks for ``--force`` (about 2 core-hours at 0.3 s each).
+#: Positions above which the command asks for ``--force`` (with an estimate of the cost).
 MAX_POSITIONS = 20_000
 #: Default boundary tolerance of the atlas, rad: coarser than a single workspace's
 #: (resolution.DEFAULT_TOLERANCE) because an atlas computes thousands of them.
 ATLAS_TOLERANCE = 1e-4
-#: Seconds per position, for the estimate in the ``--force`` message (example GPM, one core).
-_SECONDS_PER_POSITION = 0.3
+#: Positions of the grid timed for the estimate of the ``--force`` message (after one untimed
+#: position that loads the compiled kernels).
+ESTIMATE_SAMPLES = 8
 
 
 ATLAS_HELP = "orientation capability over a box of positions (Dask, Zarr store)"
@@ -128,18 +132,60 @@ def atlas_arguments(sub: argparse.ArgumentParser) -> None:
 
 
 def _grid(options: argparse.Namespace) -> AtlasGrid:
-    """The box grid of the options, within the position cap unless ``--force``."""
-    grid = AtlasGrid.box(
+    """The box grid of the options."""
+    return AtlasGrid.box(
         finite(options.box, "--box", "m"), finite([options.step], "--step", "m")[0]
     )
-    if grid.size > MAX_POSITIONS and not options.force:
-        hours = grid.size * _SECONDS_PER_POSITION / 3600.0
-        msg = (
-            f"--box/--step give {grid.size} positions, more than the cap of {MAX_POSITIONS} "
-            f"(about {hours:.1f} core-hours): add --force to run it"
-        )
-        raise CliError(msg)
-    return grid
+
+
+def measured_seconds_per_position(
+    manipulator: Manipulator,
+    grid: AtlasGrid,
+    options: AtlasOptions,
+    samples: int = ESTIMATE_SAMPLES,
+) -> tuple[float, int]:
+    """Time the atlas at a few positions of ``grid``, spread evenly over it (C order).
+
+    The cost of a position depends on the machine, the options (``n_phi``, tolerance,
+    ``volume``) and where it is (an unreachable reference costs one check), so the estimate of
+    a run is measured on the run's own grid, not taken from a constant.
+
+    Returns
+    -------
+    seconds : float
+        Mean wall time per position, one core (this process), s.
+    count : int
+        Positions timed.
+    """
+    count = min(samples, grid.size)
+    flat = np.unique(np.linspace(0, grid.size - 1, count + 1).round().astype(np.int64))
+    positions = np.vstack(
+        [
+            grid.points(tuple(slice(int(i), int(i) + 1) for i in where))
+            for where in zip(*np.unravel_index(flat, grid.shape), strict=True)
+        ]
+    )
+    positions_capability(manipulator, positions[:1], options)  # loads the kernels, untimed
+    started = time.perf_counter()
+    positions_capability(manipulator, positions[1:], options)
+    return (time.perf_counter() - started) / max(len(positions) - 1, 1), len(positions) - 1
+
+
+def _check_cap(
+    grid: AtlasGrid, manipulator: Manipulator, options: AtlasOptions, force: bool
+) -> None:
+    """Refuse more than :data:`MAX_POSITIONS` positions without ``--force``, with the cost
+    estimated from a measurement."""
+    if grid.size <= MAX_POSITIONS or force:
+        return
+    seconds, timed = measured_seconds_per_position(manipulator, grid, options)
+    hours = grid.size * seconds / 3600.0
+    msg = (
+        f"--box/--step give {grid.size} positions, more than the cap of {MAX_POSITIONS} "
+        f"(about {hours:.3g} core-hours: {1e3 * seconds:.3g} ms per position, measured here at "
+        f"{timed} positions of this grid): add --force to run it"
+    )
+    raise CliError(msg)
 
 
 def atlas_summary(
@@ -206,6 +252,7 @@ def cmd_atlas(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
     except InputError as error:
         raise CliError(str(error)) from error
     manipulator = load_manipulator(options.config, None, err)
+    _check_cap(grid, manipulator, atlas_options, options.force)
     from ..atlas import workspace_atlas
 
     bar = ProgressBar("atlas")

@@ -3,7 +3,9 @@
 The CSV file has a header row. Columns ``x,y,z,phi_deg,theta_deg,psi_deg`` (m, degrees) give a
 fixed orientation per waypoint; columns ``x,y,z,i,j,k`` give a tool axis (approach vector, any
 non-zero length) and the torsion is then planned (:func:`hexapod_workspace.plan_torsion`).
-Columns may come in any order; blank lines and lines starting with ``#`` are skipped.
+Columns are read by name, in any order; angles may be in radians (``phi_rad``), positions in
+millimetres (``x_mm``). Blank lines and lines starting with ``#`` are skipped; rules and errors
+as for every CSV file the CLI reads (:mod:`.tables`).
 
 Exit codes: 0 the whole path runs, 1 it does not (where, on stderr), 2 bad input (one line on
 stderr).
@@ -37,7 +39,8 @@ from ..core.paths import (
 from ..core.rotations import degrees_to_radians, matrix_to_quaternion, tt_to_matrix
 from ..errors import InputError
 from .commands import PROG
-from .inputs import PLOT_FORMATS, finite, is_number, load_manipulator, output_file
+from .inputs import PLOT_FORMATS, finite, load_manipulator, output_file
+from .tables import ANGLE_UNITS, LENGTH_UNITS, PLAIN, Columns, parse_table
 
 if TYPE_CHECKING:
     from matplotlib.projections.polar import PolarAxes
@@ -56,8 +59,16 @@ __all__ = [
 ]
 
 _POSITION = ("x", "y", "z")
-_ANGLES = ("phi_deg", "theta_deg", "psi_deg")
+_ANGLES = ("phi", "theta", "psi")
 _AXIS = ("i", "j", "k")
+#: The columns of a path file: positions in m (or mm), angles in degrees or radians, axes.
+PATH_COLUMNS = Columns(
+    {
+        **dict.fromkeys(_POSITION, LENGTH_UNITS),
+        **dict.fromkeys(_ANGLES, ANGLE_UNITS),
+        **dict.fromkeys(_AXIS, PLAIN),
+    }
+)
 
 
 @dataclass(frozen=True)
@@ -84,77 +95,46 @@ class PathFile:
 
 
 def read_path_file(path: str | Path) -> PathFile:
-    """Read a path CSV (see the module documentation).
+    """Read a path CSV (see the module documentation; rules: :mod:`.tables`).
 
     Raises
     ------
     InputError
         Unreadable file, missing or unknown columns, non-numbers, NaN or infinite values,
-        fewer than 2 waypoints.
+        fewer than 2 waypoints; every line error names the line of the file.
     """
     path = Path(path)
     try:
-        with path.open("r", encoding="utf-8") as handle:
-            header = ""
-            skipped = 0
-            for line in handle:
-                skipped += 1
-                if line.strip() and not line.lstrip().startswith("#"):
-                    header = line
-                    break
+        text = path.read_text(encoding="utf-8")
     except OSError as error:
         msg = f"cannot read path file {path}: {error.strerror or error}"
         raise InputError(msg) from error
     except UnicodeDecodeError as error:
         msg = f"path file {path} is not text"
         raise InputError(msg) from error
-    names = [cell.strip().lower() for cell in header.split(",")]
-    expected = "a header x,y,z,phi_deg,theta_deg,psi_deg or x,y,z,i,j,k"
-    if not header or any(is_number(name) for name in names):
-        msg = f"path file {path}: expected {expected} as the first row"
-        raise InputError(msg)
-    unknown = [n for n in names if n not in (*_POSITION, *_ANGLES, *_AXIS)]
-    duplicated = sorted({n for n in names if names.count(n) > 1})
-    has_angles, has_axis = set(_ANGLES) <= set(names), set(_AXIS) <= set(names)
+    table = parse_table(text, f"path file {path}", None, rows_name="waypoints")
+    columns = PATH_COLUMNS.read(table)
+    given = set(columns)
+    has_angles, has_axis = set(_ANGLES) <= given, set(_AXIS) <= given
     if (
-        unknown
-        or duplicated
-        or not set(_POSITION) <= set(names)
+        not set(_POSITION) <= given
         or has_angles == has_axis
-        or (has_angles and set(_AXIS) & set(names))
-        or (has_axis and set(_ANGLES) & set(names))
+        or (has_angles and set(_AXIS) & given)
+        or (has_axis and set(_ANGLES) & given)
     ):
-        problem = (
-            f"unknown column {unknown[0]!r}"
-            if unknown
-            else f"column {duplicated[0]!r} twice"
-            if duplicated
-            else f"columns {','.join(names)}"
+        msg = (
+            f"path file {path}, line {table.header_line}: expected a header "
+            f"x,y,z,phi_deg,theta_deg,psi_deg (or phi_rad, ...) or x,y,z,i,j,k, got "
+            f"{','.join(table.header or [])}"
         )
-        msg = f"path file {path}: expected {expected}, got {problem}"
         raise InputError(msg)
-    try:
-        rows = np.loadtxt(path, delimiter=",", skiprows=skipped, ndmin=2, comments="#")
-    except ValueError as error:
-        reason = str(error).splitlines()[0]
-        msg = f"path file {path}: expected {len(names)} numbers per row ({reason})"
-        raise InputError(msg) from error
-    if rows.shape[0] < 2:
-        msg = f"path file {path}: expected at least 2 waypoints, got {rows.shape[0]}"
+    if table.values.shape[0] < 2:
+        msg = f"path file {path}: expected at least 2 waypoints, got {table.values.shape[0]}"
         raise InputError(msg)
-    if rows.shape[1] != len(names):
-        msg = f"path file {path}: expected {len(names)} columns, got {rows.shape[1]}"
-        raise InputError(msg)
-    bad = ~np.all(np.isfinite(rows), axis=1)
-    if np.any(bad):
-        row = int(np.flatnonzero(bad)[0])
-        msg = f"path file {path}: expected finite numbers, waypoint {row} is {rows[row].tolist()}"
-        raise InputError(msg)
-    column = {name: rows[:, names.index(name)] for name in names}
-    positions = np.column_stack([column[n] for n in _POSITION])
+    positions = np.column_stack([columns[n] for n in _POSITION])
     if has_angles:
-        return PathFile(positions, np.column_stack([column[n] for n in _ANGLES]), None)
-    return PathFile(positions, None, np.column_stack([column[n] for n in _AXIS]))
+        return PathFile(positions, np.column_stack([columns[n] for n in _ANGLES]), None)
+    return PathFile(positions, None, np.column_stack([columns[n] for n in _AXIS]))
 
 
 # ---------------------------------------------------------------------------- JSON

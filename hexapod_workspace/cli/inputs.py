@@ -8,7 +8,6 @@ and radians. The core still checks everything again; this layer only re-phrases.
 from __future__ import annotations
 
 import math
-import re
 import sys
 import warnings
 from pathlib import Path
@@ -23,9 +22,11 @@ from ..core.frames import cell_from_params_file, tool_model
 from ..core.manipulator import Manipulator
 from ..core.rotations import degrees_to_radians
 from ..errors import HexapodWorkspaceError, InputError
+from .tables import ANGLE_UNITS, Columns, parse_table
 
 __all__ = [
     "PLOT_FORMATS",
+    "POSE_COLUMNS",
     "CliError",
     "finite",
     "load_manipulator",
@@ -173,25 +174,18 @@ def output_file(path: str | Path, flag: str, *, force: bool, suffixes: tuple[str
 
 
 # ---------------------------------------------------------------------------- poses CSV
-_HEADER_CELL = re.compile(r"^[A-Za-z_][\w\[\] ()/-]*$")
-
-
-def _split(line: str) -> list[str]:
-    """Cells of a CSV line: semicolon-, comma-, tab- or space-separated (in that preference, so
-    that ``1,5;2;3`` is read as a decimal comma, and refused with a hint)."""
-    for separator in (";", ",", "\t"):
-        if separator in line:
-            return [cell.strip() for cell in line.split(separator)]
-    return line.split()
+#: The columns of a poses file: each angle in degrees or radians, named by the header.
+POSE_COLUMNS = Columns({"phi": ANGLE_UNITS, "theta": ANGLE_UNITS, "psi": ANGLE_UNITS})
+_POSE_DEFAULT = ["phi_deg", "theta_deg", "psi_deg"]
 
 
 def read_poses_file(path: str | Path) -> NDArray[np.float64]:
-    """Read a CSV of poses ``phi_deg,theta_deg,psi_deg`` (degrees), one pose per line.
+    """Read a CSV of poses (φ, θ, ψ), one pose per line (rules: :mod:`.tables`).
 
-    Cells are separated by commas, semicolons, tabs or spaces. A first line whose cells are all
-    names (``phi_deg,theta_deg,psi_deg``) is a header; a line with any number in it is data.
-    Blank lines and lines starting with ``#`` are skipped. ``-`` reads standard input (as does
-    ``/dev/stdin``, piped or not). Errors name the line of the file.
+    With a header, the columns are read by name in any order, each angle in the unit it names
+    (``theta_deg``, ``phi_rad``); all three angles are required and any other name is refused.
+    Without a header, the columns are ``phi_deg,theta_deg,psi_deg``. ``-`` reads standard input
+    (as does ``/dev/stdin``, piped or not). Errors name the line of the file.
 
     Parameters
     ----------
@@ -200,12 +194,13 @@ def read_poses_file(path: str | Path) -> NDArray[np.float64]:
     Returns
     -------
     ndarray, shape (N, 3)
-        (φ, θ, ψ) in degrees, as typed.
+        (φ, θ, ψ) in degrees (as typed, or converted from the radians the header names).
 
     Raises
     ------
     InputError
-        Unreadable file, a line without exactly 3 numbers, NaN or infinite values, no poses.
+        Unreadable file, an unknown or incomplete header, a line without exactly 3 numbers,
+        NaN or infinite values, no poses.
     """
     name = "standard input" if str(path) == "-" else str(path)
     try:
@@ -220,58 +215,18 @@ def read_poses_file(path: str | Path) -> NDArray[np.float64]:
     except UnicodeDecodeError as error:
         msg = f"poses file {name} is not text"
         raise InputError(msg) from error
-    lines = text.splitlines()
-    numbers: list[int] = []  # file line (1-based) of every data row
-    cells_of: list[list[str]] = []
-    for number, line in enumerate(lines, start=1):
-        stripped = line.strip()
-        if not stripped or stripped.startswith("#"):
-            continue
-        cells = _split(stripped)
-        header = all(_HEADER_CELL.match(c) and not is_number(c) for c in cells if c)
-        if not numbers and header:
-            continue  # the header line: a first line of names only
-        numbers.append(number)
-        cells_of.append(cells)
-    if not cells_of:
-        msg = f"poses file {name}: no poses (expected lines phi_deg,theta_deg,psi_deg)"
-        raise InputError(msg)
-    for number, cells in zip(numbers, cells_of, strict=True):
-        if len(cells) != 3:
-            msg = (
-                f"poses file {name}, line {number}: expected 3 values phi_deg,theta_deg,psi_deg, "
-                f"got {len(cells)}: {lines[number - 1].strip()!r}"
-            )
-            raise InputError(msg)
-    flat = [cell for cells in cells_of for cell in cells]
-    try:
-        poses = np.array(flat, dtype=np.float64).reshape(-1, 3)
-    except ValueError:
-        for number, cells in zip(numbers, cells_of, strict=True):
-            bad = next((c for c in cells if not is_number(c)), None)
-            if bad is not None:
-                hint = " (use a decimal point)" if re.fullmatch(r"-?\d+,\d+", bad) else ""
-                msg = f"poses file {name}, line {number}: {bad!r} is not a number{hint}"
-                raise InputError(msg) from None
-        raise
-    rows = np.flatnonzero(~np.all(np.isfinite(poses), axis=1))
-    if rows.size:
-        number = numbers[int(rows[0])]
+    table = parse_table(text, f"poses file {name}", _POSE_DEFAULT, rows_name="poses")
+    if table.header is None:
+        return table.values
+    columns = POSE_COLUMNS.read(table)
+    missing = [q for q in POSE_COLUMNS.quantities if q not in columns]
+    if missing:
         msg = (
-            f"poses file {name}, line {number}: expected finite numbers, "
-            f"got {lines[number - 1].strip()!r}"
+            f"poses file {name}, line {table.header_line}: no column for {missing[0]} "
+            f"(expected {POSE_COLUMNS.expected()})"
         )
         raise InputError(msg)
-    return poses
-
-
-def is_number(cell: str) -> bool:
-    """Whether a CSV cell reads as a number (so a first line of names is a header)."""
-    try:
-        float(cell)
-    except ValueError:
-        return False
-    return True
+    return np.column_stack([columns[q] for q in POSE_COLUMNS.quantities])
 
 
 def core_error(error: HexapodWorkspaceError) -> str:

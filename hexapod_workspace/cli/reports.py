@@ -22,7 +22,7 @@ from ..core.projected import ProjectedWorkspace
 from ..core.resolution import WorkspaceKind
 
 if TYPE_CHECKING:  # the log reports only: `check` need not load the logs layer
-    from ..logs.summary import LogSummary, PoseCheckCall, WorkspaceRecord
+    from ..logs.summary import AtlasRecord, LogSummary, PoseCheckCall, WorkspaceRecord
 
 __all__ = [
     "check_json",
@@ -357,11 +357,38 @@ def _check_json(index: int, call: PoseCheckCall, start_ns: int) -> dict[str, Any
         "time_s": (call.log_time_ns - start_ns) / 1e9,
         "topic": call.topic,
         "position": call.position,
-        "n_poses": None if call.angles is None else len(call.angles),
+        "pose_form": call.angles is None and call.n_poses is not None,
+        "n_poses": call.n_poses,
         "answered": call.response is not None,
         "success": response.get("success"),
         "message": response.get("message"),
         "n_reachable": sum(bool(r["reachable"]) for r in results),
+    }
+
+
+def _atlas_json(index: int, record: AtlasRecord, start_ns: int) -> dict[str, Any]:
+    """An atlas cloud in a few numbers: grid extent, reachable positions, tilt capability."""
+    columns = record.columns
+    count = len(columns["x"]) if "x" in columns else 0
+    reachable = columns.get("reference_reachable", np.zeros(count)) > 0.5
+    capability = columns.get("tilt_capability", np.full(count, np.nan))[reachable]
+    capability = capability[np.isfinite(capability)]
+
+    def extent(axis: str) -> list[float] | None:
+        values = columns.get(axis)
+        return None if values is None or not count else [float(values.min()), float(values.max())]
+
+    return {
+        "index": index,
+        "time_s": (record.log_time_ns - start_ns) / 1e9,
+        "topic": record.topic,
+        "n_positions": count,
+        "n_reference_reachable": int(reachable.sum()),
+        "extent_m": {axis: extent(axis) for axis in "xyz"},
+        "tilt_capability_max_deg": _deg(float(capability.max())) if capability.size else None,
+        "tilt_capability_median_deg": (
+            _deg(float(np.median(capability))) if capability.size else None
+        ),
     }
 
 
@@ -386,6 +413,7 @@ def log_report(summary: LogSummary) -> dict[str, Any]:
         ],
         "workspaces": [_workspace_json(i + 1, r, start) for i, r in enumerate(summary.workspaces)],
         "pose_checks": [_check_json(i + 1, c, start) for i, c in enumerate(summary.checks)],
+        "atlases": [_atlas_json(i + 1, a, start) for i, a in enumerate(summary.atlases)],
         "reachability": {
             "count": len(reach),
             "reachable": sum(bool(r["success"] and r["check"]["reachable"]) for r in reach),
@@ -441,24 +469,38 @@ def log_report_text(report: dict[str, Any], out: IO[str]) -> None:
     for topic in report["topics"]:
         out.write(f"  {topic['topic']:<{width}}  {topic['type']:<{type_width}}  {topic['count']}\n")
     out.write(f"workspace results: {len(report['workspaces'])}\n")
+    lines = []
     for ws in report["workspaces"]:
         position = ", ".join(f"{v:.4g}" for v in ws["position"])
         request = f" request_id={ws['request_id']!r}" if ws["request_id"] else ""
-        out.write(
-            f"  [{ws['index']}] +{ws['time_s']:.3f} s{request} at ({position}) m: {_line(ws)}\n"
+        lines.append(
+            f"[{ws['index']}] +{ws['time_s']:.3f} s{request} at ({position}) m: {_line(ws)}"
         )
+    _capped(lines, "workspace results", out)
+    if report["atlases"]:
+        out.write(f"atlas results: {len(report['atlases'])}\n")
+        _capped([_atlas_line(atlas) for atlas in report["atlases"]], "atlas results", out)
     if report["pose_checks"]:
-        out.write(f"pose checks: {len(report['pose_checks'])}\n")
-        for check in report["pose_checks"]:
+        checks = report["pose_checks"]
+        answered = [c for c in checks if c["answered"] and c["success"]]
+        poses = sum(c["n_poses"] or 0 for c in answered)
+        reachable = sum(c["n_reachable"] for c in answered)
+        failed = sum(1 for c in checks if c["answered"] and not c["success"])
+        out.write(
+            f"pose checks: {len(checks)} ({poses} poses answered, {reachable} reachable; "
+            f"{failed} calls failed)\n"
+        )
+        lines = []
+        for check in checks:
             if not check["answered"]:
                 verdict = "no response recorded"
             elif check["success"]:
                 verdict = f"{check['n_reachable']}/{check['n_poses'] or 0} reachable"
+                verdict += " (Pose form)" if check["pose_form"] else ""
             else:
                 verdict = f"failed: {check['message']}"
-            out.write(
-                f"  [{check['index']}] +{check['time_s']:.3f} s {check['topic']}: {verdict}\n"
-            )
+            lines.append(f"[{check['index']}] +{check['time_s']:.3f} s {check['topic']}: {verdict}")
+        _capped(lines, "pose checks", out)
     reach = report["reachability"]
     if reach["count"]:
         out.write(
@@ -467,13 +509,53 @@ def log_report_text(report: dict[str, Any], out: IO[str]) -> None:
         )
     if report["path_checks"]:
         out.write(f"path checks: {len(report['path_checks'])}\n")
-        for call in report["path_checks"]:
-            out.write(f"  {path_call_line(call)}\n")
-    for call in report["trigger_calls"]:
-        out.write(
-            f"  trigger {call['topic']} +{call['time_s']:.3f} s: "
-            f"{'ok' if call['success'] else 'failed'}: {call['message']}\n"
-        )
+        _capped([path_call_line(call) for call in report["path_checks"]], "path checks", out)
+    if report["trigger_calls"]:
+        out.write(f"trigger calls: {len(report['trigger_calls'])}\n")
+        lines = [
+            f"trigger {call['topic']} +{call['time_s']:.3f} s: "
+            f"{'ok' if call['success'] else 'failed'}: {call['message']}"
+            for call in report["trigger_calls"]
+        ]
+        _capped(lines, "trigger calls", out)
+
+
+#: Text replay lists at most this many entries per kind (the first and the last ones).
+LIST_CAP = 20
+
+
+def _capped(lines: list[str], what: str, out: IO[str]) -> None:
+    """Write ``lines`` indented, at most :data:`LIST_CAP`: the first and the last halves, with
+    how many were left out in between (``--json`` lists every one)."""
+    if len(lines) > LIST_CAP:
+        half = LIST_CAP // 2
+        left_out = len(lines) - 2 * half
+        lines = [
+            *lines[:half],
+            f"... {left_out} more {what} (replay --json lists every one)",
+            *lines[-half:],
+        ]
+    for line in lines:
+        out.write(f"  {line}\n")
+
+
+def _atlas_line(atlas: dict[str, Any]) -> str:
+    extent = " ".join(
+        f"{axis} {span[0]:.4g}..{span[1]:.4g}"
+        for axis, span in atlas["extent_m"].items()
+        if span is not None
+    )
+    capability = (
+        "tilt capability: none reachable"
+        if atlas["tilt_capability_max_deg"] is None
+        else f"tilt capability up to {atlas['tilt_capability_max_deg']:.2f} deg (median "
+        f"{atlas['tilt_capability_median_deg']:.2f} deg)"
+    )
+    return (
+        f"[{atlas['index']}] +{atlas['time_s']:.3f} s {atlas['topic']}: {atlas['n_positions']} "
+        f"positions ({extent} m), reference reachable at {atlas['n_reference_reachable']}; "
+        f"{capability}"
+    )
 
 
 def _line(ws: dict[str, Any]) -> str:

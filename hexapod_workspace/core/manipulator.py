@@ -27,6 +27,7 @@ from .params import (
     unknown_parameter,
 )
 from .resolution import MAX_POSITION_NORM
+from .validation import coincident_joints_reason, require_usable, unusable_reason
 
 __all__ = ["PARAMETER_DEFAULTS", "HomePoseWarning", "Manipulator"]
 
@@ -188,7 +189,9 @@ class Manipulator:
             ``geometry``, ``limits`` and ``pose`` groups and ``frame_id`` are ignored (they
             belong to the node: resolution, recording).
         warn : bool
-            Emit a :class:`HomePoseWarning` when the home pose violates a constraint.
+            Emit a :class:`HomePoseWarning` when the home pose violates a constraint or the
+            platform is singular there (:func:`~hexapod_workspace.core.validation.unusable_reason`).
+            The node and :meth:`from_params_file` refuse such a model instead.
 
         Returns
         -------
@@ -197,7 +200,8 @@ class Manipulator:
         Raises
         ------
         GeometryError
-            Invalid geometry or limits (names the parameter, the expectation and the value).
+            Invalid geometry or limits (names the parameter, the expectation and the value),
+            coincident base or platform joints, a zero-length leg at the home pose.
         ConfigError
             Missing or unknown model parameters, non-numbers, non-finite values.
         """
@@ -230,6 +234,13 @@ class Manipulator:
         platform_joints = _joint_array(
             "geometry.platform_joints", values["geometry.platform_joints"]
         )
+        for name, joints in (
+            ("geometry.base_joints", base_joints),
+            ("geometry.platform_joints", platform_joints),
+        ):
+            coincident = coincident_joints_reason(name, joints)
+            if coincident is not None:
+                raise GeometryError(coincident)
         home = _vector3("geometry.home_position", values["geometry.home_position"])
         position = _vector3("pose.position", values["pose.position"])
         length_min = _length(
@@ -304,14 +315,9 @@ class Manipulator:
             axes_from_home=(base_axes is None, platform_axes is None),
         )
         if warn:
-            problems = manipulator.home_pose_violations()
-            if problems:
-                warnings.warn(
-                    f"the home pose (position {home.tolist()} m, identity orientation) is "
-                    f"unreachable: {', '.join(problems)} violated",
-                    HomePoseWarning,
-                    stacklevel=2,
-                )
+            reason = unusable_reason(manipulator)
+            if reason is not None:
+                warnings.warn(reason, HomePoseWarning, stacklevel=2)
         return manipulator
 
     @classmethod
@@ -322,13 +328,17 @@ class Manipulator:
         Every name in the file must be known: the model's, the node's (``resolution.*``,
         ``check.*``, ``recording.*``, read by the node only) or ROS's own (``use_sim_time``,
         ...). A misspelt name is reported at its own level (``limitz: unknown section``).
+        A model whose home pose is unreachable or singular is refused
+        (:func:`~hexapod_workspace.core.validation.require_usable`, with a unit hint). Every
+        message starts with the file's name.
 
         Parameters
         ----------
         path : str or pathlib.Path
             YAML parameters file, as in the README's section *ROS 2 node*, *Parameters*.
         warn : bool
-            See :meth:`from_mapping`.
+            No effect (a file's unusable model is refused, not warned about); accepted so that
+            callers written when it warned keep working.
 
         Returns
         -------
@@ -337,7 +347,8 @@ class Manipulator:
         Raises
         ------
         ConfigError
-            Unreadable file, unknown names, or a model :meth:`from_mapping` refuses.
+            Unreadable file, unknown names, a model :meth:`from_mapping` refuses, or an
+            unreachable or singular home pose (:class:`GeometryError`).
         """
         parameters = load_params_file(path)
         unknown = unknown_parameter(
@@ -346,7 +357,11 @@ class Manipulator:
         if unknown is not None:
             msg = f"parameters file {path}: {unknown}"
             raise ConfigError(msg)
-        return cls.from_mapping(parameters, warn=warn)
+        try:
+            return require_usable(cls.from_mapping(parameters, warn=False))
+        except ConfigError as error:
+            msg = f"parameters file {path}: {error}"
+            raise type(error)(msg) from error
 
     @classmethod
     def example(cls, *, warn: bool = True) -> Manipulator:

@@ -42,6 +42,9 @@ NODE_PARAMETERS = (
     "check.max_command_age",
     "recording.enabled",
     "recording.directory",
+    "recording.max_file_mb",
+    "recording.max_file_duration",
+    "recording.max_total_mb",
     "motion.current_pose_topic",
 )
 #: Parameters of the machining cell (tool and work frames, tool table, actuator speeds), read by

@@ -75,13 +75,36 @@ class WorkspaceRecord:
 
 @dataclass
 class PoseCheckCall:
-    """One recorded CheckPoses call (request and its response, paired in order)."""
+    """One recorded CheckPoses call (request and its response, paired in order).
+
+    ``position`` is None for the ``geometry_msgs/Pose`` form (each pose has its own position,
+    ``angles`` is then None) and for a response without its request; ``n_poses`` counts the
+    poses of either form.
+    """
 
     log_time_ns: int
     topic: str
     position: list[float] | None = None
     angles: np.ndarray | None = None
     response: dict[str, Any] | None = None
+    n_poses: int | None = None
+
+
+@dataclass
+class AtlasRecord:
+    """One recorded atlas cloud (``~/atlas``: x, y, z then one float32 per atlas value).
+
+    Attributes
+    ----------
+    log_time_ns : int
+    topic : str
+    columns : dict of str to ndarray, shape (M,)
+        Every FLOAT32/FLOAT64 field of the cloud by name (x, y, z in m, angles in rad).
+    """
+
+    log_time_ns: int
+    topic: str
+    columns: dict[str, np.ndarray]
 
 
 @dataclass
@@ -94,6 +117,7 @@ class LogSummary:
     reachability: list[dict[str, Any]] = field(default_factory=list)
     triggers: list[dict[str, Any]] = field(default_factory=list)
     paths: list[dict[str, Any]] = field(default_factory=list)
+    atlases: list[AtlasRecord] = field(default_factory=list)
     decoded: int = 0
 
 
@@ -146,8 +170,11 @@ def summarize_log(
                 known.points = points if points is not None else clouds.pop(record.key[0], None)
             if known.points is None:
                 awaiting[record.key[0]] = known
+        elif msgtype == _CLOUD and _is_atlas(fields := message_to_fields(item.message)):
+            columns = _cloud_columns(fields, contents, item.topic)
+            if columns is not None:
+                summary.atlases.append(AtlasRecord(item.log_time_ns, item.topic, columns))
         elif msgtype == _CLOUD:
-            fields = message_to_fields(item.message)
             points = _cloud_points(fields, contents, item.topic)
             stamp = messages.stamp_to_ns(fields["header"]["stamp"])
             waiting = awaiting.pop(stamp, None)
@@ -157,15 +184,20 @@ def summarize_log(
                 clouds[stamp] = points
         elif msgtype == _CHECK_REQUEST:
             fields = message_to_fields(item.message)
-            position = fields["position"]
-            call = PoseCheckCall(
-                item.log_time_ns,
-                item.topic,
-                [position["x"], position["y"], position["z"]],
-                np.array(
+            position, poses = fields["position"], fields.get("poses") or []
+            if poses:  # the geometry_msgs/Pose form: each pose at its own position
+                call = PoseCheckCall(item.log_time_ns, item.topic, n_poses=len(poses))
+            else:
+                angles = np.array(
                     [[o["phi"], o["theta"], o["psi"]] for o in fields["orientations"]], dtype=float
-                ).reshape(-1, 3),
-            )
+                ).reshape(-1, 3)
+                call = PoseCheckCall(
+                    item.log_time_ns,
+                    item.topic,
+                    [position["x"], position["y"], position["z"]],
+                    angles,
+                    n_poses=len(angles),
+                )
             summary.checks.append(call)
             pending_requests.setdefault(_service_of(item.topic), []).append(call)
         elif msgtype == _CHECK_RESPONSE:
@@ -191,6 +223,39 @@ def summarize_log(
 
 def _service_of(topic: str) -> str:
     return topic.rsplit("/", 1)[0]
+
+
+#: A cloud with this field is an atlas (``~/atlas``), not a workspace boundary.
+_ATLAS_FIELD = "tilt_capability"
+
+
+def _is_atlas(fields: dict[str, Any]) -> bool:
+    return any(str(f["name"]) == _ATLAS_FIELD for f in fields["fields"])
+
+
+def _cloud_columns(
+    fields: dict[str, Any], contents: LogContents, topic: str
+) -> dict[str, np.ndarray] | None:
+    """Every FLOAT32/FLOAT64 field of a cloud by name, or None (a note) when unreadable."""
+    count = int(fields["width"]) * int(fields["height"])
+    step = int(fields["point_step"])
+    buffer = np.frombuffer(bytes(fields["data"]), dtype=np.uint8)
+    if buffer.size < count * step:
+        contents.problems.append(
+            f"{topic}: a PointCloud2 could not be read (data has {buffer.size} bytes, "
+            f"expected {count * step})"
+        )
+        return None
+    order = ">" if fields["is_bigendian"] else "<"
+    rows = buffer[: count * step].reshape(count, step)
+    columns: dict[str, np.ndarray] = {}
+    for point_field in fields["fields"]:
+        datatype, offset = int(point_field["datatype"]), int(point_field["offset"])
+        if datatype in (7, 8):  # FLOAT32, FLOAT64
+            width = 4 if datatype == 7 else 8
+            raw = np.ascontiguousarray(rows[:, offset : offset + width])
+            columns[str(point_field["name"])] = raw.view(f"{order}f{width}")[:, 0].astype(float)
+    return columns
 
 
 def _cloud_points(fields: dict[str, Any], contents: LogContents, topic: str) -> np.ndarray | None:

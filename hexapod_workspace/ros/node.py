@@ -65,8 +65,10 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
+from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import kernels, planner_kernels
 from hexapod_workspace.core.constraints import check
+from hexapod_workspace.core.params import NODE_PARAMETERS, ROS_PARAMETERS, unknown_parameter
 from hexapod_workspace.errors import ConfigError, InputError
 from hexapod_workspace.logs import (
     REQUEST_QOS,
@@ -81,8 +83,12 @@ from . import health
 from .commands import CommandStream
 from .conversions import angles_from_orientations, position_from_point, to_message, type_name
 from .parameters import (
+    MODEL_GROUPS,
     State,
     command_line_override_names,
+    missing_model_parameters,
+    model_default,
+    model_given,
     parameter_specs,
     refusal,
     state_from,
@@ -181,7 +187,6 @@ class WorkspaceNode(Node):
             self.recorder.shutdown()
             super().destroy_node()
             raise
-        self._warn_home_pose()
         self.add_on_set_parameters_callback(self._validate_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
 
@@ -207,16 +212,21 @@ class WorkspaceNode(Node):
         self.create_timer(1.0, self._publish_diagnostics)
         # ~/check_path, Pose inputs and the current-pose parameter (hexapod_workspace.ros.paths)
         self.paths = attach_paths(self, lambda: self.state.manipulator, self.recorder)
+        extensions = list(extensions)
         for attach in extensions:
             attach(self)
-        self._warn_unknown_overrides()
-        if self.state.settings.recording_enabled:
-            self.recorder.open(self.state.settings.recording_directory)
+        settings = self.state.settings
+        if settings.recording_enabled:
+            self.recorder.open(settings.recording_directory, settings.recording_rotation)
         self.worker.start()  # it warms its own kernels up meanwhile
         self.get_logger().info(f"core kernels ready in {_warm_up():.1f} s")
+        atlas = ", compute_atlas (action)" if _attach_atlas in extensions else ""
+        current = self.paths.subscription
         self.get_logger().info(
-            f"ready: {self.get_fully_qualified_name()} serving check_poses, compute_workspace "
-            f"(action), compute_orientation_workspace, compute_projected_workspace"
+            f"ready: {self.get_fully_qualified_name()} serving check_poses, check_path, "
+            f"compute_workspace (action){atlas}, compute_orientation_workspace, "
+            "compute_projected_workspace; listening on commanded_pose, workspace_request"
+            + (f", {current.topic_name} (current pose)" if current is not None else "")
         )
 
     # ------------------------------------------------------------------ wiring helpers
@@ -282,19 +292,31 @@ class WorkspaceNode(Node):
 
     # ------------------------------------------------------------------ parameters
     def _declare_parameters(self) -> None:
-        """Declare the table (a wrong type in the file: ConfigError naming it)."""
+        """Declare the table. Refused with a ConfigError naming the parameter: a name no part
+        of the node declares (misspelt key or section), a model given in part, a wrong type.
+        With no model parameter given the packaged example is the model, and the log says so."""
+        names = set(self._override_names) | set(getattr(self, "_parameter_overrides", {}))
+        unknown = unknown_parameter(names, (*self._specs, *NODE_PARAMETERS, *ROS_PARAMETERS))
+        if unknown is not None:
+            raise ConfigError(f"unknown parameter given to the node: {unknown}")
+        given = model_given(names)
+        missing = missing_model_parameters(given) if given else None
+        if missing is not None:
+            raise ConfigError(missing)
+        declared: dict[str, Any] = {}
         for name, spec in self._specs.items():
+            default = spec.default
+            if given and name.startswith(MODEL_GROUPS) and name not in given:
+                default = model_default(name, declared)
             try:
-                self.declare_parameter(name, spec.default, spec.descriptor())
+                declared[name] = self.declare_parameter(name, default, spec.descriptor()).value
             except ParameterException as error:  # a wrong type in the file
                 raise ConfigError(f"{name}: {error}") from error
-
-    def _warn_unknown_overrides(self) -> None:
-        """Name the overrides no part of the node declared (after the extensions declared
-        theirs)."""
-        unknown = sorted(set(self._override_names) - set(self.list_parameters([], 0).names))
-        if unknown:
-            self.get_logger().warning(f"ignoring unknown parameters: {', '.join(unknown)}")
+        if not given:
+            self.get_logger().info(
+                "no model parameter (geometry.*, limits.*, pose.*) given: using the packaged "
+                f"example {example_config_path()}"
+            )
 
     def _parameter_values(self) -> dict[str, Any]:
         return {name: self.get_parameter(name).value for name in self._specs}
@@ -319,14 +341,6 @@ class WorkspaceNode(Node):
                 return SetParametersResult(successful=False, reason=refused)
         return super().set_parameters_atomically(parameter_list)
 
-    def _warn_home_pose(self) -> None:
-        problems = self.state.manipulator.home_pose_violations()
-        if problems:
-            self.get_logger().warning(
-                f"the home pose (geometry.home_position, identity orientation) is unreachable: "
-                f"{', '.join(problems)} violated"
-            )
-
     def _validate_parameters(self, parameters: list[Parameter]) -> SetParametersResult:
         """Accept an update only when the would-be full parameter set is valid."""
         values = self._parameter_values()
@@ -341,14 +355,17 @@ class WorkspaceNode(Node):
 
     def _apply_parameters(self, parameters: list[Parameter]) -> None:
         """Swap in the new model and settings after an accepted update."""
+        names = [p.name for p in parameters if p.name in self._specs]
+        if not names:  # an extension declaring its own parameter (motion.current_pose_topic)
+            return
         previous, state = self.state, state_from(self._parameter_values())
         self.state = state
-        self.get_logger().info(f"parameters updated: {', '.join(p.name for p in parameters)}")
-        if state.manipulator != previous.manipulator:
-            self._warn_home_pose()
+        self.get_logger().info(f"parameters updated: {', '.join(names)}")
         if state.settings.recording_enabled != previous.settings.recording_enabled:
             if state.settings.recording_enabled:
-                self.recorder.open(state.settings.recording_directory)
+                self.recorder.open(
+                    state.settings.recording_directory, state.settings.recording_rotation
+                )
             else:
                 self.recorder.close()
 
@@ -417,9 +434,14 @@ class WorkspaceNode(Node):
         self.worker.close()
 
     def destroy_node(self) -> None:
-        """Stop the jobs and the worker, finish the MCAP log, then destroy the node."""
+        """Stop the jobs and the worker, finish the MCAP log (logging where it went), then
+        destroy the node."""
         self.stop_worker()
+        path = self.recorder.status().path
         self.recorder.shutdown()
+        self.get_logger().info(
+            f"stopped; the log is {path}" if path else "stopped (recording was off)"
+        )
         super().destroy_node()
 
 

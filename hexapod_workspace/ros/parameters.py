@@ -7,13 +7,21 @@ example GPM; the resolution bounds and defaults come from :mod:`hexapod_workspac
 
 :func:`refusal` checks one parameter as a client sent it (unknown name, wrong type, read-only,
 out of range) and :func:`state_from` the would-be full set (it builds the
-:class:`~hexapod_workspace.Manipulator`): every refusal names the parameter and the value given.
+:class:`~hexapod_workspace.Manipulator` and refuses an unusable one with
+:func:`~hexapod_workspace.core.validation.require_usable`): the node's start-up and run-time
+validation are this one function, and every refusal names the parameter and the value given.
+
+The packaged example stands in for the model only when the node is given no model parameter at
+all (:func:`model_given`); given any, it must be given the whole model
+(:func:`missing_model_parameters`), the optional ones taking the model's own defaults
+(:func:`model_default`), never the example's.
 """
 
 from __future__ import annotations
 
 import math
 import os
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -24,15 +32,22 @@ from rclpy.parameter import Parameter
 
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import resolution
-from hexapod_workspace.core.manipulator import Manipulator
+from hexapod_workspace.core.manipulator import PARAMETER_DEFAULTS, Manipulator
+from hexapod_workspace.core.validation import require_usable
 from hexapod_workspace.errors import ConfigError
+
+from .recorder import Rotation
 
 __all__ = [
     "MODEL_DESCRIPTIONS",
+    "MODEL_GROUPS",
     "Settings",
     "Spec",
     "State",
     "command_line_override_names",
+    "missing_model_parameters",
+    "model_default",
+    "model_given",
     "parameter_specs",
     "refusal",
     "state_from",
@@ -186,6 +201,30 @@ def parameter_specs() -> dict[str, Spec]:
             "Record every request and result to an MCAP log (rosbag2 form); false stops.",
         ),
         Spec(
+            "recording.max_file_mb",
+            100.0,
+            "Split the log (finish it, go on in a new one, as rosbag2's --max-bag-size) once "
+            "its messages reach this many MB; 0 = no size split.",
+            read_only=True,
+            float_range=(0.0, 1e6),
+        ),
+        Spec(
+            "recording.max_file_duration",
+            3600.0,
+            "Split the log once it is this many s old (at its next message, as rosbag2's "
+            "--max-bag-duration); 0 = no age split.",
+            read_only=True,
+            float_range=(0.0, 1e9),
+        ),
+        Spec(
+            "recording.max_total_mb",
+            1000.0,
+            "Keep the folder's hexapod_workspace_*.mcap logs (earlier runs included) under this "
+            "many MB by removing the oldest when a log starts; 0 = keep every log.",
+            read_only=True,
+            float_range=(0.0, 1e9),
+        ),
+        Spec(
             "recording.directory",
             "",
             "Folder of the MCAP logs (one per run, named by start time); empty = "
@@ -209,6 +248,7 @@ class Settings:
     max_command_age: float
     recording_enabled: bool
     recording_directory: Path
+    recording_rotation: Rotation
 
 
 @dataclass(frozen=True)
@@ -281,8 +321,10 @@ def state_from(values: dict[str, Any]) -> State:
     ConfigError
         Invalid model or settings; the message names the parameter and the value.
     """
-    manipulator = Manipulator.from_mapping(
-        {name: _plain(values[name]) for name in MODEL_DESCRIPTIONS}, warn=False
+    manipulator = require_usable(
+        Manipulator.from_mapping(
+            {name: _plain(values[name]) for name in MODEL_DESCRIPTIONS}, warn=False
+        )
     )
     method = str(values["resolution.projected_method"])
     if method not in PROJECTED_METHODS:
@@ -311,8 +353,54 @@ def state_from(values: dict[str, Any]) -> State:
         max_command_age=age,
         recording_enabled=bool(values["recording.enabled"]),
         recording_directory=folder,
+        recording_rotation=Rotation(
+            max_file_bytes=int(float(values["recording.max_file_mb"]) * 1e6),
+            max_file_seconds=float(values["recording.max_file_duration"]),
+            max_total_bytes=int(float(values["recording.max_total_mb"]) * 1e6),
+        ),
     )
     return State(manipulator, settings)
+
+
+#: Name prefixes of the model's parameters (``frame_id`` only names the frame).
+MODEL_GROUPS = ("geometry.", "limits.", "pose.")
+
+
+def model_given(names: Iterable[str]) -> list[str]:
+    """The model parameters (``geometry.*``, ``limits.*``, ``pose.*``) among ``names``."""
+    return sorted({name for name in names if name.startswith(MODEL_GROUPS)})
+
+
+def missing_model_parameters(given: Iterable[str]) -> str | None:
+    """Why a start with model parameters ``given`` (non-empty) is refused, or None.
+
+    A node given any model parameter must be given every required one: the packaged example
+    never fills in the rest of a user's machine.
+    """
+    given = set(given)
+    required = [
+        name
+        for name, default in PARAMETER_DEFAULTS.items()
+        if default is None and name.startswith(MODEL_GROUPS) and name != "pose.position"
+    ]
+    missing = [name for name in required if name not in given]
+    if not missing:
+        return None
+    also = f" (and {', '.join(missing[1:])})" if len(missing) > 1 else ""
+    return (
+        f"{missing[0]}: required parameter is missing{also}; the node was given "
+        f"{', '.join(sorted(given))}, and a node given any model parameter must be given the "
+        "whole model (the packaged example is used only when none is given)"
+    )
+
+
+def model_default(name: str, declared: dict[str, Any]) -> Any:
+    """The start value of optional model parameter ``name`` when the user gives a model but
+    not this parameter: the model's own default (no joint axes given, no interference check,
+    ``pose.position`` = ``geometry.home_position``), not the packaged example's value."""
+    if name == "pose.position":
+        return list(declared["geometry.home_position"])
+    return PARAMETER_DEFAULTS[name]
 
 
 def _flatten(tree: dict[str, Any], prefix: str = "") -> list[str]:

@@ -9,6 +9,7 @@ module keeps only its own wiring:
 * parameter ``motion.current_pose_topic`` (read-only, default ``""``): a
   ``geometry_msgs/PoseStamped`` topic; when set, the last pose received there is the *current
   pose* and :meth:`PathServices.motion_fields` checks each commanded pose as a move from it;
+  every pose received there is recorded (the log reproduces each motion verdict);
 * conversions of ``geometry_msgs/Pose`` to arrays and back, and of the Pose forms of
   ``CheckPoses`` requests and ``CommandedPose`` messages.
 
@@ -43,9 +44,9 @@ from ..core.paths import (
 )
 from ..core.rotations import matrix_to_tt, quaternion_to_matrix, tt_to_matrix, wrap_angle
 from ..errors import HexapodWorkspaceError, InputError
-from ..logs import SERVICE_QOS, messages, recorded_type, service_topics
+from ..logs import REQUEST_QOS, SERVICE_QOS, messages, recorded_type, service_topics
 from ..logs import paths as path_fields
-from .conversions import to_message
+from .conversions import to_message, type_name
 
 __all__ = [
     "CURRENT_POSE_PARAMETER",
@@ -251,10 +252,14 @@ class PathServices:
             ),
         ).value
         self.subscription = None
+        self._current_pose_topic = ""
         if topic:
             self.subscription = node.create_subscription(
                 PoseStamped, str(topic), self._on_current_pose, 10, callback_group=group
             )
+            self._current_pose_topic = self.subscription.topic_name
+            if recorder is not None:  # every pose a motion verdict may start from is in the log
+                recorder.add_channel(self._current_pose_topic, type_name(PoseStamped), REQUEST_QOS)
 
     # ------------------------------------------------------------------ check_path
     def _on_check_path(self, request: Any, response: Any) -> Any:
@@ -274,6 +279,9 @@ class PathServices:
 
     # ------------------------------------------------------------------ current pose
     def _on_current_pose(self, message: Any) -> None:
+        """Keep the last current pose, recorded first: in the log, each motion verdict comes
+        after the pose it started from."""
+        self._record(self._current_pose_topic, message)
         positions, quaternions = pose_arrays([message.pose])
         with self._lock:
             self._current = _CurrentPose(positions[0], quaternions[0], str(message.header.frame_id))

@@ -12,6 +12,13 @@ every :data:`WAKE_INTERVAL` s; so a message is in the file (the operating system
 SIGKILL of the node does not lose it) at most about ``FLUSH_INTERVAL + WAKE_INTERVAL`` s after
 the callback queued it. :data:`FLUSH_BOUND` is the bound the README states and
 ``test_node_recording`` proves under a 200 Hz stream with some margin for a loaded machine.
+
+Rotation (:class:`Rotation`, the ``recording.max_*`` parameters), as rosbag2 splits a bag: the
+current log is finished and a new one started (named by its own start time, in the same folder)
+once the messages written to it reach ``max_file_bytes`` or it is ``max_file_seconds`` old (checked
+at each message); after each start, the oldest ``hexapod_workspace_*.mcap`` logs of the folder
+(earlier runs included, never the current one) are removed until the folder's logs take at most
+``max_total_bytes``. Every split and removal is logged.
 """
 
 from __future__ import annotations
@@ -29,7 +36,15 @@ from rclpy.serialization import serialize_message
 from hexapod_workspace.errors import RecordingError
 from hexapod_workspace.logs import LogWriter, run_log_path
 
-__all__ = ["FLUSH_BOUND", "FLUSH_INTERVAL", "MAX_QUEUED", "Recorder", "RecorderStatus"]
+__all__ = [
+    "FLUSH_BOUND",
+    "FLUSH_INTERVAL",
+    "LOG_PREFIX",
+    "MAX_QUEUED",
+    "Recorder",
+    "RecorderStatus",
+    "Rotation",
+]
 
 #: Seconds a written message may stay in memory before the writer flushes it.
 FLUSH_INTERVAL = 0.1
@@ -43,6 +58,28 @@ FLUSH_BOUND = 0.5
 MAX_QUEUED = 200_000
 
 _OPEN, _CLOSE, _STOP = "open", "close", "stop"
+#: Logs of this node are named ``<LOG_PREFIX>_<start time>.mcap``; rotation removes only those.
+LOG_PREFIX = "hexapod_workspace"
+
+
+@dataclass(frozen=True)
+class Rotation:
+    """When the node's log is split and old logs removed (0 = no such limit).
+
+    Attributes
+    ----------
+    max_file_bytes : int
+        Split once the messages written to the current log reach this many bytes (the file is a
+        little larger: MCAP records and index).
+    max_file_seconds : float
+        Split once the current log is this old (s), at its next message.
+    max_total_bytes : int
+        Remove the oldest logs of the folder until all take at most this many bytes.
+    """
+
+    max_file_bytes: int = 0
+    max_file_seconds: float = 0.0
+    max_total_bytes: int = 0
 
 
 @dataclass(frozen=True)
@@ -78,6 +115,12 @@ class Recorder:
         self._lost = 0
         self._last_error = ""
         self._accepting = False  # a log is open or being opened: callbacks queue messages
+        # rotation state, recorder thread only
+        self._directory: Path | None = None
+        self._rotation = Rotation()
+        self._file_bytes = 0
+        self._file_started = 0.0
+        self._file_messages = 0
         self._thread = threading.Thread(
             target=self._run, name="hexapod_workspace_recorder", daemon=True
         )
@@ -97,12 +140,15 @@ class Recorder:
             return
         self._queue.put((topic, message, time.time_ns()))
 
-    def open(self, directory: Path, timeout: float = 10.0) -> None:
-        """Start a new log in ``directory`` (named by its start time); no-op when open.
-        Returns once the file exists (or after ``timeout``)."""
+    def open(
+        self, directory: Path, rotation: Rotation | None = None, timeout: float = 10.0
+    ) -> None:
+        """Start a new log in ``directory`` (named by its start time), split and pruned as
+        ``rotation`` says; no-op when open. Returns once the file exists (or after
+        ``timeout``)."""
         self._accepting = True
         done = threading.Event()
-        self._queue.put((_OPEN, Path(directory), done))
+        self._queue.put((_OPEN, Path(directory), done, rotation or Rotation()))
         done.wait(timeout)
 
     def close(self, timeout: float = 10.0) -> None:
@@ -151,7 +197,9 @@ class Recorder:
     def _handle(self, item: tuple[Any, ...]) -> None:
         kind = item[0]
         if kind == _OPEN:
-            self._open(item[1])
+            if self._writer is None:
+                self._directory, self._rotation = item[1], item[3]
+                self._open(item[1])
             item[2].set()
         elif kind == _CLOSE:
             self._finish()
@@ -166,6 +214,54 @@ class Recorder:
                 return
             self._messages += 1
             self._bytes += len(data)
+            self._file_messages += 1
+            self._file_bytes += len(data)
+            if self._split_due():
+                self._split()
+
+    def _split_due(self) -> bool:
+        rotation = self._rotation
+        return bool(
+            (rotation.max_file_bytes and self._file_bytes >= rotation.max_file_bytes)
+            or (
+                rotation.max_file_seconds
+                and time.monotonic() - self._file_started >= rotation.max_file_seconds
+            )
+        )
+
+    def _split(self) -> None:
+        """Finish the current log and go on in a new one (rotation)."""
+        self._finish()
+        if self._directory is not None:
+            self._open(self._directory)
+
+    def _prune(self, current: Path) -> None:
+        """Remove the oldest logs of the folder beyond ``max_total_bytes`` (never ``current``)."""
+        limit = self._rotation.max_total_bytes
+        if not limit:
+            return
+        try:
+            logs = sorted(current.parent.glob(f"{LOG_PREFIX}_*.mcap"))  # names sort by time
+            sizes = {log: log.stat().st_size for log in logs}
+        except OSError as error:
+            self._logger.warning(f"could not list the logs in {current.parent}: {error}")
+            return
+        total = sum(sizes.values())
+        for log in logs:
+            if total <= limit:
+                break
+            if log == current:
+                continue
+            try:
+                log.unlink()
+            except OSError as error:
+                self._logger.warning(f"could not remove the old log {log}: {error}")
+                continue
+            total -= sizes[log]
+            self._logger.info(
+                f"removed the old log {log} ({sizes[log] / 1e6:.1f} MB): the logs in "
+                f"{current.parent} are kept under {limit / 1e6:g} MB (recording.max_total_mb)"
+            )
 
     def _open(self, directory: Path) -> None:
         if self._writer is not None:
@@ -179,7 +275,10 @@ class Recorder:
             self._failed(error, writer)
             return
         self._writer = writer
+        self._file_bytes, self._file_messages = 0, 0
+        self._file_started = time.monotonic()
         self._logger.info(f"recording to {writer.path}")
+        self._prune(writer.path)
 
     def _finish(self) -> None:
         writer, self._writer = self._writer, None
@@ -190,6 +289,11 @@ class Recorder:
         except RecordingError as error:
             self._last_error = str(error)
             self._logger.error(f"could not finish the log {writer.path}: {error}")
+            return
+        self._logger.info(
+            f"log finished: {writer.path} ({self._file_messages} messages, "
+            f"{self._file_bytes / 1e6:.2f} MB of messages)"
+        )
 
     def _failed(self, error: RecordingError, writer: LogWriter | None = None) -> None:
         """A write failed: recording off (the node keeps serving)."""

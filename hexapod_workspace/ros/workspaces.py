@@ -155,7 +155,7 @@ class WorkspaceServer:
             job,
             n_rays=job.n_rays,
             tolerance=job.tolerance,
-            empty_cloud=isinstance(error, UnreachableReferenceError),
+            reference_reachable=not isinstance(error, UnreachableReferenceError),
         )
 
     def _publish_failure(
@@ -165,36 +165,36 @@ class WorkspaceServer:
         *,
         n_rays: int = 0,
         tolerance: float = float("nan"),
-        empty_cloud: bool = False,
+        reference_reachable: bool = True,
     ) -> tuple[Any, Any]:
-        """Publish (and return) the summary of a failed computation and an empty cloud.
+        """Publish (and return) the summary of a failed computation; return an empty cloud.
 
-        ``empty_cloud``: the workspace is empty (unreachable reference): the cloud is published
-        too, so that viewers do not keep showing a stale boundary.
+        Only the summary is published: the transient-local cloud topics keep the last boundary
+        that was computed, for a late subscriber (RViz, a dashboard); the failure's summary, with
+        its request's ``kind`` as given and ``reference_reachable`` false for an empty
+        workspace, says what happened. The empty cloud goes to the action's result only.
         """
         if isinstance(origin, WorkspaceJob):
             position, stamp_ns, kind = origin.position, origin.stamp_ns, origin.kind
         else:
             position, stamp_ns = position_from_point(origin.position), self._node._now_ns()
-            kind = WorkspaceKind.of(origin.kind) or WorkspaceKind.ORIENTATION
+            kind = int(origin.kind)  # as requested, even when unknown (7 is not orientation)
         frame_id = self._node.state.manipulator.frame_id
         fields = messages.summary_fields(
             None,
             message=reason,
-            reference_reachable=not empty_cloud,
+            reference_reachable=reference_reachable,
             n_rays=n_rays,
             tolerance=tolerance,
             stamp_ns=stamp_ns,
             frame_id=frame_id,
             request_id=origin.request_id,
             kind=kind,
-            position=np.nan_to_num(position),
+            position=position,  # as requested: NaN stays NaN (replay shows it)
         )
         summary = to_message(WorkspaceSummary, fields)
         empty = messages.pointcloud_fields(np.zeros((0, 6)), frame_id=frame_id, stamp_ns=stamp_ns)
         cloud = to_message(PointCloud2, empty)
-        if empty_cloud:
-            self._node.publish(self._cloud_publishers[kind], cloud)
         self._node.publish(self._summary_publisher, summary)
         self._node.get_logger().warning(f"workspace request failed: {reason}")
         return summary, cloud

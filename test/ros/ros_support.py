@@ -141,17 +141,26 @@ def node_environment() -> dict[str, str]:
 
 @contextlib.contextmanager
 def running_node(
-    directory: Path, overrides: dict[str, Any] | None = None, extra_args: list[str] | None = None
+    directory: Path,
+    overrides: dict[str, Any] | None = None,
+    extra_args: list[str] | None = None,
+    params_text: str | None = None,
 ) -> Iterator[NodeProcess]:
     """Start workspace_node with a parameters file in ``directory``; stop it on exit.
 
-    The node records into ``directory / "logs"``. Needs ROS_DOMAIN_ID set (``ros_domain``).
+    The file is the example with ``overrides``, or ``params_text`` as given. The node records
+    into ``directory / "logs"``. Needs ROS_DOMAIN_ID set (``ros_domain``).
     """
     assert "ROS_DOMAIN_ID" in os.environ, "use the ros_domain fixture first"
     record_dir = directory / "logs"
-    params = write_params(
-        directory / "params.yaml", {"recording.directory": str(record_dir), **(overrides or {})}
-    )
+    if params_text is None:
+        params = write_params(
+            directory / "params.yaml",
+            {"recording.directory": str(record_dir), **(overrides or {})},
+        )
+    else:
+        params = directory / "params.yaml"
+        params.write_text(params_text, encoding="utf-8")
     log_path = directory / "node.log"
     command = [str(NODE_EXECUTABLE), "--ros-args", "--params-file", str(params)]
     with log_path.open("wb") as log:

@@ -97,11 +97,18 @@ def test_rclpy_parameters_stay_settable(node):
     assert result.successful, result.reason
 
 
+def example_model(**changes) -> dict:
+    """The packaged example's whole model as overrides (empty axes left out), changed."""
+    model = {k: v for k, v in Manipulator.example().to_parameters().items() if v != []}
+    model.pop("frame_id")
+    return {**model, **changes}
+
+
 @pytest.mark.parametrize(
     ("overrides", "named"),
     [
-        ({"limits.leg_length_min": [2.0]}, "limits.leg_length_min"),
-        ({"limits.leg_diameter": 0}, "limits.leg_diameter"),
+        (example_model(**{"limits.leg_length_min": [2.0]}), "limits.leg_length_min"),
+        (example_model(**{"limits.leg_diameter": 0}), "limits.leg_diameter"),
         ({"resolution.projected_method": "fastest"}, "resolution.projected_method"),
         ({"check.max_command_age": -1.0}, "check.max_command_age"),
     ],
@@ -111,6 +118,115 @@ def test_invalid_overrides_refuse_to_start(ros_context, overrides, named):
     with pytest.raises(ConfigError) as raised:
         make_node(ros_context, **overrides)
     assert named in str(raised.value)
+
+
+# ------------------------------------------- the model is the user's whole model or the example's
+@pytest.mark.parametrize(
+    ("overrides", "named"),
+    [
+        # issue 16, item 1: the misspelt key used to be dropped with a warning, the example's
+        # 1.45 m stood in and z = -1.45 m was answered reachable
+        (
+            {**example_model(), "limits.leg_lenght_max": [1.30]},
+            "limits.leg_lenght_max: unknown parameter",
+        ),
+        (
+            {**example_model(), "limit.leg_length_max": [1.30]},
+            "limit: unknown section",
+        ),
+        ({"resolution.n_rayz": 36}, "resolution.n_rayz: unknown parameter"),
+    ],
+    ids=["misspelt-key", "misspelt-section", "misspelt-setting"],
+)
+def test_an_unknown_parameter_stops_the_node_with_its_name(ros_context, overrides, named):
+    with pytest.raises(ConfigError) as raised:
+        make_node(ros_context, **overrides)
+    assert named in str(raised.value)
+
+
+def test_a_partial_model_is_refused_not_completed_from_the_example(ros_context):
+    # only leg_length_max: before, the example's joints and other limits filled in the rest
+    with pytest.raises(ConfigError) as raised:
+        make_node(ros_context, **{"limits.leg_length_max": [1.30]})
+    text = str(raised.value)
+    assert "geometry.base_joints: required parameter is missing" in text
+    assert "limits.leg_length_max" in text and "whole model" in text
+    with pytest.raises(ConfigError, match="missing .*geometry.home_position.* given pose.position"):
+        make_node(ros_context, **{"pose.position": [0.0, 0.0, -1.2]})
+
+
+def test_optional_model_parameters_take_the_model_defaults_not_the_example(ros_context):
+    overrides = example_model(**{"limits.leg_length_max": [1.30]})
+    del overrides["limits.leg_diameter"], overrides["pose.position"]
+    node = make_node(ros_context, **overrides)
+    try:
+        model = node.state.manipulator
+        assert model.leg_diameter == 0.0  # the example's is 0.05 m
+        np.testing.assert_array_equal(model.position, model.home_position)
+        assert node.get_parameter("limits.leg_diameter").value == 0.0
+        # the verdict of the issue: z = -1.45 m is out of reach of 1.30 m legs
+        response = node._on_check_poses(
+            check_request([(0.0, 0.0, 0.0)], (0.0, 0.0, -1.45)), CheckPoses.Response()
+        )
+        assert response.success and not response.results[0].reachable
+    finally:
+        node.destroy_node()
+
+
+def test_no_model_parameter_uses_the_example_and_says_so(ros_context, capfd):
+    node = make_node(ros_context)
+    try:
+        assert node.state.manipulator == Manipulator.example()
+    finally:
+        node.destroy_node()
+    logged = capfd.readouterr().err
+    assert "no model parameter" in logged and str(example_config_path()) in logged, logged
+
+
+# ------------------------------------------- degenerate machines: refused at start and at run time
+DEGENERATE = [
+    (
+        {"geometry.base_joints": [0.0] * 18},
+        "geometry.base_joints: expected six distinct joint centres, joints 1 and 2 coincide",
+    ),
+    (
+        {"geometry.platform_joints": [0.1, 0.0, 0.1] * 6},
+        "geometry.platform_joints: expected six distinct joint centres",
+    ),
+    (
+        # home + b_1 = a_1: leg 1 has zero length at the home pose
+        {"geometry.home_position": [0.337242, 0.108592, -0.1]},
+        "geometry.home_position: expected non-zero legs at the home pose, leg 1",
+    ),
+]
+
+
+def singular_layout() -> dict:
+    """Vertical legs (each platform joint under its base joint): six parallel lines, the
+    Plücker matrix has rank 3 at home. The lengths fit the example's limits there."""
+    base = np.reshape(Manipulator.example().to_parameters()["geometry.base_joints"], (6, 3))
+    platform = base.copy()
+    platform[:, 2] = 0.1
+    return {"geometry.platform_joints": platform.ravel().tolist()}
+
+
+@pytest.mark.parametrize(
+    ("changes", "reason"),
+    [*DEGENERATE, (singular_layout(), "platform is singular at the home pose")],
+    ids=["base-joints-at-one-point", "platform-joints-at-one-point", "zero-legs", "singular"],
+)
+def test_a_degenerate_machine_is_refused_at_run_time_and_at_start(
+    node, ros_context, changes, reason
+):
+    before = node.state
+    result = node.set_parameters_atomically(
+        [Parameter(name, value=value) for name, value in changes.items()]
+    )
+    assert not result.successful
+    assert reason in result.reason, result.reason
+    assert node.state is before
+    with pytest.raises(ConfigError, match=reason):
+        make_node(ros_context, **example_model(**changes))
 
 
 def test_override_names_from_the_command_line(tmp_path):

@@ -32,7 +32,15 @@ def test_node_stops_cleanly_on_signal(ros_client, tmp_path, sig):
         output = node.output()
     assert status == 0, output
     assert "Traceback" not in output, output
-    assert list((tmp_path / "logs").glob("*.mcap")), "the run's log is missing"
+    (log,) = (tmp_path / "logs").glob("*.mcap")
+    # issue 16, item 17: what the node serves, and where its log went when it stopped
+    (ready,) = [line for line in output.splitlines() if "ready: /hexapod_workspace" in line]
+    for name in ("check_poses", "check_path", "compute_workspace", "compute_atlas"):
+        assert name in ready, ready
+    assert "commanded_pose" in ready and "workspace_request" in ready, ready
+    assert f"log finished: {log}" in output and f"stopped; the log is {log}" in output, output
+    # no spurious update at start (an extension declaring its own parameter)
+    assert "parameters updated" not in output, output
 
 
 def test_node_stops_cleanly_while_goals_compute_and_queue(ros_client, tmp_path):
@@ -69,8 +77,23 @@ def test_node_stops_cleanly_while_goals_compute_and_queue(ros_client, tmp_path):
         ({"limits.leg_diameter": 0}, "limits.leg_diameter"),  # an integer where m is a float
         ({"resolution.projected_method": "fastest"}, "resolution.projected_method"),
         ({"resolution.n_rays": 1}, "resolution.n_rays"),
+        # issue 16, item 1: a misspelt key or section stops the node (it used to warn and
+        # answer for the example's 1.45 m legs)
+        ({"limits.leg_lenght_max": [1.30]}, "limits.leg_lenght_max: unknown parameter"),
+        ({"limit.leg_length_max": [1.30]}, "limit: unknown section"),
+        # issue 16, item 3: six legs from one point
+        ({"geometry.base_joints": [0.0] * 18}, "joints 1 and 2 coincide"),
     ],
-    ids=["lengths", "joints-shape", "int-type", "method", "range"],
+    ids=[
+        "lengths",
+        "joints-shape",
+        "int-type",
+        "method",
+        "range",
+        "misspelt-key",
+        "misspelt-section",
+        "coincident-joints",
+    ],
 )
 def test_invalid_parameters_file_exits_with_the_reason(ros_domain, tmp_path, overrides, named):
     with running_node(tmp_path, overrides) as node:
@@ -84,10 +107,20 @@ def test_invalid_parameters_file_exits_with_the_reason(ros_domain, tmp_path, ove
     assert "Traceback" not in output, output
 
 
-def test_unknown_parameter_is_reported(ros_client, tmp_path):
-    with running_node(tmp_path, {"limits.leg_diamter": 0.05}) as node:
-        serve_one_check(ros_client)
-        ros_client.drop_client(f"{NODE}/check_poses")
-        assert node.stop() == 0
+def test_a_partial_model_in_the_file_stops_the_node(ros_domain, tmp_path):
+    """Issue 16, item 1: only limits.leg_length_max given; the example must not fill in the
+    rest of the machine."""
+    text = (
+        "hexapod_workspace:\n  ros__parameters:\n"
+        f"    recording:\n      directory: {tmp_path / 'logs'}\n"
+        "    limits:\n      leg_length_max: [1.30]\n"
+    )
+    with running_node(tmp_path, params_text=text) as node:
+        try:
+            status = node.process.wait(timeout=STOP_TIMEOUT * 2)
+        except subprocess.TimeoutExpired:
+            pytest.fail(f"node kept running with a partial model:\n{node.output()}")
         output = node.output()
-    assert "limits.leg_diamter" in output, output
+    assert status == 1, output
+    assert "geometry.base_joints: required parameter is missing" in output, output
+    assert "Traceback" not in output, output

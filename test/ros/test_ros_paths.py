@@ -231,6 +231,17 @@ def test_path_calls_are_recorded_and_replayed(client, workspace_node):
         assert len(requests) == len(responses) >= 1
         assert requests[-1] == plain(request)
         assert responses[-1] == plain(response)
+        # issue 16, item 5: the current pose of every motion verdict is in the log, before it
+        current = None
+        verdicts = 0
+        for topic, _, message in reader(logs[0]):
+            if topic == CURRENT_POSE_TOPIC:
+                current = plain(message)["pose"]
+            elif topic == f"{NODE}/reachability" and plain(message)["motion_checked"]:
+                assert current is not None
+                assert plain(message)["current_pose"] == current
+                verdicts += 1
+        assert verdicts >= 1
     replay = run_cli("replay", str(logs[0]), "--json")
     assert replay.returncode == 0, replay.stderr
     calls = json.loads(replay.stdout)["path_checks"]

@@ -234,6 +234,32 @@ def test_late_subscriber_gets_the_last_result(client, model):
     assert clouds[0].width == response.boundary.width
 
 
+def test_failed_requests_leave_the_last_boundary_for_late_subscribers(client):
+    """Issue 16, item 4: failures publish their summary only; the transient-local cloud stays
+    the last computed boundary, and an unknown kind's summary keeps its kind."""
+    good = compute(client, workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO, request_id="ok"))
+    assert good.success and good.boundary.width > 0, good.message
+    failures = [
+        workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO, (math.nan, 0, 0), "nan"),
+        workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO, (0, 0, 0), "unreachable"),
+    ]
+    for request in failures:
+        assert not compute(client, request).success
+    late = client.collect(PointCloud2, f"{NODE}/projected_workspace", transient_local=True)
+    client.spin_until(lambda: late, what="the latched cloud")
+    assert late[-1].width == good.boundary.width
+    assert late[-1].header.stamp == good.summary.header.stamp
+    summaries = client.collect(WorkspaceSummary, f"{NODE}/workspace_summary")
+    publisher = client.publisher(WorkspaceRequest, f"{NODE}/workspace_request")
+    publisher.publish(workspace_request(7, request_id="kind-7"))
+    client.spin_until(
+        lambda: any(s.request_id == "kind-7" for s in summaries), what="the kind-7 summary"
+    )
+    failed = next(s for s in summaries if s.request_id == "kind-7")
+    assert (failed.kind, failed.success) == (7, False)
+    assert "kind: expected 0 (orientation)" in failed.message
+
+
 # ---------------------------------------------------------------------------- request topic
 
 

@@ -1,0 +1,136 @@
+"""Layouts no verdict can be given for: refused with the reason, at start-up and at run time.
+
+One set of rules for every door a model comes in by (the CLI's ``--config`` file, the node's
+parameters at start, a ``set_parameters`` call): the node's start-up and run-time validation
+and the CLI's all end here.
+
+* **Coincident joints** (:func:`coincident_joints_reason`): two base joints, or two platform
+  joints, closer than :data:`COINCIDENT_TOLERANCE`. Each leg of a 6-UPS hexapod has its own
+  universal and spherical joint; two legs sharing a joint centre make the leg-interference
+  distance zero for every pose and, when more than two share it, the platform singular.
+* **Zero-length legs** at the home pose (checked by the model builder itself).
+* **A platform singular at the home pose** (:func:`home_conditioning`): the 6×6 matrix whose
+  rows are the legs' normalised Plücker coordinates ``(n_i, (R·b_i × n_i) / ρ)`` (identity
+  R at the home pose, ρ the platform radius max |b_i|, so that both halves are dimensionless and
+  of order 1) has its smallest singular value below :data:`SINGULAR_TOLERANCE`. Six legs through
+  one point, six parallel legs, a planar layout with every leg in the plane: rank < 6, the leg
+  lengths do not fix the platform and no verdict about its orientation means anything.
+* **An unreachable home pose** (:func:`unusable_reason`): the home pose is where the machine is
+  assembled; a model that cannot take it is almost always a unit mistake (millimetres in a file
+  of metres, degrees for radians) and is refused with that hint.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import GeometryError
+
+if TYPE_CHECKING:
+    from .manipulator import Manipulator
+
+__all__ = [
+    "COINCIDENT_TOLERANCE",
+    "SINGULAR_TOLERANCE",
+    "coincident_joints_reason",
+    "home_conditioning",
+    "require_usable",
+    "unusable_reason",
+]
+
+#: Two joint centres closer than this (m) are the same point.
+COINCIDENT_TOLERANCE = 1e-6
+#: Smallest singular value of the normalised Plücker matrix below which the platform is singular.
+#: The example GPM has 0.13 at home; rounding errors of an exactly singular layout are ~1e-16.
+SINGULAR_TOLERANCE = 1e-6
+#: Lengths in a file written in millimetres are 1000 times too large.
+_MM = 1000.0
+
+
+def coincident_joints_reason(name: str, joints: NDArray[np.float64]) -> str | None:
+    """Why six joint centres are degenerate (two at one point), or None.
+
+    Parameters
+    ----------
+    name : str
+        The parameter (``geometry.base_joints``), for the message.
+    joints : ndarray, shape (6, 3)
+        Joint centres, m.
+    """
+    gaps = np.linalg.norm(joints[:, None, :] - joints[None, :, :], axis=-1)
+    close = np.argwhere(np.triu(gaps < COINCIDENT_TOLERANCE, k=1))
+    if close.size == 0:
+        return None
+    i, j = (int(k) for k in close[0])
+    return (
+        f"{name}: expected six distinct joint centres, joints {i + 1} and {j + 1} coincide "
+        f"at {np.round(joints[i], 9).tolist()} m (distance {gaps[i, j]:.3g} m < "
+        f"{COINCIDENT_TOLERANCE:g} m)"
+    )
+
+
+def home_conditioning(manipulator: Manipulator) -> float:
+    """Smallest singular value of the normalised Plücker matrix of the legs at the home pose.
+
+    Rows ``(n_i, (b_i × n_i) / ρ)``: n_i the unit leg direction at the home position with the
+    identity orientation, b_i the platform joint (mobile frame = base frame orientation there),
+    ρ = max |b_i| (1 m when every b_i is 0). Dimensionless; 0 for a singular platform.
+    """
+    legs = manipulator.home_position + manipulator.platform_joints - manipulator.base_joints
+    directions = legs / np.linalg.norm(legs, axis=1)[:, None]
+    radius = float(np.max(np.linalg.norm(manipulator.platform_joints, axis=1))) or 1.0
+    moments = np.cross(manipulator.platform_joints, directions) / radius
+    plucker = np.hstack((directions, moments))
+    return float(np.linalg.svd(plucker, compute_uv=False)[-1])
+
+
+def _unit_hint(manipulator: Manipulator) -> str:
+    """Which lengths look like millimetres, from the home leg lengths against the limits."""
+    legs = manipulator.home_position + manipulator.platform_joints - manipulator.base_joints
+    lengths = np.linalg.norm(legs, axis=1)
+    low, high = manipulator.leg_length_min, manipulator.leg_length_max
+    span = f"{lengths.min():.4g} to {lengths.max():.4g} m"
+    if np.all((low / _MM <= lengths) & (lengths <= high / _MM)):
+        return (
+            f"the legs are {span} long there and limits.leg_length_min/max look like "
+            "millimetres (they fit once divided by 1000); parameters are in metres"
+        )
+    if np.all((low <= lengths / _MM) & (lengths / _MM <= high)):
+        return (
+            f"the legs are {span} long there, which fits limits.leg_length_min/max once "
+            "divided by 1000: geometry.* look like millimetres; parameters are in metres"
+        )
+    return (
+        f"the legs are {span} long there; parameters are in metres and radians (a unit "
+        "mistake, millimetres or degrees, is the usual cause)"
+    )
+
+
+def unusable_reason(manipulator: Manipulator) -> str | None:
+    """Why no verdict can be given for this model (see the module documentation), or None."""
+    problems = manipulator.home_pose_violations()
+    if problems:
+        return (
+            f"the home pose (geometry.home_position {manipulator.home_position.tolist()} m, "
+            f"identity orientation) is unreachable: {', '.join(problems)} violated; "
+            f"{_unit_hint(manipulator)}"
+        )
+    conditioning = home_conditioning(manipulator)
+    if conditioning < SINGULAR_TOLERANCE:
+        return (
+            "geometry: the platform is singular at the home pose (smallest singular value of "
+            f"the legs' Plücker matrix {conditioning:.3g} < {SINGULAR_TOLERANCE:g}): the leg "
+            "lengths do not fix the platform there"
+        )
+    return None
+
+
+def require_usable(manipulator: Manipulator) -> Manipulator:
+    """Return ``manipulator``, or raise :class:`GeometryError` with :func:`unusable_reason`."""
+    reason = unusable_reason(manipulator)
+    if reason is not None:
+        raise GeometryError(reason)
+    return manipulator
