@@ -240,7 +240,10 @@ def test_help_describes_every_option_and_shows_defaults():
                 assert "default" in shown or action.dest == "json", option
             elif action.default not in (None, []):
                 default = action.default
-                text = f"{default:g}" if isinstance(default, float) else str(default)
+                if isinstance(default, list):  # nargs options show their values as typed
+                    text = " ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in default)
+                else:
+                    text = f"{default:g}" if isinstance(default, float) else str(default)
                 said = (f"default {text}", f"default: {text}", f"{text}, default")
                 assert any(words in shown for words in said), (option, shown)
             elif action.option_strings[0] in computed.get(name, set()):
