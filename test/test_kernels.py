@@ -281,8 +281,9 @@ def test_sincos_within_an_ulp_of_libm():
 
 
 def test_warm_up_compiles_everything_and_says_how_long(example):
+    # How long it takes is measured by benchmarks/speed.py (cold start), not asserted here.
     seconds = kernels.warm_up()
-    assert 0.0 < seconds < 600.0
+    assert isinstance(seconds, float) and math.isfinite(seconds) and seconds > 0.0
     assert kernels.cache_is_warm()
 
 

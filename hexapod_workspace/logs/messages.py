@@ -56,6 +56,7 @@ __all__ = [
 #: PointCloud2 fields of a boundary cloud, all float32, in this order (point_step 24 bytes).
 POINT_FIELD_NAMES = ("x", "y", "z", "phi", "theta", "psi")
 _FLOAT32 = 7  # sensor_msgs/PointField.FLOAT32
+_FLOAT64 = 8  # sensor_msgs/PointField.FLOAT64
 
 #: Topic and service names the node uses and the CLI records under (the node is named
 #: ``hexapod_workspace``; ``~/workspace_summary`` resolves to
@@ -578,10 +579,10 @@ def pointcloud_to_array(cloud: Any) -> NDArray[np.float64]:
         if name not in POINT_FIELD_NAMES:
             continue
         datatype, offset = int(_get(point_field, "datatype")), int(_get(point_field, "offset"))
-        if datatype not in (7, 8):
+        if datatype not in (_FLOAT32, _FLOAT64):
             msg = f"PointCloud2 field {name} has datatype {datatype}, expected FLOAT32/FLOAT64"
             raise ValueError(msg)
-        width = 4 if datatype == 7 else 8
+        width = 4 if datatype == _FLOAT32 else 8
         column = np.ascontiguousarray(rows[:, offset : offset + width]).view(f"{order}f{width}")
         out[:, POINT_FIELD_NAMES.index(name)] = column[:, 0]
     return out
