@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..core.paths import INTERPOLATIONS, PathCheck, SegmentChecks, TorsionPlan, reported_parts
 from ..core.rotations import matrix_to_quaternion, tt_to_matrix
 from . import messages
+from .interfaces import interface
 
 __all__ = [
     "CHECK_PATH_TOPIC",
@@ -34,8 +35,8 @@ __all__ = [
 ]
 
 #: The node's path service and its type (recorded as ``<service>/request`` and ``/response``).
-CHECK_PATH_TOPIC = "/hexapod_workspace/check_path"
-CHECK_PATH_TYPE = "hexapod_workspace_msgs/srv/CheckPath"
+CHECK_PATH_TOPIC = interface("check_path").name
+CHECK_PATH_TYPE = interface("check_path").type
 #: ``CheckPath`` interpolation constants by core name (SLERP = 0, TILT_TORSION = 1).
 INTERPOLATION_CODES = {name: code for code, name in enumerate(INTERPOLATIONS)}
 

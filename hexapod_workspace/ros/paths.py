@@ -45,6 +45,7 @@ from ..core.rotations import matrix_to_tt, quaternion_to_matrix, tt_to_matrix, w
 from ..errors import HexapodWorkspaceError, InputError
 from ..logs import SERVICE_QOS, messages, recorded_type, service_topics
 from ..logs import paths as path_fields
+from ..logs.interfaces import relative_name
 from .conversions import to_message
 
 __all__ = [
@@ -224,10 +225,10 @@ class PathServices:
         self.parameter_names = [CURRENT_POSE_PARAMETER]
         group = ReentrantCallbackGroup()
         self.service = node.create_service(
-            CheckPath, "~/check_path", self._on_check_path, callback_group=group
+            CheckPath, relative_name("check_path"), self._on_check_path, callback_group=group
         )
         self._request_topic, self._response_topic = service_topics(
-            node.resolve_service_name("~/check_path")
+            node.resolve_service_name(relative_name("check_path"))
         )
         if recorder is not None:
             recorder.add_channel(
