@@ -76,7 +76,6 @@ class Interface:
 
 
 _MSGS = "hexapod_workspace_msgs"
-_RESULT = {"durability": "transient_local", "depth": 1}
 
 #: Every interface of the node, in the order of the reference.
 INTERFACES: tuple[Interface, ...] = (
@@ -107,21 +106,24 @@ INTERFACES: tuple[Interface, ...] = (
         "publisher",
         f"{_MSGS}/msg/WorkspaceSummary",
         "the summary of every computation (failed ones too)",
-        **_RESULT,
+        durability="transient_local",
+        depth=1,
     ),
     Interface(
         "orientation_workspace",
         "publisher",
         "sensor_msgs/msg/PointCloud2",
         "boundary of the last 3-D orientation workspace",
-        **_RESULT,
+        durability="transient_local",
+        depth=1,
     ),
     Interface(
         "projected_workspace",
         "publisher",
         "sensor_msgs/msg/PointCloud2",
         "boundary of the last projected workspace",
-        **_RESULT,
+        durability="transient_local",
+        depth=1,
     ),
     Interface(
         "check_poses",
@@ -169,7 +171,8 @@ INTERFACES: tuple[Interface, ...] = (
         "sensor_msgs/msg/PointCloud2",
         "the last atlas, one point per position",
         extension="hexapod_workspace.ros.atlas_action",
-        **_RESULT,
+        durability="transient_local",
+        depth=1,
     ),
     Interface(
         "/diagnostics",
