@@ -8,7 +8,7 @@ module keeps only its own wiring:
   ``free_torsion`` the rotation about each pose's z-axis (the tool axis) planned;
 * parameter ``motion.current_pose_topic`` (read-only, default ``""``): a
   ``geometry_msgs/PoseStamped`` topic; when set, the last pose received there is the *current
-  pose* and :meth:`PathServices.motion_fields` checks each commanded pose as a move from it;
+  pose* and :meth:`PathServices.with_motion` checks each commanded pose as a move from it;
 * conversions of ``geometry_msgs/Pose`` to arrays and back, and of the Pose forms of
   ``CheckPoses`` requests and ``CommandedPose`` messages.
 
@@ -63,7 +63,7 @@ CURRENT_POSE_PARAMETER = "motion.current_pose_topic"
 
 
 def pose_arrays(poses: Sequence[Any]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Positions (N, 3), m, and quaternions (N, 4) ``(x, y, z, w)`` of ``geometry_msgs/Pose``s.
+    """Positions (N, 3), m, and quaternions (N, 4) ``(x, y, z, w)`` of Pose messages.
 
     Not validated here (NaN stays NaN; the core refuses it with the waypoint's index).
     """
