@@ -136,8 +136,8 @@ INTERFACES: tuple[Interface, ...] = (
         "action",
         # Recorded in the form of the service of the same name (rosbag2 records no actions).
         f"{_MSGS}/srv/ComputeWorkspace",
-        "a workspace at any position, with progress and cancel "
-        f"(action type {_MSGS}/action/ComputeWorkspace)",
+        "a workspace at any position, with progress and cancel (logs record it in the form "
+        "of the service of the same name)",
     ),
     Interface(
         "compute_orientation_workspace",
