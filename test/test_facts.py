@@ -102,3 +102,14 @@ def test_every_message_twin_has_its_service():
             assert _fields(path.read_text(encoding="utf-8")) == _fields(definition)
             continue
         assert path.name in twins, f"{path.name}: no service {stem}.srv to be the twin of"
+
+
+def test_the_declared_licence_is_the_one_shipped():
+    text = (ROOT / "LICENSE").read_text(encoding="utf-8")
+    assert "Apache License" in text and "Version 2.0, January 2004" in text
+    assert "END OF TERMS AND CONDITIONS" in text  # the whole text, not a pointer to it
+    for package_xml in (ROOT / "package.xml", MSG_DEFS / "package.xml"):
+        assert ET.parse(package_xml).getroot().findtext("license") == "Apache-2.0"
+    from importlib.metadata import metadata
+
+    assert metadata("hexapod_workspace")["License"] == "Apache-2.0"

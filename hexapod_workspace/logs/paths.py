@@ -149,7 +149,11 @@ def segment_check_fields(segments: SegmentChecks, index: int = 0) -> dict[str, A
 
 
 def check_path_response_fields(
-    result: PathCheck | TorsionPlan, *, pairs: bool = True, message: str | None = None
+    result: PathCheck | TorsionPlan,
+    *,
+    pairs: bool = True,
+    message: str | None = None,
+    baseline: PathCheck | None = None,
 ) -> dict[str, Any]:
     """hexapod_workspace_msgs/srv/CheckPath_Response of a path check or a torsion plan.
 
@@ -162,11 +166,15 @@ def check_path_response_fields(
         Whether the interference check is enabled (``limiting_pair`` filled).
     message : str, optional
         Default: a one-line verdict (see :func:`path_verdict`).
+    baseline : PathCheck, optional
+        The ψ = 0 baseline of a path of fixed orientations
+        (:func:`hexapod_workspace.core.baseline.reported_baseline`); a plan's is its own.
     """
     path, plan = reported_parts(result)
     waypoints = path.waypoints
     rotations = tt_to_matrix(waypoints.angles)
-    baseline = plan.baseline if plan is not None else None
+    if plan is not None:
+        baseline = plan.baseline
     fields: dict[str, Any] = {
         "success": True,
         "message": message if message is not None else path_verdict(result),

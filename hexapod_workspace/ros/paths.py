@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.callback_groups import ReentrantCallbackGroup
 
+from ..core.baseline import reported_baseline
 from ..core.manipulator import Manipulator
 from ..core.paths import (
     DEFAULT_PATH_TOLERANCE,
@@ -171,7 +172,11 @@ def check_path_response_fields(manipulator: Manipulator, request: Any) -> dict[s
             )
     except HexapodWorkspaceError as error:
         return path_fields.failed_check_path_response_fields(str(error))
-    return path_fields.check_path_response_fields(result, pairs=manipulator.leg_diameter > 0.0)
+    return path_fields.check_path_response_fields(
+        result,
+        pairs=manipulator.leg_diameter > 0.0,
+        baseline=reported_baseline(manipulator, result),
+    )
 
 
 def _option(value: float, name: str, default: float) -> float:
