@@ -20,35 +20,33 @@ from hexapod_workspace.cli.plotting import plot_orientation, plot_projected
 out_dir = Path(sys.argv[1]) if len(sys.argv) > 1 else Path("tutorial_out")
 out_dir.mkdir(parents=True, exist_ok=True)
 
-# The packaged example (config/example_gpm.yaml): axisymmetric, the platform hanging below the
-# base, at the scale of the paper's Fig. 1.
+# The packaged example (config/example_gpm.yaml): axisymmetric, the platform
+# hanging below the base, at the scale of the paper's Fig. 1.
 machine = Manipulator.example()
 
 # The paper analyses its machine on the axis of symmetry and off it.
 positions = {"on_axis": (0.0, 0.0, -1.3), "off_axis": (0.2, 0.2, -0.95)}
 
-print("case      position [m]         tilt, psi = 0 [deg]   tilt, exact [deg]   psi range [deg]")
+print("case      position [m]        tilt psi=0 [deg]  tilt exact [deg]  psi [deg]")
 for name, position in positions.items():
-    # The paper's projected workspace: the first violation along each azimuth at psi = 0 ...
+    # The paper's projected workspace: first violation per azimuth at psi = 0 ...
     paper = projected_workspace(machine, position)
-    # ... and the true shadow of the orientation workspace (the best torsion per azimuth).
+    # ... and the true shadow of the workspace (the best torsion per azimuth).
     exact = projected_workspace(machine, position, method="exact")
-    # The 3-D orientation workspace in the cylindrical picture (theta cos phi, theta sin phi, psi).
+    # The 3-D orientation workspace, cylindrical picture (theta, phi polar; psi up).
     solid = orientation_workspace(machine, position)
 
     plot_projected([paper, exact], out_dir / f"projected_{name}.png")
     plot_orientation(solid, out_dir / f"orientation_{name}.png")
 
     def deg(*angles: float) -> str:
-        return " .. ".join(f"{math.degrees(angle):6.2f}" for angle in angles)
+        return "..".join(f"{math.degrees(angle):.2f}" for angle in angles)
 
     where = "(" + ", ".join(f"{v:g}" for v in position) + ")"
     print(
-        f"{name:9} {where:20} {deg(paper.tilt_min, paper.tilt_max):21} "
-        f"{deg(exact.tilt_min, exact.tilt_max):19} {deg(solid.psi_min, solid.psi_max)}"
+        f"{name:9} {where:19} {deg(paper.tilt_min, paper.tilt_max):17} "
+        f"{deg(exact.tilt_min, exact.tilt_max):17} {deg(solid.psi_min, solid.psi_max)}"
     )
     assert exact.gap is not None
-    print(
-        f"          the psi = 0 boundary lies inside the exact one by up to "
-        f"{math.degrees(float(np.max(exact.gap))):.2f} deg; volume {solid.volume:.4f} rad^3"
-    )
+    gap = math.degrees(float(np.max(exact.gap)))
+    print(f"{'':10}psi = 0 inside exact by up to {gap:.2f} deg, volume {solid.volume:.4f} rad^3")

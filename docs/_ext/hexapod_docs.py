@@ -42,16 +42,6 @@ ROOT = DOCS.parent
 GENERATED = DOCS / "_generated"
 
 
-def _table(header: list[str], rows: list[list[str]], widths: str = "auto") -> list[str]:
-    """A list-table in reStructuredText."""
-    lines = [".. list-table::", "   :header-rows: 1", f"   :widths: {widths}", ""]
-    for row in [header, *rows]:
-        first, *rest = row
-        lines.append(f"   * - {first}")
-        lines.extend(f"     - {cell}" for cell in rest)
-    return [*lines, ""]
-
-
 def _literal(text: str, language: str = "text") -> list[str]:
     body = [f"   {line}" if line else "" for line in text.rstrip("\n").splitlines()]
     return [f".. code-block:: {language}", "", *body, ""]
@@ -94,23 +84,30 @@ class CliDirective(_Generated):
 
 
 class InterfacesDirective(_Generated):
-    """Every topic, service and action of the node."""
+    """Every topic, service and action of the node, one definition each."""
 
     def lines(self) -> list[str]:
         from hexapod_workspace.logs.interfaces import INTERFACES
 
-        rows = []
+        out: list[str] = []
         for row in INTERFACES:
-            where = f" (added by :mod:`{row.extension}`)" if row.extension else ""
-            type_text = f"``{row.type}``"
+            name = row.key if row.key.startswith("/") else f"~/{row.key}"
+            type_name = row.type
             if row.kind == "action" and "/srv/" in row.type:
-                type_text = f"``{row.type.replace('/srv/', '/action/')}``"
-            rows.append([f"``{row.name}``", row.kind, type_text, row.qos_text, row.summary + where])
-        return _table(["name", "kind", "type", "QoS", "what"], rows, "22 10 25 18 25")
+                type_name = row.type.replace("/srv/", "/action/")
+            where = f" Added by :mod:`{row.extension}`." if row.extension else ""
+            out += [
+                f"``{name}``",
+                f"   {row.kind} · ``{type_name}`` · QoS: {row.qos_text}",
+                "",
+                f"   {row.summary[0].upper()}{row.summary[1:]}.{where}",
+                "",
+            ]
+        return out
 
 
 class ParametersDirective(_Generated):
-    """The node's parameter table (model parameters or the node's own)."""
+    """The node's parameters (the model's or the node's own), one definition each."""
 
     option_spec = {"group": directives.unchanged_required}  # noqa: RUF012
 
@@ -118,29 +115,27 @@ class ParametersDirective(_Generated):
         from hexapod_workspace.ros.parameters import MODEL_DESCRIPTIONS, parameter_specs
 
         group = self.options.get("group", "node")
-        rows = []
+        out: list[str] = []
         for spec in parameter_specs().values():
             if (spec.name in MODEL_DESCRIPTIONS) != (group == "model"):
                 continue
             kind = "any (list of 18 floats or empty)" if spec.dynamic_typing else _kind(spec)
-            bounds = []
+            facts = [kind, f"default ``{_value_text(spec.default)}``"]
             if spec.float_range is not None or spec.int_range is not None:
                 low, high = spec.float_range or spec.int_range  # type: ignore[misc]
-                bounds.append(f"{low:g} .. {high:g}")
+                facts.append(f"range {low:g} .. {high:g}")
             if spec.constraints:
-                bounds.append(spec.constraints)
+                facts.append(spec.constraints)
             if spec.read_only:
-                bounds.append("read-only")
-            rows.append(
-                [
-                    f"``{spec.name}``",
-                    kind,
-                    f"``{_value_text(spec.default)}``",
-                    ", ".join(bounds) or "–",
-                    _escape_bars(spec.description),
-                ]
-            )
-        return _table(["parameter", "type", "default", "range", "meaning (unit)"], rows)
+                facts.append("read-only")
+            out += [
+                f"``{spec.name}``",
+                f"   {', '.join(facts)}",
+                "",
+                f"   {_escape_bars(spec.description)}",
+                "",
+            ]
+        return out
 
 
 def _kind(spec: Any) -> str:
