@@ -87,20 +87,27 @@ def node_graph(ros_client, tmp_path_factory):
             timeout=60.0,
         )
         topics = offered()
-        endpoints: dict[str, list[tuple[str, str]]] = {}
-        for row in interfaces.INTERFACES:
-            if row.kind not in ("publisher", "subscription"):
-                continue
+        rows = [r for r in interfaces.INTERFACES if r.kind in ("publisher", "subscription")]
+
+        def endpoints_of(row: interfaces.Interface) -> list[tuple[str, str]]:
             info = (
                 ros_client.node.get_publishers_info_by_topic
                 if row.kind == "publisher"
                 else ros_client.node.get_subscriptions_info_by_topic
             )(row.name)
-            endpoints[row.name] = [
+            return [
                 (e.qos_profile.reliability.name.lower(), e.qos_profile.durability.name.lower())
                 for e in info
                 if e.node_name == NODE.lstrip("/")
             ]
+
+        # endpoint details arrive with discovery, after the names: wait for every row's
+        ros_client.spin_until(
+            lambda: all(endpoints_of(row) for row in rows),
+            what="the node's publishers and subscriptions",
+            timeout=60.0,
+        )
+        endpoints = {row.name: endpoints_of(row) for row in rows}
         node.stop()
     return topics, endpoints
 
