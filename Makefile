@@ -2,7 +2,8 @@
 #   make demo   CLI demo (no ROS needed): venv with base requirements + the package
 #   make ros    colcon build of hexapod_workspace_msgs and hexapod_workspace (full venv)
 #   make lint   ruff (lint + format check) and mypy (config in pyproject.toml, strict on the core)
-#   make test   full venv + colcon build + ruff + Foxglove's npm libraries (npm ci, pinned by
+#   make docs   the documentation site (Sphinx) -> docs/_build/html, every warning an error
+#   make test   full venv + colcon build + ruff + the docs + Foxglove's npm libraries (npm ci, pinned by
 #               test/foxglove/package-lock.json; needs Node.js >= 18 and npm, checked first)
 #               + the whole pytest suite over real DDS
 #   make clean  remove build/ install/ log/ demo_out/ (keeps .venv)
@@ -22,7 +23,7 @@ export HEXAPOD_REQUIRE_ROS := 1
 export HEXAPOD_REQUIRE_FOXGLOVE := 1
 FOXGLOVE := test/foxglove
 
-.PHONY: demo ros test lint venv-base venv-full node-check foxglove clean
+.PHONY: demo ros test lint docs venv-base venv-full node-check foxglove clean
 
 venv-base:
 	tools/venv.sh base
@@ -55,8 +56,15 @@ $(FOXGLOVE)/node_modules/.package-lock.json: $(FOXGLOVE)/package.json $(FOXGLOVE
 
 foxglove: $(FOXGLOVE)/node_modules/.package-lock.json
 
-test: node-check ros lint foxglove
+# -W --keep-going: every warning fails the build (all of them listed); -n: nitpicky, every
+# cross reference to the package's own objects must resolve. In the ROS environment, because
+# the API and parameter references import the node's modules.
+docs: ros
+	tools/with_ros_env.sh $(VENV)/bin/sphinx-build -W --keep-going -n -q -b html docs docs/_build/html
+	@echo "docs: docs/_build/html/index.html" >&2
+
+test: node-check ros lint foxglove docs
 	tools/with_ros_env.sh python -m pytest test
 
 clean:
-	rm -rf build install log demo_out $(FOXGLOVE)/node_modules
+	rm -rf build install log demo_out docs/_build docs/_generated $(FOXGLOVE)/node_modules

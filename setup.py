@@ -5,6 +5,7 @@ package under colcon (adds the ROS 2 node ``workspace_node``). ROS is never an i
 requirement: rclpy comes from the ROS installation (apt) or from the ``ros`` test requirements.
 """
 
+import re
 import shutil
 from glob import glob
 from pathlib import Path
@@ -14,6 +15,13 @@ from setuptools.command.build_py import build_py
 
 PACKAGE = "hexapod_workspace"
 HERE = Path(__file__).resolve().parent
+# The version's one definition is hexapod_workspace/_version.py (read here without importing
+# the package, whose dependencies may not be installed yet).
+VERSION = re.search(
+    r'^__version__ = "([^"]+)"$',
+    (HERE / PACKAGE / "_version.py").read_text(encoding="utf-8"),
+    re.MULTILINE,
+)[1]
 # Data that lives at the top of the repository (where ROS users expect it) and is also needed by
 # the installed Python package: the example parameters file and the interface definitions (the
 # CLI writes MCAP schemas from them without ROS). Copied into hexapod_workspace/_data at build.
@@ -35,7 +43,7 @@ class BuildPyWithData(build_py):
 
 setup(
     name=PACKAGE,
-    version="0.1.0",
+    version=VERSION,
     description="Orientation workspace of hexapods (Gough-Stewart platforms), CLI and ROS 2 node",
     long_description=(HERE / "README.md").read_text(encoding="utf-8"),
     long_description_content_type="text/markdown",

@@ -7,7 +7,7 @@ Prints absolute times (median of --repeat runs) and ratios:
 and the service-time impact: a workspace computation with and without recording its result.
 
 Usage: python benchmarks/recording.py [--points 1000000] [--repeat 5] [--dir DIR]
-Goal (issue 5): <= 100 ms for 10^6 points, and no slowdown of the service that produced it.
+Goal: <= 100 ms for 10^6 points, and no slowdown of the service that produced it.
 """
 
 from __future__ import annotations

@@ -44,7 +44,7 @@ NODE_EXECUTABLE = (
 NODE = "/hexapod_workspace"
 FLOOR = "/load_floor/check_poses"
 FLOOR_SERVER = floor_server_source(FLOOR, "load_floor")
-#: Goals of issue 10.
+#: The node's goals under load (zero loss, latency, check_poses against the floor).
 GOAL_P99_MS = 10.0
 GOAL_FLOOR_RATIO = 1.3
 GOAL_CORE_RATIO = 3.0

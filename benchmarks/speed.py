@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Every speed figure of issue 12 against its goal, with ratios measured in the same run.
+"""Every speed figure of the compiled kernels against its goal, with same-run ratios.
 
 The baseline is the numpy implementation of commit 0b9ef59 (before the compiled kernels),
 extracted with ``git archive`` into a temporary directory and imported under another name, so

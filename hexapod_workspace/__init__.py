@@ -1,12 +1,14 @@
 """hexapod_workspace: orientation workspace of 6-DOF parallel manipulators (hexapods, GPMs).
 
-The core (model, kinematics, constraints, workspace algorithms) depends on numpy and the
-standard library only; ROS 2 lives in :mod:`hexapod_workspace.ros`.
+The core (model, kinematics, constraints, workspace algorithms) depends on numpy, numba (its
+compiled kernels) and the standard library, with PyYAML only to read a parameters file; ROS 2
+lives in :mod:`hexapod_workspace.ros`.
 
 Units are SI (m, rad). Orientations are Tilt-and-Torsion angles (φ, θ, ψ) with
 ``R = Rz(φ) Ry(θ) Rz(−φ) Rz(ψ)``; see :mod:`hexapod_workspace.core.rotations`.
 """
 
+from ._version import __version__ as __version__
 from .atlas import workspace_atlas
 from .core.atlas import AtlasGrid, AtlasOptions
 from .core.cldata import CLProgram, parse_cldata, read_cldata
@@ -36,8 +38,6 @@ from .errors import (
     ResolutionError,
     UnreachableReferenceError,
 )
-
-__version__ = "0.1.0"
 
 __all__ = [
     "CONSTRAINT_NAMES",

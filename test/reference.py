@@ -17,7 +17,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hexapod_workspace.core.constraints import PAIRS_I, PAIRS_J, _segment_distance_squared
+from hexapod_workspace.core.constraints import PAIRS_I, PAIRS_J
 from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.core.rotations import tt_to_matrix
 
@@ -28,6 +28,7 @@ __all__ = [
     "point_segment_distance",
     "pose_margins_literal",
     "segment_distance_literal",
+    "segment_distance_squared_batch",
 ]
 
 
@@ -62,6 +63,44 @@ def segment_distance_literal(p0: NDArray, p1: NDArray, q0: NDArray, q1: NDArray)
         if 0.0 < s < 1.0 and 0.0 < t < 1.0:
             candidates.append(float(np.linalg.norm(r + s * d1 - t * d2)))
     return min(candidates)
+
+
+def segment_distance_squared_batch(
+    a: NDArray, b: NDArray, c: NDArray, e: NDArray, f: NDArray, rr: NDArray
+) -> NDArray:
+    """Squared segment distances from the dot products of d1 = p1 − p0, d2 = q1 − q0,
+    r = p0 − q0 (``a = d1·d1, b = d1·d2, c = d1·r, e = d2·d2, f = d2·r, rr = r·r``).
+
+    The same method as :func:`segment_distance_literal`, batched: the squared distance
+    ``D(s, t) = rr + s²a + t²e + 2sc − 2tf − 2stb`` is convex on the unit square, so its minimum
+    is the interior critical point (when there is one inside) or the minimum over the four
+    edges, where D is a parabola in one parameter minimised by clamping its vertex. Unlike the
+    package (Ericson's clamp-and-recompute), every candidate is evaluated and the least taken.
+    """
+
+    def clamp(numerator: NDArray, denominator: NDArray) -> NDArray:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            value = np.where(denominator > 0.0, numerator / denominator, 0.0)
+        return np.clip(value, 0.0, 1.0)
+
+    def squared(s: NDArray, t: NDArray) -> NDArray:
+        return rr + s * s * a + t * t * e + 2.0 * s * c - 2.0 * t * f - 2.0 * s * t * b
+
+    zero, one = np.zeros_like(a), np.ones_like(a)
+    candidates = [
+        squared(zero, clamp(f, e)),  # s = 0
+        squared(one, clamp(f + b, e)),  # s = 1
+        squared(clamp(-c, a), zero),  # t = 0
+        squared(clamp(b - c, a), one),  # t = 1
+    ]
+    denom = a * e - b * b
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s_in = (b * f - c * e) / denom
+        t_in = (a * f - b * c) / denom
+    inside = (denom > 1e-12 * a * e) & (s_in > 0.0) & (s_in < 1.0) & (t_in > 0.0) & (t_in < 1.0)
+    interior = squared(np.where(inside, s_in, 0.0), np.where(inside, t_in, 0.0))
+    candidates.append(np.where(inside, interior, np.inf))
+    return np.maximum(np.minimum.reduce(candidates), 0.0)
 
 
 def _rotation(phi: float, theta: float, psi: float) -> NDArray:
@@ -258,7 +297,9 @@ class BatchedMargins:
         c = xi * self.r[:, 0] + yi * self.r[:, 1] + zi * self.r[:, 2]
         f = xj * self.r[:, 0] + yj * self.r[:, 1] + zj * self.r[:, 2]
         distance = np.sqrt(
-            _segment_distance_squared(squared[:, PAIRS_I], b, c, squared[:, PAIRS_J], f, self.rr)
+            segment_distance_squared_batch(
+                squared[:, PAIRS_I], b, c, squared[:, PAIRS_J], f, self.rr
+            )
         )
         pair = distance.argmin(axis=1)
         margins_out[3] = distance[rows, pair] - self.diameter

@@ -307,9 +307,8 @@ def test_cli_bad_input_exits_2_with_one_line(arguments, words, tmp_path):
     assert not (tmp_path / "a.zarr").exists()
 
 
-def test_cli_unreachable_scheduler_exits_2_quickly(tmp_path):
+def test_cli_unreachable_scheduler_exits_2(tmp_path):
     address = f"tcp://127.0.0.1:{_free_port()}"  # nothing listens there
-    started = time.monotonic()
     done = run_cli(
         "atlas",
         *CLI_JOB[1:],
@@ -321,7 +320,6 @@ def test_cli_unreachable_scheduler_exits_2_quickly(tmp_path):
     )
     assert done.returncode == 2
     assert done.stderr.count("\n") == 1 and "cannot reach the Dask scheduler" in done.stderr
-    assert time.monotonic() - started < 40
     assert not (tmp_path / "a.zarr").exists()
 
 

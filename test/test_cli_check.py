@@ -69,7 +69,7 @@ def test_check_table_says_its_columns_are_margins():
 
 
 def test_huge_angles_get_the_verdict_of_the_orientation_they_denote(example):
-    """Item 1: 1e20 deg is 280 deg (1e20 mod 360, exact in floating point); the verdict and the
+    """1e20 deg is 280 deg (1e20 mod 360, exact in floating point); the verdict and the
     margins are those of 280 deg, while the output echoes what the user typed."""
     assert math.fmod(1e20, 360.0) == 280.0
     code, out, _ = run_main(
@@ -117,13 +117,13 @@ def test_disabled_interference_is_null_in_json(tmp_path, example):
         (["--config", "/nonexistent.yaml", "check", "--pose", "0", "0", "0"], "cannot read"),
         (["check", "--poses-file", "/nonexistent.csv"], "cannot read poses file"),
         (["frobnicate"], "invalid choice"),
-        # Item 4: negative numbers in any notation are values, not options.
+        # Negative numbers in any notation are values, not options.
         (["check", "--pose", "0", "0", "-inf"], "--pose: expected finite numbers"),
         (
             ["check", "--pose", "0", "0", "0", "--position", "0", "0", "-1e300"],
             "--position: expected a distance from the base origin of at most 1e+06 m",
         ),
-        # Item 9: --record writes MCAP only, never over a file that is not a log.
+        # --record writes MCAP only, never over a file that is not a log.
         (["check", "--pose", "0", "0", "0", "--record", "poses.csv"], "ending in .mcap"),
         (["check", "--pose", "0", "0", "0", "--record", "/nope/x.mcap"], "folder /nope does not"),
     ],
@@ -146,7 +146,7 @@ def test_negative_numbers_in_exponent_form_are_values():
 
 
 def test_huge_positions_are_refused_never_answered_with_nan(example):
-    """Item 2: a margin is a finite number, or the request is refused with a reason."""
+    """A margin is a finite number, or the request is refused with a reason."""
     from hexapod_workspace.errors import InputError
 
     for position in ([1e300, 0, 0], [0, -1e200, 1e200], [2e6, 0, 0]):
@@ -278,7 +278,7 @@ def test_invalid_geometry_exit_2(tmp_path, example):
 
 
 def test_misspelt_section_is_named(tmp_path, example):
-    """Item 7: ``limitz:`` is named, not reported as a missing limits parameter."""
+    """``limitz:`` is named, not reported as a missing limits parameter."""
     parameters = example.to_parameters()
     lines = ["hexapod_workspace:", "  ros__parameters:"]
     for group in ("geometry", "limitz", "pose"):

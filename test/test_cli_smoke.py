@@ -39,7 +39,7 @@ def test_bad_input_is_one_line_on_stderr_never_a_traceback(tmp_path):
 
 
 def test_poses_through_a_pipe():
-    """Item 6: /dev/stdin through a pipe, and ``-``, are read once, whole."""
+    """/dev/stdin through a pipe, and ``-``, are read once, whole."""
     for name in ("/dev/stdin", "-"):
         done = run_cli("--json", "check", "--poses-file", name, input="10,20,5\n0,0,0\n")
         assert done.returncode == 0, done.stderr

@@ -84,7 +84,7 @@ def test_projected_text_says_the_table_is_thinned():
 
 @pytest.mark.parametrize("name", ["plot.txt", "plot"])
 def test_plot_name_must_say_the_format_before_any_work(tmp_path, name):
-    """Item 3/9: no result, then a traceback; a refused name costs nothing."""
+    """No result, then a traceback; a refused name costs nothing."""
     code, out, err = run_main("projected", "--plot", str(tmp_path / name))
     assert (code, out) == (2, "")
     assert "--plot: expected a file name ending in .png or .pdf or .svg" in one_error_line(err)
@@ -130,7 +130,7 @@ def test_orientation_json_fields(tmp_path):
 
 
 def test_orientation_text_says_what_the_zero_slice_numbers_are():
-    """Item 12: the psi = 0 slice's tilts come from rays from the slice centre, not from
+    """The psi = 0 slice's tilts come from rays from the slice centre, not from
     theta = 0 as in `projected`; the text says so and gives the centre."""
     code, out, _ = run_main("--position", "0.2", "0.2", "-0.95", "orientation", "--n-rays", "36")
     assert code == 0
@@ -149,7 +149,7 @@ def test_torsion_range_json_is_exact_shape():
 
 
 def test_torsion_range_of_a_huge_azimuth_is_that_of_its_principal_value(example):
-    """Item 1: phi = 1e20 deg denotes 280 deg; 1e20 rad in the API denotes its own value."""
+    """Phi = 1e20 deg denotes 280 deg; 1e20 rad in the API denotes its own value."""
     _, out, _ = run_main("--json", "torsion-range", "--direction", "1e20", "10")
     _, reference, _ = run_main("--json", "torsion-range", "--direction", "280", "10")
     assert json.loads(out)["direction_deg"] == [1e20, 10.0]
@@ -183,7 +183,7 @@ def test_unreachable_reference_exit_1_with_reason():
 @pytest.mark.parametrize(
     ("args", "reason"),
     [
-        # Item 5: the flag's own words and units.
+        # The flag's own words and units.
         (["projected", "--n-phi", "1000000"], "--n-phi: expected 3 to 7200, got 1000000"),
         (["projected", "--n-phi", "2"], "--n-phi: expected 3 to 7200, got 2"),
         (["projected", "--tol-deg", "0"], "--tol-deg: expected 5.73e-11 to 5.73 degrees, got 0"),
@@ -194,7 +194,7 @@ def test_unreachable_reference_exit_1_with_reason():
         (["torsion-range", "--direction", "0", "200"], "--direction: expected THETA in [0, 180]"),
         (["torsion-range", "--direction", "0", "10", "--tol-deg", "-1e-3"], "--tol-deg"),
         (["projected", "--method", "paper"], "invalid choice"),
-        # Item 13: options that would be ignored are refused.
+        # Options that would be ignored are refused.
         (["--position", "0", "0", "-1.3", "demo"], "demo: --position does not apply"),
         (["replay", "x.mcap", "--config", "c.yaml"], "unrecognized arguments: --config"),
         (["--config", "c.yaml", "replay", "x.mcap"], "replay: --config does not apply"),
@@ -283,7 +283,7 @@ def test_demo_writes_table_plots_and_a_log_with_real_times(tmp_path, monkeypatch
     code, out, err = run_main("--json", "replay", str(out_dir / "demo.mcap"))
     assert code == 0, err
     report = json.loads(out)
-    # Item 14: each result at the time it was computed, not one timestamp for all.
+    # Each result at the time it was computed, not one timestamp for all.
     times = [w["time_s"] for w in report["workspaces"]]
     assert len(times) == 6 and times == sorted(times)
     total = sum(sum(row["elapsed_s"].values()) for row in rows)

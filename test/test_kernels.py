@@ -281,8 +281,9 @@ def test_sincos_within_an_ulp_of_libm():
 
 
 def test_warm_up_compiles_everything_and_says_how_long(example):
+    # How long it takes is measured by benchmarks/speed.py (cold start), not asserted here.
     seconds = kernels.warm_up()
-    assert 0.0 < seconds < 600.0
+    assert isinstance(seconds, float) and math.isfinite(seconds) and seconds > 0.0
     assert kernels.cache_is_warm()
 
 
@@ -294,25 +295,44 @@ def test_compile_notice_only_when_compiling():
     assert said == []
 
 
-def _read_only_runner() -> list[str] | None:
-    """Command prefix under which a chmod'ed directory is really read-only (None: none)."""
+def _read_only_runner(probe_dir: Path) -> list[str]:
+    """Command prefix under which a chmod'ed directory is really read-only.
+
+    Root ignores permission bits through CAP_DAC_OVERRIDE. ``setpriv`` (util-linux) drops it
+    (and CAP_DAC_READ_SEARCH, CAP_FOWNER) from the child's bounding set, so root stays root
+    but obeys the bits, which works in containers without user namespaces; ``unshare -U``
+    (an unprivileged user namespace) is the second choice. When neither makes ``probe_dir``
+    read-only, the test fails and says why: it never skips silently.
+    """
     if os.geteuid() != 0:
         return []
-    unshare = shutil.which("unshare")
-    if unshare is None:
-        return None
-    probe = subprocess.run(
-        [unshare, "-U", "--map-user=1000", "--map-group=1000", "true"], check=False
+    candidates = []
+    if setpriv := shutil.which("setpriv"):
+        candidates.append([setpriv, "--bounding-set=-dac_override,-dac_read_search,-fowner", "--"])
+    if unshare := shutil.which("unshare"):
+        candidates.append([unshare, "-U", "--map-user=1000", "--map-group=1000"])
+    probe_dir.mkdir()
+    probe_dir.chmod(0o555)
+    try:
+        for runner in candidates:
+            probe = subprocess.run(
+                [*runner, "sh", "-c", f"! touch {str(probe_dir / 'x')!r} 2>/dev/null"],
+                check=False,
+            )
+            if probe.returncode == 0:
+                return runner
+    finally:
+        probe_dir.chmod(0o755)
+    pytest.fail(
+        "running as root, and neither setpriv (util-linux: drops CAP_DAC_OVERRIDE) nor "
+        "unshare -U (user namespaces) makes a directory read-only here: install util-linux"
     )
-    return [unshare, "-U", "--map-user=1000", "--map-group=1000"] if probe.returncode == 0 else None
 
 
 def test_cache_works_in_a_read_only_install(tmp_path):
     """A read-only copy of the package (as colcon's install space or system site-packages):
     the first run compiles into the user cache and says so in one line; the second loads."""
-    runner = _read_only_runner()
-    if runner is None:
-        pytest.skip("root without user namespaces: cannot make a directory read-only here")
+    runner = _read_only_runner(tmp_path / "probe")
     site = tmp_path / "site"
     shutil.copytree(
         PACKAGE, site / "hexapod_workspace", ignore=shutil.ignore_patterns("__pycache__")

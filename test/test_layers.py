@@ -1,12 +1,11 @@
 """The import boundary is the architecture: every module is parsed, lazy imports included.
 
-Layers, inner to outer (DESIGN.md §5): ``core`` (numpy, numba, the standard library; PyYAML only
-to read a parameters file) -> ``logs`` (adds mcap, rosbags) -> ``atlas`` (adds dask, xarray,
-zarr) -> the front ends ``cli`` (adds matplotlib) and ``ros`` (the only place for rclpy and
-generated message modules). Nothing reaches back inward-to-outward, and no module imports
-itself through a cycle. Imports inside ``if TYPE_CHECKING:`` are annotations, not imports, and
-are left out.
-"""
+Layers, inner to outer (CONTRIBUTING.md, *Package layout*): ``core`` (numpy, numba, the standard
+library; PyYAML only to read a parameters file) -> ``logs`` (adds mcap, rosbags) -> ``atlas``
+(adds dask, xarray, zarr) -> the front ends ``cli`` (adds matplotlib) and ``ros`` (the only
+place for rclpy and generated message modules). Nothing reaches back inward-to-outward, and no
+module imports itself through a cycle. Imports inside ``if TYPE_CHECKING:`` are annotations, not
+imports, and are left out."""
 
 from __future__ import annotations
 

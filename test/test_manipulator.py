@@ -267,7 +267,7 @@ def _write(tmp_path, parameters: dict, extra: str = "") -> object:
     ],
 )
 def test_unknown_names_in_a_file_are_named_at_their_level(tmp_path, example, name, reason):
-    """Item 7: every level of the file is checked; a misspelt section is named."""
+    """Every level of the file is checked; a misspelt section is named."""
     parameters = {**example.to_parameters(), name: 1.0}
     with pytest.raises(ConfigError, match=re.escape(reason)):
         Manipulator.from_params_file(_write(tmp_path, parameters))
@@ -292,7 +292,7 @@ def test_unknown_key_next_to_ros__parameters(tmp_path, example):
 
 @pytest.mark.parametrize("name", ["geometry.base_joints", "limits.leg_length_max", "pose.position"])
 def test_lengths_beyond_a_million_metres_are_refused(example_parameters, name):
-    """Item 2: margins must stay finite numbers; absurd geometry is refused with its name."""
+    """Margins must stay finite numbers; absurd geometry is refused with its name."""
     parameters = dict(example_parameters)
     value = np.array(parameters.get(name, [1.0]), dtype=float)
     parameters[name] = (value * 1e300).tolist()
@@ -301,13 +301,13 @@ def test_lengths_beyond_a_million_metres_are_refused(example_parameters, name):
 
 
 def test_example_from_any_working_directory(tmp_path, monkeypatch, example):
-    """Item 20: the README's API snippet uses the packaged example, not a relative path."""
+    """The README's API snippet uses the packaged example, not a relative path."""
     monkeypatch.chdir(tmp_path)
     assert Manipulator.example() == example
 
 
 def test_a_clone_named_like_the_package_does_not_shadow_it(tmp_path):
-    """Item 20: Python started in the folder above a clone named hexapod_workspace imports the
+    """Python started in the folder above a clone named hexapod_workspace imports the
     package (editable install in compat mode), not the clone as an empty namespace package."""
     import subprocess
     import sys

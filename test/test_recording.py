@@ -445,7 +445,7 @@ def test_corrupt_chunk_is_skipped_and_reported(tmp_path: Path) -> None:
     contents = logs.read_log(path)
     assert [m.message.request_id for m in contents.messages] == ["request-0", "request-2"]
     assert any("corrupt" in p for p in contents.problems)
-    # Item 15: finished (it has its footer), but damaged, and replay says so with exit 1.
+    # Finished (it has its footer), but damaged, and replay says so with exit 1.
     assert contents.finished and contents.damaged
     out, err = io.StringIO(), io.StringIO()
     assert run_replay(path, stdout=out, stderr=err) == 1
@@ -478,7 +478,7 @@ def test_not_a_log(tmp_path: Path) -> None:
 
 
 def test_every_channel_decodes_as_rosbags_documents_it(finished_log) -> None:
-    """Item 18: AnyReader with the default store plus the log's definitions, then
+    """AnyReader with the default store plus the log's definitions, then
     ``reader.deserialize(raw, connection.msgtype)``: every channel, services included."""
     path, written = finished_log
     decoded = [(t, m, plain(msg)) for t, m, msg in read_with_rosbags_documented(path)]
@@ -487,7 +487,7 @@ def test_every_channel_decodes_as_rosbags_documents_it(finished_log) -> None:
 
 
 def test_every_channel_opens_in_foxglove(finished_log, tmp_path) -> None:
-    """Item 19: Foxglove's own libraries open every channel (no empty schema but
+    """Foxglove's own libraries open every channel (no empty schema but
     std_msgs/Empty) and decode every message to what was written."""
     path, written = finished_log
     opened = read_with_foxglove(path, tmp_path)

@@ -217,7 +217,7 @@ def test_truncated_logs(tmp_path: Path, check_result) -> None:
     half = tmp_path / "half.mcap"
     half.write_bytes(data[: len(data) // 2])
     code, out, err = replay(half, as_json=True)
-    # Item 15: a damaged log is reported as damaged, exit 1, after everything intact.
+    # A damaged log is reported as damaged, exit 1, after everything intact.
     assert code == 1 and err.startswith("note: half.mcap: unreadable from about byte")
     assert err.splitlines()[-1].endswith(
         "is damaged; everything intact was read (see the notes above)"
@@ -387,7 +387,7 @@ def test_publish_republishes_recorded_clouds(tmp_path: Path, monkeypatch) -> Non
     reason="rclpy not importable: run under the ROS venv (make test) to exercise replay --publish",
 )
 def test_publish_counts_only_what_went_out(tmp_path: Path, monkeypatch) -> None:
-    """Item 16: messages of a type this ROS environment lacks are named and not counted as
+    """Messages of a type this ROS environment lacks are named and not counted as
     republished (before: "12 not republished", then "republished 18 messages")."""
     import importlib
 
@@ -441,9 +441,9 @@ print(matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules)
 
 
 def test_projected_plot_radial_axis_clears_the_largest_tilt(tmp_path: Path) -> None:
-    """Item 17: the curves never lie on the frame; issue 16 item 18: every ring is labelled,
-    and no label covers a curve (checked on the drawn figure, in display coordinates), also
-    where the curves hug a ring (on the axis: 38-39.5° against the 40° ring)."""
+    """The curves never lie on the frame; every ring is labelled, and no label covers a curve
+    (checked on the drawn figure, in display coordinates), also where the curves hug a ring (on
+    the axis: 38-39.5° against the 40° ring)."""
     from hexapod_workspace import Manipulator, projected_workspace
     from hexapod_workspace.cli import plotting
 

@@ -166,7 +166,7 @@ def test_zero_quaternion_is_refused():
 
 # ---------------------------------------------------------------------------- huge angles
 def test_any_finite_angle_denotes_its_principal_value(rng):
-    """Item 1: a huge but finite angle is the orientation of its principal value. numpy's sin
+    """A huge but finite angle is the orientation of its principal value. numpy's sin
     and cos reduce the argument exactly, so the reference is atan2(sin a, cos a)."""
     huge = np.array([1e20, -3.7e15, 1e300, 2.0**60, -1e200])
     for a in huge:

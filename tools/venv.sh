@@ -3,7 +3,7 @@
 #
 #   tools/venv.sh base   runtime requirements + the package (editable): enough for the CLI, demo
 #   tools/venv.sh full   base + dev tools (pytest, ruff) + ROS 2 Jazzy wheels and build tools
-#                        + the atlas extra (Dask, xarray, Zarr)
+#                        + the atlas extra (Dask, xarray, Zarr) + the docs tools (Sphinx)
 #
 # Idempotent: each level records a hash of its requirement files and packaging metadata in the
 # venv and is skipped when nothing changed. Needs only Python >= 3.11 ($PYTHON, default python3)
@@ -16,7 +16,8 @@ level="${1:-full}"
 case "$level" in
   base) reqs=("$ROOT/requirements/base.txt") ;;
   full) reqs=("$ROOT/requirements/base.txt" "$ROOT/requirements/dev.txt"
-              "$ROOT/requirements/ros.txt" "$ROOT/requirements/atlas.txt") ;;
+              "$ROOT/requirements/ros.txt" "$ROOT/requirements/atlas.txt"
+              "$ROOT/requirements/docs.txt") ;;
   *) log "usage: tools/venv.sh [base|full]"; exit 2 ;;
 esac
 

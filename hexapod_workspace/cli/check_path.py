@@ -14,7 +14,6 @@ stderr).
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import time
 from dataclasses import dataclass
@@ -24,6 +23,7 @@ from typing import IO, TYPE_CHECKING, Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
+from ..core.baseline import psi_zero_baseline, reported_baseline
 from ..core.constraints import CONSTRAINT_NAMES
 from ..core.manipulator import Manipulator
 from ..core.paths import (
@@ -40,6 +40,7 @@ from ..core.rotations import degrees_to_radians, matrix_to_quaternion, tt_to_mat
 from ..errors import InputError
 from .commands import PROG
 from .inputs import PLOT_FORMATS, finite, load_manipulator, output_file
+from .reports import write_json
 from .tables import ANGLE_UNITS, LENGTH_UNITS, PLAIN, Columns, parse_table
 
 if TYPE_CHECKING:
@@ -231,20 +232,6 @@ def _segment_json(segments: Any, k: int) -> dict[str, Any]:
         "min_at_s": float(segments.min_at_s[k]),
         "min_relative_margin_bound": _number(segments.min_relative_margin_bound[k]),
     }
-
-
-def psi_zero_baseline(manipulator: Manipulator, path: PathCheck) -> PathCheck:
-    """The same positions and tool directions with ψ = 0 at every waypoint (the paper's
-    recommendation), checked the same way."""
-    angles = path.waypoints.angles.copy()
-    angles[:, 2] = 0.0
-    return check_path(
-        manipulator,
-        path.waypoints.positions,
-        angles=angles,
-        interpolation=path.interpolation,
-        tolerance=path.tolerance,
-    )
 
 
 # ---------------------------------------------------------------------------- text
@@ -459,6 +446,7 @@ def record_path(
     *,
     pairs: bool = True,
     stamp_ns: int | None = None,
+    baseline: PathCheck | None = None,
 ) -> Path:
     """Record a path check as a ``~/check_path`` call (request, then response) in MCAP.
 
@@ -473,6 +461,9 @@ def record_path(
         The interference check is enabled.
     stamp_ns : int, optional
         Log time of the request, ns since the epoch (default now).
+    baseline : PathCheck, optional
+        The ψ = 0 baseline of a path of fixed orientations
+        (:func:`~hexapod_workspace.core.baseline.psi_zero_baseline`).
     """
     from ..logs import SERVICE_QOS, LogWriter, recorded_type, service_topics
     from ..logs import paths as path_fields
@@ -490,7 +481,7 @@ def record_path(
         writer.write_fields(
             response_topic,
             recorded_type(f"{path_fields.CHECK_PATH_TYPE}_Response"),
-            path_fields.check_path_response_fields(result, pairs=pairs),
+            path_fields.check_path_response_fields(result, pairs=pairs, baseline=baseline),
             stamp + 1_000,
             qos=SERVICE_QOS,
         )
@@ -547,11 +538,7 @@ def cmd_check_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> i
             tolerance=tolerance,
         )
         degrees = waypoints.degrees
-    baseline = (
-        result.baseline
-        if isinstance(result, TorsionPlan)
-        else psi_zero_baseline(manipulator, result)
-    )
+    baseline = reported_baseline(manipulator, result)
     document = path_to_json(result, baseline, degrees)
     document["frame"] = "base"
     if record is not None:
@@ -566,12 +553,14 @@ def cmd_check_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> i
             max_dpsi=max_dpsi,
             psi_step=psi_step if waypoints.free_torsion else 0.0,
         )
-        written = record_path(record, result, request, pairs=manipulator.leg_diameter > 0.0)
+        written = record_path(
+            record, result, request, pairs=manipulator.leg_diameter > 0.0, baseline=baseline
+        )
         err.write(f"{PROG}: recorded the path check to {written}\n")
     if plot is not None:
         plot_path(result, baseline, manipulator, plot)
     if options.json:
-        out.write(json.dumps(document, allow_nan=False) + "\n")
+        write_json(document, out)
     else:
         _text(result, document, out)
         if plot is not None:

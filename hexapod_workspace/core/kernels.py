@@ -1,9 +1,10 @@
 """Compiled kernels (numba): the four constraint margins of a pose, and the ray searches.
 
 Everything the workspace computations evaluate per pose runs here, compiled once and cached on
-disk (``cache=True``): the margins of :mod:`hexapod_workspace.core.constraints` (DESIGN.md
-section 2) and the certified march + secant/bisection of :mod:`hexapod_workspace.core.search`
-along whole families of rays, so that a search pays no per-call overhead per step.
+disk (``cache=True``): the margins of :mod:`hexapod_workspace.core.constraints` (one per name
+of :data:`~hexapod_workspace.core.constraints.CONSTRAINT_NAMES`) and the certified march +
+secant/bisection of :mod:`hexapod_workspace.core.search` along whole families of rays, so that
+a search pays no per-call overhead per step.
 
 Batches are evaluated 128 poses at a time as planes of one flat array, stage by stage
 (:func:`_check_block`), so that every loop vectorises; single poses and the rare poses that need

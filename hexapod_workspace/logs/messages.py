@@ -21,6 +21,7 @@ from ..core.orientation import OrientationWorkspace
 from ..core.projected import ProjectedWorkspace
 from ..core.resolution import WorkspaceKind
 from ..core.rotations import approach_vector
+from .interfaces import TOPICS, TYPES
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike, NDArray
@@ -56,36 +57,7 @@ __all__ = [
 #: PointCloud2 fields of a boundary cloud, all float32, in this order (point_step 24 bytes).
 POINT_FIELD_NAMES = ("x", "y", "z", "phi", "theta", "psi")
 _FLOAT32 = 7  # sensor_msgs/PointField.FLOAT32
-
-#: Topic and service names the node uses and the CLI records under (the node is named
-#: ``hexapod_workspace``; ``~/workspace_summary`` resolves to
-#: ``/hexapod_workspace/workspace_summary``).
-TOPICS = {
-    "workspace_request": "/hexapod_workspace/workspace_request",
-    "commanded_pose": "/hexapod_workspace/commanded_pose",
-    "orientation_workspace": "/hexapod_workspace/orientation_workspace",
-    "projected_workspace": "/hexapod_workspace/projected_workspace",
-    "workspace_summary": "/hexapod_workspace/workspace_summary",
-    "reachability": "/hexapod_workspace/reachability",
-    "check_poses": "/hexapod_workspace/check_poses",
-    "compute_workspace": "/hexapod_workspace/compute_workspace",
-    "compute_orientation_workspace": "/hexapod_workspace/compute_orientation_workspace",
-    "compute_projected_workspace": "/hexapod_workspace/compute_projected_workspace",
-}
-#: ROS type of each entry of :data:`TOPICS` (services: the service type).
-TYPES = {
-    "workspace_request": "hexapod_workspace_msgs/msg/WorkspaceRequest",
-    "commanded_pose": "hexapod_workspace_msgs/msg/CommandedPose",
-    "orientation_workspace": "sensor_msgs/msg/PointCloud2",
-    "projected_workspace": "sensor_msgs/msg/PointCloud2",
-    "workspace_summary": "hexapod_workspace_msgs/msg/WorkspaceSummary",
-    "reachability": "hexapod_workspace_msgs/msg/ReachabilityResult",
-    "check_poses": "hexapod_workspace_msgs/srv/CheckPoses",
-    "compute_workspace": "hexapod_workspace_msgs/srv/ComputeWorkspace",
-    "compute_orientation_workspace": "std_srvs/srv/Trigger",
-    "compute_projected_workspace": "std_srvs/srv/Trigger",
-}
-
+_FLOAT64 = 8  # sensor_msgs/PointField.FLOAT64
 
 # --------------------------------------------------------------------------- small pieces
 
@@ -578,10 +550,10 @@ def pointcloud_to_array(cloud: Any) -> NDArray[np.float64]:
         if name not in POINT_FIELD_NAMES:
             continue
         datatype, offset = int(_get(point_field, "datatype")), int(_get(point_field, "offset"))
-        if datatype not in (7, 8):
+        if datatype not in (_FLOAT32, _FLOAT64):
             msg = f"PointCloud2 field {name} has datatype {datatype}, expected FLOAT32/FLOAT64"
             raise ValueError(msg)
-        width = 4 if datatype == 7 else 8
+        width = 4 if datatype == _FLOAT32 else 8
         column = np.ascontiguousarray(rows[:, offset : offset + width]).view(f"{order}f{width}")
         out[:, POINT_FIELD_NAMES.index(name)] = column[:, 0]
     return out

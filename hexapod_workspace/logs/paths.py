@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..core.paths import INTERPOLATIONS, PathCheck, SegmentChecks, TorsionPlan, reported_parts
 from ..core.rotations import matrix_to_quaternion, tt_to_matrix
 from . import messages
+from .interfaces import interface
 
 __all__ = [
     "CHECK_PATH_TOPIC",
@@ -34,8 +35,8 @@ __all__ = [
 ]
 
 #: The node's path service and its type (recorded as ``<service>/request`` and ``/response``).
-CHECK_PATH_TOPIC = "/hexapod_workspace/check_path"
-CHECK_PATH_TYPE = "hexapod_workspace_msgs/srv/CheckPath"
+CHECK_PATH_TOPIC = interface("check_path").name
+CHECK_PATH_TYPE = interface("check_path").type
 #: ``CheckPath`` interpolation constants by core name (SLERP = 0, TILT_TORSION = 1).
 INTERPOLATION_CODES = {name: code for code, name in enumerate(INTERPOLATIONS)}
 
@@ -148,7 +149,11 @@ def segment_check_fields(segments: SegmentChecks, index: int = 0) -> dict[str, A
 
 
 def check_path_response_fields(
-    result: PathCheck | TorsionPlan, *, pairs: bool = True, message: str | None = None
+    result: PathCheck | TorsionPlan,
+    *,
+    pairs: bool = True,
+    message: str | None = None,
+    baseline: PathCheck | None = None,
 ) -> dict[str, Any]:
     """hexapod_workspace_msgs/srv/CheckPath_Response of a path check or a torsion plan.
 
@@ -161,11 +166,15 @@ def check_path_response_fields(
         Whether the interference check is enabled (``limiting_pair`` filled).
     message : str, optional
         Default: a one-line verdict (see :func:`path_verdict`).
+    baseline : PathCheck, optional
+        The ψ = 0 baseline of a path of fixed orientations
+        (:func:`hexapod_workspace.core.baseline.reported_baseline`); a plan's is its own.
     """
     path, plan = reported_parts(result)
     waypoints = path.waypoints
     rotations = tt_to_matrix(waypoints.angles)
-    baseline = plan.baseline if plan is not None else None
+    if plan is not None:
+        baseline = plan.baseline
     fields: dict[str, Any] = {
         "success": True,
         "message": message if message is not None else path_verdict(result),

@@ -109,7 +109,7 @@ class AtlasRecord:
 
 @dataclass
 class LogSummary:
-    """Everything :func:`run_replay` reports about a log."""
+    """Everything :func:`hexapod_workspace.cli.replay.run_replay` reports about a log."""
 
     contents: LogContents
     workspaces: list[WorkspaceRecord] = field(default_factory=list)

@@ -8,11 +8,14 @@ definition (dependencies after lines of 80 ``=`` and ``MSG: pkg/Type``), message
 record. ``ros2 bag play``/``ros2 bag info`` (Jazzy), Foxglove, ``rosbags`` (>= 0.11) and
 ``mcap_ros2`` read it.
 
-Service calls are recorded as two messages of the generated types: the request
-(``<pkg>/srv/<Name>_Request``) on ``<service>/request`` when it arrives and the response
-(``<pkg>/srv/<Name>_Response``) on ``<service>/response`` when it is sent; the n-th response
-answers the n-th request. (Jazzy's ``_service_event`` form nests ``pkg/srv/...`` types inside
-the event, which the ``ros2msg`` schema parsers of mcap_ros2 and Foxglove reject.)
+Service calls are recorded as two messages: the request on ``<service>/request`` when it arrives
+and the response on ``<service>/response`` when it is sent; the n-th response answers the n-th
+request. Their types are the message twins of the service parts (``<pkg>/msg/<Name>Request`` for
+``<pkg>/srv/<Name>_Request``, ``std_msgs/msg/Empty`` for an empty part;
+:func:`~hexapod_workspace.logs.typestore.recorded_type`), because rosbags files a ``srv`` part
+under another name than the one a reader looks up. (Jazzy's ``_service_event`` form nests
+``pkg/srv/...`` types inside the event, which the ``ros2msg`` schema parsers of mcap_ros2 and
+Foxglove reject.)
 
 Durability: messages are collected in MCAP chunks; a chunk is written and the file flushed when
 ``flush_messages`` messages are pending, when a :meth:`LogWriter.write` or
@@ -39,12 +42,14 @@ from __future__ import annotations
 import contextlib
 import time
 from collections.abc import Mapping
+from importlib.metadata import version
 from pathlib import Path
 from typing import Any
 
 from mcap.writer import CompressionType
 from mcap.writer import Writer as McapWriter
 
+from hexapod_workspace._version import __version__
 from hexapod_workspace.errors import RecordingError
 
 from .fields import serialize
@@ -58,6 +63,9 @@ from .typestore import (
     type_hash,
 )
 
+#: The MCAP header's library string: who wrote the file, with versions (as mcap's own writer
+#: and rosbag2_storage_mcap name themselves), so a reader can tell which writer made a log.
+LIBRARY = f"hexapod_workspace {__version__}; mcap {version('mcap')}"
 #: Seconds after which a pending message is written out by the background flusher.
 DEFAULT_FLUSH_INTERVAL = 0.5
 #: Pending messages that trigger a write-out at once.
@@ -156,7 +164,7 @@ class LogWriter:
             self._mcap = McapWriter(
                 self._file, chunk_size=self._chunk_size, compression=CompressionType.NONE
             )
-            self._mcap.start(profile=PROFILE, library="hexapod_workspace (python mcap)")
+            self._mcap.start(profile=PROFILE, library=LIBRARY)
             self._file.flush()
         except OSError as err:
             self._closed = True

@@ -36,14 +36,15 @@ from sensor_msgs.msg import PointCloud2, PointField
 from ..core.atlas import ATLAS_VARIABLES, AtlasGrid, AtlasOptions, dexterous_mask
 from ..errors import HexapodWorkspaceError
 from ..logs import qos_profile_text
+from ..logs.interfaces import relative_name
 from ..logs.messages import header_fields
 from .conversions import to_message
 from .jobs import in_thread
 
 __all__ = ["ACTION_NAME", "CLOUD_FIELDS", "CLOUD_TOPIC", "atlas_cloud", "attach_atlas_action"]
 
-ACTION_NAME = "~/compute_atlas"
-CLOUD_TOPIC = "~/atlas"
+ACTION_NAME = relative_name("compute_atlas")
+CLOUD_TOPIC = relative_name("atlas")
 #: Atlas values carried by the cloud after x, y, z (float32 each, this order).
 CLOUD_FIELDS = tuple(v.name for v in ATLAS_VARIABLES if v.name != "orientation_volume")
 #: The largest grid a goal may ask for (as the CLI's cap without --force).

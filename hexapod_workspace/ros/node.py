@@ -66,7 +66,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from hexapod_workspace._resources import example_config_path
-from hexapod_workspace.core import kernels, planner_kernels
+from hexapod_workspace.core import kernels, params, planner_kernels
 from hexapod_workspace.core.constraints import check
 from hexapod_workspace.core.params import NODE_PARAMETERS, ROS_PARAMETERS, unknown_parameter
 from hexapod_workspace.errors import ConfigError, InputError
@@ -78,6 +78,7 @@ from hexapod_workspace.logs import (
     recorded_type,
     service_topics,
 )
+from hexapod_workspace.logs.interfaces import relative_name
 
 from . import health
 from .commands import CommandStream
@@ -101,7 +102,7 @@ from .workspaces import WorkspaceServer
 
 __all__ = ["EXTENSIONS", "NODE_NAME", "WorkspaceNode", "main"]
 
-NODE_NAME = "hexapod_workspace"
+NODE_NAME = params.NODE_NAME  # one definition, read by the CLI's parameters files too
 
 
 def _attach_atlas(node: WorkspaceNode) -> object:
@@ -128,7 +129,7 @@ SWITCH_INTERVAL = 2e-4
 def _name(key: str) -> str:
     """The node-relative name (``~/...``) of :data:`messages.TOPICS` entry ``key``, so that a
     remapped namespace moves every topic, service and action with the node."""
-    return "~/" + messages.TOPICS[key].rsplit("/", 1)[1]
+    return relative_name(key)
 
 
 def _result_qos(depth: int = 1) -> QoSProfile:

@@ -8,7 +8,7 @@ module keeps only its own wiring:
   ``free_torsion`` the rotation about each pose's z-axis (the tool axis) planned;
 * parameter ``motion.current_pose_topic`` (read-only, default ``""``): a
   ``geometry_msgs/PoseStamped`` topic; when set, the last pose received there is the *current
-  pose* and :meth:`PathServices.motion_fields` checks each commanded pose as a move from it;
+  pose* and :meth:`PathServices.with_motion` checks each commanded pose as a move from it;
   every pose received there is recorded (the log reproduces each motion verdict);
 * conversions of ``geometry_msgs/Pose`` to arrays and back, and of the Pose forms of
   ``CheckPoses`` requests and ``CommandedPose`` messages.
@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.callback_groups import ReentrantCallbackGroup
 
+from ..core.baseline import reported_baseline
 from ..core.manipulator import Manipulator
 from ..core.paths import (
     DEFAULT_PATH_TOLERANCE,
@@ -46,6 +47,7 @@ from ..core.rotations import matrix_to_tt, quaternion_to_matrix, tt_to_matrix, w
 from ..errors import HexapodWorkspaceError, InputError
 from ..logs import REQUEST_QOS, SERVICE_QOS, messages, recorded_type, service_topics
 from ..logs import paths as path_fields
+from ..logs.interfaces import relative_name
 from .conversions import to_message, type_name
 
 __all__ = [
@@ -63,7 +65,7 @@ CURRENT_POSE_PARAMETER = "motion.current_pose_topic"
 
 
 def pose_arrays(poses: Sequence[Any]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Positions (N, 3), m, and quaternions (N, 4) ``(x, y, z, w)`` of ``geometry_msgs/Pose``s.
+    """Positions (N, 3), m, and quaternions (N, 4) ``(x, y, z, w)`` of Pose messages.
 
     Not validated here (NaN stays NaN; the core refuses it with the waypoint's index).
     """
@@ -171,7 +173,11 @@ def check_path_response_fields(manipulator: Manipulator, request: Any) -> dict[s
             )
     except HexapodWorkspaceError as error:
         return path_fields.failed_check_path_response_fields(str(error))
-    return path_fields.check_path_response_fields(result, pairs=manipulator.leg_diameter > 0.0)
+    return path_fields.check_path_response_fields(
+        result,
+        pairs=manipulator.leg_diameter > 0.0,
+        baseline=reported_baseline(manipulator, result),
+    )
 
 
 def _option(value: float, name: str, default: float) -> float:
@@ -225,10 +231,10 @@ class PathServices:
         self.parameter_names = [CURRENT_POSE_PARAMETER]
         group = ReentrantCallbackGroup()
         self.service = node.create_service(
-            CheckPath, "~/check_path", self._on_check_path, callback_group=group
+            CheckPath, relative_name("check_path"), self._on_check_path, callback_group=group
         )
         self._request_topic, self._response_topic = service_topics(
-            node.resolve_service_name("~/check_path")
+            node.resolve_service_name(relative_name("check_path"))
         )
         if recorder is not None:
             recorder.add_channel(

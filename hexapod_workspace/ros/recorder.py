@@ -1,10 +1,10 @@
 """The node's MCAP log: one queue between the callbacks and the disk, one thread that owns it.
 
 Callbacks (any thread) only append ``(topic, message, time)`` to a queue: no lock, no CDR, no
-disk. The recorder's thread is the only one that touches the :class:`~hexapod_workspace.logs.
-LogWriter`: it serialises each message, writes it, opens and finishes logs (requests to do so
-travel through the same queue, so they keep their order with the messages), flushes, and turns
-recording off on the first write failure.
+disk. The recorder's thread is the only one that touches the
+:class:`~hexapod_workspace.logs.LogWriter`: it serialises each message, writes it, opens and
+finishes logs (requests to do so travel through the same queue, so they keep their order with
+the messages), flushes, and turns recording off on the first write failure.
 
 Flush bound (end to end, for the node): the thread writes a message as soon as it gets the
 interpreter and flushes whatever has been pending for :data:`FLUSH_INTERVAL` s, waking at least

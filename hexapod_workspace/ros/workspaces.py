@@ -1,6 +1,6 @@
 """Workspace requests of the node: the ``~/compute_workspace`` action, the Trigger services and
-the request topic, all through one first-in first-out :class:`~hexapod_workspace.ros.jobs.
-JobQueue`.
+the request topic, all through one first-in first-out
+:class:`~hexapod_workspace.ros.jobs.JobQueue`.
 
 A request is checked here (a refusal names the field and the value) and becomes a
 :class:`~hexapod_workspace.ros.worker.WorkspaceJob` with the node's resolution parameters filled

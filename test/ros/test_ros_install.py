@@ -14,7 +14,7 @@ import pytest
 import yaml
 from ros_support import INSTALL, NODE_EXECUTABLE, require_ros, running_node
 
-from hexapod_workspace.logs import messages
+from hexapod_workspace.logs import interfaces, messages
 
 require_ros()
 
@@ -60,8 +60,9 @@ def test_launch_file_names_installed_files():
 
 
 @pytest.fixture(scope="module")
-def node_topics(ros_client, tmp_path_factory):
-    """Topic and service name -> types offered by a running node (seen from this process)."""
+def node_graph(ros_client, tmp_path_factory):
+    """Topic and service name -> types offered by a running node (seen from this process), and
+    topic name -> the QoS (reliability, durability) of the node's own endpoints on it."""
     with running_node(tmp_path_factory.mktemp("install_node")) as node:
         wanted = messages.TOPICS["orientation_workspace"]
 
@@ -86,8 +87,49 @@ def node_topics(ros_client, tmp_path_factory):
             timeout=60.0,
         )
         topics = offered()
+        rows = [r for r in interfaces.INTERFACES if r.kind in ("publisher", "subscription")]
+
+        def endpoints_of(row: interfaces.Interface) -> list[tuple[str, str]]:
+            info = (
+                ros_client.node.get_publishers_info_by_topic
+                if row.kind == "publisher"
+                else ros_client.node.get_subscriptions_info_by_topic
+            )(row.name)
+            return [
+                (e.qos_profile.reliability.name.lower(), e.qos_profile.durability.name.lower())
+                for e in info
+                if e.node_name == NODE.lstrip("/")
+            ]
+
+        # endpoint details arrive with discovery, after the names: wait for every row's
+        ros_client.spin_until(
+            lambda: all(endpoints_of(row) for row in rows),
+            what="the node's publishers and subscriptions",
+            timeout=60.0,
+        )
+        endpoints = {row.name: endpoints_of(row) for row in rows}
         node.stop()
-    return topics
+    return topics, endpoints
+
+
+@pytest.fixture(scope="module")
+def node_topics(node_graph):
+    return node_graph[0]
+
+
+def test_the_interface_table_is_what_the_node_offers(node_graph):
+    """Every row of logs.interfaces.INTERFACES, with its type and QoS (history depth is not
+    discovered across processes, so only reliability and durability are compared)."""
+    topics, endpoints = node_graph
+    for row in interfaces.INTERFACES:
+        if row.kind == "action":
+            goal = f"{row.name}/_action/send_goal"
+            action_type = row.type.replace("/srv/", "/action/")
+            assert topics.get(goal) == [f"{action_type}_SendGoal"], row.key
+        else:
+            assert topics.get(row.name) == [row.type], row.key
+        if row.kind in ("publisher", "subscription"):
+            assert endpoints[row.name] == [(row.reliability, row.durability)], row.key
 
 
 def test_rviz_layout_shows_the_node_clouds(node_topics):

@@ -92,7 +92,7 @@ def test_check_poses_matches_core(client, model):
 
 
 def test_check_poses_huge_angles_get_the_verdict_of_their_principal_values(client, model):
-    """Item 1 at the node: phi = 1e300 rad is the orientation of its principal value."""
+    """At the node: phi = 1e300 rad is the orientation of its principal value."""
     huge = np.array([[1e300, 0.17, 2.6], [0.3, 0.2, -1e20], [1e20, 0.6, 1e20]])
     principal = np.arctan2(np.sin(huge), np.cos(huge))
     expected = check(model, principal, model.position)
@@ -105,7 +105,7 @@ def test_check_poses_huge_angles_get_the_verdict_of_their_principal_values(clien
 
 
 def test_check_poses_huge_position_is_refused_not_answered(client):
-    """Item 2 at the node: no NaN margins with success=true; a refusal with the reason."""
+    """At the node: no NaN margins with success=true; a refusal with the reason."""
     request = check_request(np.zeros((1, 3)), (1e300, 0.0, 0.0))
     response = client.call(CheckPoses, f"{NODE}/check_poses", request)
     assert not response.success
@@ -293,7 +293,7 @@ def test_parameters_have_descriptors(client):
 
 
 def test_a_parameters_file_check_knows_every_parameter_of_the_node(client):
-    """Item 7: the CLI refuses unknown names in a parameters file, so it must know every name
+    """The CLI refuses unknown names in a parameters file, so it must know every name
     the node declares (core.params.NODE_PARAMETERS + the model's + ROS's own), and no more."""
     from hexapod_workspace.core.manipulator import PARAMETER_DEFAULTS
     from hexapod_workspace.core.params import NODE_PARAMETERS, ROS_PARAMETERS, unknown_parameter

@@ -27,6 +27,7 @@ from hexapod_workspace_msgs.msg import (  # noqa: E402
 from hexapod_workspace_msgs.srv import CheckPath, CheckPoses  # noqa: E402
 
 from hexapod_workspace import check, check_path, plan_torsion  # noqa: E402
+from hexapod_workspace.core.baseline import psi_zero_baseline  # noqa: E402
 from hexapod_workspace.core.rotations import (  # noqa: E402
     approach_vector,
     matrix_to_quaternion,
@@ -72,6 +73,10 @@ def test_check_path_fixed_orientations_matches_core(client, model):
     assert response.success, response.message
     expected = check_path(model, positions, angles=angles)
     assert response.ok == expected.ok and not response.planned_torsion
+    # the psi = 0 baseline, as the CLI reports it (one function: core.baseline)
+    baseline = psi_zero_baseline(model, expected)
+    assert list(response.psi_zero_waypoints_failed) == baseline.failed_waypoints
+    assert list(response.psi_zero_segments_failed) == baseline.failed_segments
     assert [w.reachable for w in response.waypoints] == expected.waypoints.reachable.tolist()
     assert [s.ok for s in response.segments] == expected.segments.ok.tolist()
     for k, segment in enumerate(response.segments):

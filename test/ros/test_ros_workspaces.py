@@ -11,6 +11,7 @@ import itertools
 import math
 import os
 import signal
+import time
 from pathlib import Path
 
 import numpy as np
@@ -354,7 +355,13 @@ def test_cancel_stops_the_computation_and_the_node_keeps_serving(client, workspa
     assert status == GoalStatus.STATUS_CANCELED
     assert not result.success and result.message == "canceled"
     # the worker stopped computing: it waits for the next job (or was replaced)
+    # A computing worker is never asleep (R, or waiting for a CPU on a loaded machine, which is
+    # R too); one that waits for its next job sleeps (S). One sample can catch it between the
+    # two (sending its reply), so it is sampled until it sleeps; the bound only ends a hang.
     if worker in worker_pids(workspace_node.process.pid):
+        deadline = time.monotonic() + 60.0
+        while process_state(worker) != "S" and time.monotonic() < deadline:
+            time.sleep(0.05)
         assert process_state(worker) == "S", "the worker still computes after the cancel"
     response = compute(client, workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO))
     assert response.success, response.message

@@ -19,9 +19,6 @@ from hexapod_workspace.ros.worker import (
     WorkspaceWorker,
 )
 
-#: What the node promises for a cancel (issue 10): the computation stops within this, s.
-CANCEL_BOUND = 0.5
-
 
 @pytest.fixture(scope="module")
 def worker():
@@ -60,11 +57,14 @@ def test_result_and_progress_match_the_core(worker):
 
 
 @pytest.mark.parametrize("grace", ["cooperative", "terminate"])
-def test_cancel_stops_the_computation_within_the_bound(worker, grace):
-    """Cooperative: the job stops at its next progress report. Terminate: a job that does not
-    stop within the grace (here 0 s) is ended with its process, which is then replaced."""
-    if grace == "terminate":
-        worker = WorkspaceWorker(cancel_grace=0.0)
+def test_cancel_stops_the_computation(grace):
+    """Cooperative: the job stops at its next progress report and its process lives on (the
+    grace is long enough that only the job itself can have stopped). Terminate: a job that does
+    not stop within the grace (here 0 s) is ended with its process, which is then replaced.
+    How soon a cancel takes effect is measured by benchmarks/cancel.py, not asserted here."""
+    worker = WorkspaceWorker(cancel_grace=0.0 if grace == "terminate" else 300.0)
+    worker.start()
+    process = worker._process  # the process before the cancel (private: no public handle)
     long_job = job(n_rays=720, psi_step=0.001, tolerance=1e-9)
     canceled = threading.Event()
     outcome: list = []
@@ -75,23 +75,22 @@ def test_cancel_stops_the_computation_within_the_bound(worker, grace):
             worker.compute(long_job, progress=lambda _: started.set(), canceled=canceled)
             outcome.append("finished")
         except CanceledError:
-            outcome.append(time.monotonic())
+            outcome.append("canceled")
 
     thread = threading.Thread(target=run)
     thread.start()
-    assert started.wait(60), "the job never reported progress"
-    time.sleep(0.2)
-    canceled_at = time.monotonic()
-    canceled.set()
-    thread.join(30)
-    assert outcome and outcome[0] != "finished", "the job ended before the cancel"
-    elapsed = outcome[0] - canceled_at
-    grace_s = worker.cancel_grace
-    print(f"{grace}: stopped {elapsed * 1e3:.0f} ms after the cancel (grace {grace_s} s)")
     try:
-        assert elapsed <= CANCEL_BOUND
+        assert started.wait(60), "the job never reported progress"
+        time.sleep(0.2)
+        canceled.set()
+        thread.join(120)  # a hang detector only: the job alone takes far longer
+        assert outcome == ["canceled"], outcome
+        if grace == "cooperative":
+            assert worker._process is process and process.is_alive()
+        else:
+            assert worker._process is None and not process.is_alive()
         # and the worker serves the next job (a terminated process is replaced)
         assert worker.compute(job(n_rays=12))[0]["success"]
+        assert worker.alive
     finally:
-        if grace == "terminate":
-            worker.close()
+        worker.close()
