@@ -22,7 +22,7 @@ import pytest
 from reference import batched_margins, pose_margins_literal
 
 from hexapod_workspace import CONSTRAINT_NAMES, InputError, Manipulator, check
-from hexapod_workspace.core import constraints, kernels
+from hexapod_workspace.core import constraints, kernels, margin_kernels
 from hexapod_workspace.core.constraints import (
     check_pose,
     inverse_kinematics,
@@ -274,7 +274,7 @@ def test_sincos_within_an_ulp_of_libm():
     )
     rotations = np.empty((x.size, 9))
     for index in range(0, x.size, 997):
-        kernels._tt_matrix(x[index], 0.0, x[index], rotations[index])
+        margin_kernels._tt_matrix(x[index], 0.0, x[index], rotations[index])
         # R(φ, 0, φ) = Rz(φ): [cos, -sin, 0; sin, cos, 0; 0, 0, 1].
         assert rotations[index, 0] == pytest.approx(math.cos(x[index]), abs=2.3e-16)
         assert rotations[index, 3] == pytest.approx(math.sin(x[index]), abs=2.3e-16)

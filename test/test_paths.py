@@ -16,7 +16,8 @@ from path_support import random_large_moves
 
 from hexapod_workspace import InputError, check, check_path, plan_torsion
 from hexapod_workspace.core.constraints import inverse_kinematics, pose_margins
-from hexapod_workspace.core.paths import _Certifier, _Moves
+from hexapod_workspace.core.path_certificate import _Certifier
+from hexapod_workspace.core.path_interpolation import _Moves
 from hexapod_workspace.core.rotations import (
     approach_vector,
     matrix_to_quaternion,
@@ -370,7 +371,7 @@ def test_plan_refuses_bad_axes(example, axes, match):
 
 
 def test_singular_ends_take_the_other_azimuth_and_keep_their_rotation():
-    from hexapod_workspace.core.paths import _align_singular
+    from hexapod_workspace.core.path_interpolation import _align_singular
 
     angles = np.array([[0.3, np.pi, 0.7], [0.2, 0.0, -0.4], [0.1, 0.5, 0.2]])
     other = np.array([[1.1, 0.5, 0.0], [-2.0, 0.3, 0.1], [3.0, 0.4, 0.0]])

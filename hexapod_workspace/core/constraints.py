@@ -46,6 +46,7 @@ __all__ = [
     "PoseMargins",
     "check",
     "check_pose",
+    "home_pose_violations",
     "inverse_kinematics",
     "pose_margins",
     "relative_margins",
@@ -455,6 +456,13 @@ def check(
         limiting_constraint=ints[4],
         limiting_leg=ints[5],
     )
+
+
+def home_pose_violations(manipulator: Manipulator) -> list[str]:
+    """Names of the constraints violated at the home pose (``manipulator.home_position``,
+    identity orientation); empty when it is reachable. The loaders warn with it."""
+    result = check(manipulator, np.zeros((1, 3)), manipulator.home_position)
+    return result.violated[0]
 
 
 class PoseCheck(NamedTuple):

@@ -17,7 +17,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import ConfigError, GeometryError
-from .constraints import check
 from .params import NODE_PARAMETERS, ROS_PARAMETERS, flatten, load_params_file, unknown_parameter
 from .resolution import MAX_POSITION_NORM
 
@@ -295,7 +294,11 @@ class Manipulator:
             axes_from_home=(base_axes is None, platform_axes is None),
         )
         if warn:
-            problems = manipulator.home_pose_violations()
+            # The check lives next to the constraints (the model does not import the
+            # evaluator); the loaders call it once the model is whole.
+            from .constraints import home_pose_violations
+
+            problems = home_pose_violations(manipulator)
             if problems:
                 warnings.warn(
                     f"the home pose (position {home.tolist()} m, identity orientation) is "
@@ -392,11 +395,6 @@ class Manipulator:
         from dataclasses import replace
 
         return replace(self, position=_frozen(_vector3("position", position)))
-
-    def home_pose_violations(self) -> list[str]:
-        """Names of the constraints violated at the home pose (home position, identity)."""
-        result = check(self, np.zeros((1, 3)), self.home_position)
-        return result.violated[0]
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Manipulator):

@@ -66,7 +66,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from hexapod_workspace.core import kernels, planner_kernels
-from hexapod_workspace.core.constraints import check
+from hexapod_workspace.core.constraints import check, home_pose_violations
 from hexapod_workspace.errors import ConfigError, InputError
 from hexapod_workspace.logs import (
     REQUEST_QOS,
@@ -320,7 +320,7 @@ class WorkspaceNode(Node):
         return super().set_parameters_atomically(parameter_list)
 
     def _warn_home_pose(self) -> None:
-        problems = self.state.manipulator.home_pose_violations()
+        problems = home_pose_violations(self.state.manipulator)
         if problems:
             self.get_logger().warning(
                 f"the home pose (geometry.home_position, identity orientation) is unreachable: "
