@@ -11,6 +11,7 @@ from recording_support import NAN, plain
 from hexapod_workspace import logs
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import constraints
+from hexapod_workspace.core.constraint_table import CONSTRAINT_NAMES
 from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.core.orientation import OrientationSlice, OrientationWorkspace
 from hexapod_workspace.core.projected import ProjectedWorkspace
@@ -79,7 +80,9 @@ def test_pose_check_fields_match_the_result(check_result: constraints.CheckResul
         assert fields == messages.pose_check_fields(check_result, index)
         assert fields["reachable"] == bool(check_result.reachable[index])
         assert fields["violated"] == check_result.violated[index]
-        assert fields["leg_length_margin"] == check_result.margins["leg_length"][index]
+        assert fields["constraint_names"] == list(CONSTRAINT_NAMES)
+        for name, margin in zip(fields["constraint_names"], fields["margins"], strict=True):
+            assert margin == check_result.margins[name][index]
         assert fields["limiting_leg"] == int(check_result.limiting_leg[index])
         assert roundtrip("hexapod_workspace_msgs/msg/PoseCheck", fields) == plain(fields)
 
@@ -118,9 +121,10 @@ def test_reachability_result_success_and_invalid(check_result: constraints.Check
         message="NaN in command",
     )
     assert bad["success"] is False and bad["message"] == "NaN in command"
-    assert math.isnan(bad["check"]["leg_length_margin"])
+    assert bad["check"]["constraint_names"] == list(CONSTRAINT_NAMES)
+    assert all(math.isnan(margin) for margin in bad["check"]["margins"])
     decoded = roundtrip("hexapod_workspace_msgs/msg/ReachabilityResult", bad)
-    assert decoded["check"]["base_joint_margin"] == NAN
+    assert decoded["check"]["margins"] == [NAN] * len(CONSTRAINT_NAMES)
     assert decoded == plain(bad)
 
 

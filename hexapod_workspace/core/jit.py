@@ -64,6 +64,67 @@ import numba.core.event  # noqa: E402
 
 _CACHE = CACHE_DIRECTORY is not None
 
+#: The modules whose code ends up in the compiled kernels. numba keys a cached kernel on the
+#: source file of its entry point only, so a changed helper in another module (a margin kernel
+#: compiled into a search kernel) would be loaded stale from the cache; every kernel of the
+#: core is therefore keyed on all of them together (numba's cache locators are internal API).
+KERNEL_SOURCES = tuple(
+    (Path(__file__).resolve().parent / name).resolve()
+    for name in (
+        "jit.py",
+        "constraint_table.py",
+        "model_layout.py",
+        "margin_kernels.py",
+        "search_kernels.py",
+        "planner_kernels.py",
+    )
+)
+
+
+def _kernel_stamp() -> tuple[tuple[float, int], ...]:
+    stamps = []
+    for source in KERNEL_SOURCES:
+        status = source.stat()
+        stamps.append((status.st_mtime, status.st_size))
+    return tuple(stamps)
+
+
+def _kernel_locators() -> list[type]:
+    """numba cache locators that stamp our kernels with every kernel module's stamp."""
+    from numba.core import caching
+
+    class _KernelStamp:
+        def get_source_stamp(self) -> tuple[tuple[float, int], ...]:
+            return _kernel_stamp()
+
+    locators: list[type] = []
+    for base in (
+        caching._UserProvidedCacheLocator,
+        caching._InTreeCacheLocator,
+        caching._UserWideCacheLocator,
+    ):
+
+        def from_function(cls: type, py_func: Any, py_file: str, _base: Any = base) -> Any:
+            if Path(py_file).resolve() not in KERNEL_SOURCES:
+                return None
+            return _base.from_function.__func__(cls, py_func, py_file)
+
+        locators.append(
+            type(
+                f"_Kernel{base.__name__}",
+                (_KernelStamp, base),
+                {"from_function": classmethod(from_function)},
+            )
+        )
+    return locators
+
+
+if _CACHE:
+    from numba.core import caching as _caching
+
+    if not any(c.__name__.startswith("_Kernel") for c in _caching.CacheImpl._locator_classes):
+        _caching.CacheImpl._locator_classes[:0] = _kernel_locators()
+
 # numba ships no type information: the decorators below are typed as returning the function they
 # compile, so that mypy checks the kernels' signatures at every call (the returned Dispatcher is
 # called exactly like the function).

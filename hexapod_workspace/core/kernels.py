@@ -19,7 +19,8 @@ from .jit import CACHE_DIRECTORY, compile_notice
 # isort: split
 import numpy as np
 
-from .margin_kernels import FAST_TRIG_LIMIT, check_angles, check_one, margins_rotations
+from .constraint_table import N_CONSTRAINTS
+from .margin_kernels import FAST_TRIG_LIMIT, ONE_SIZE, check_angles, check_one, margins_rotations
 from .model_layout import (
     ESTIMATE_FLOOR,
     LENGTH_FLOOR,
@@ -40,6 +41,7 @@ __all__ = [
     "KIND_CYLINDRICAL",
     "KIND_TT",
     "MAX_STEP",
+    "ONE_SIZE",
     "SAFETY",
     "SCALE",
     "cache_is_warm",
@@ -86,7 +88,7 @@ def warm_up() -> float:
     model = np.zeros(MODEL_SIZE)
     model[A : A + 18] = np.tile([1.0, 0.0, 0.0], 6)
     model[B : B + 18] = np.tile([0.5, 0.0, 0.0], 6)
-    model[SCALE : SCALE + 4] = 1.0
+    model[SCALE : SCALE + N_CONSTRAINTS] = 1.0
     model[RHO] = 0.5
     model[LENGTH_FLOOR] = model[ESTIMATE_FLOOR] = 1e-3
     model[LMAX : LMAX + 6] = 2.0
@@ -94,8 +96,8 @@ def warm_up() -> float:
     model.setflags(write=False)
     position = np.array([0.0, 0.0, 1.0])
     angles = np.zeros((1, 3))
-    margins = np.empty((4, 1))
-    legs = np.empty((4, 1), dtype=np.int64)
+    margins = np.empty((N_CONSTRAINTS, 1))
+    legs = np.empty((N_CONSTRAINTS, 1), dtype=np.int64)
     pairs = np.empty((1, 2), dtype=np.int64)
     check_angles(
         model,
@@ -104,11 +106,11 @@ def warm_up() -> float:
         0,
         1,
         margins,
-        np.empty((6, 1), dtype=np.int64),
+        np.empty((N_CONSTRAINTS + 2, 1), dtype=np.int64),
         pairs,
         np.empty(1, dtype=np.bool_),
     )
-    check_one(model, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, np.empty(12))
+    check_one(model, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, np.empty(ONE_SIZE))
     margins_rotations(model, np.eye(3)[None], position[None], True, margins, legs, pairs)
     ones = np.ones(1)
     search_rays(

@@ -20,6 +20,14 @@ from .jit import jit as _jit
 import numpy as np
 from numpy.typing import NDArray
 
+from .constraint_table import (
+    BASE_JOINT,
+    LEG_INTERFERENCE,
+    LEG_LENGTH,
+    N_CONSTRAINTS,
+    PLATFORM_JOINT,
+    SINGULARITY,
+)
 from .model_layout import (
     ALPHA,
     ALPHA_EQUAL,
@@ -34,21 +42,27 @@ from .model_layout import (
     ORDER,
     PAIR_I,
     PAIR_J,
+    RHO,
     RPAIR,
     RR,
     SCALE,
+    SINGULARITY_MIN,
+    SINGULARITY_ON,
     A,
     B,
 )
 
-__all__ = ["check_angles", "check_one", "margins_rotations"]
+__all__ = ["ONE_SIZE", "check_angles", "check_one", "margins_rotations"]
 
 # ------------------------------------------------------------------------------ one pose
 # Slots of the per-pose result vector ``out``.
-OUT_LEG = 4  # limiting leg of each margin (4 slots, as float)
-OUT_PAIR = 8  # closest pair (2 slots)
-OUT_SHORTEST = 10  # shortest leg length, m
-OUT_SIZE = 11
+# Slots 0 .. N_CONSTRAINTS − 1: the margins, in constraint-table order.
+OUT_LEG = N_CONSTRAINTS  # limiting leg of each margin (N_CONSTRAINTS slots, as float)
+OUT_PAIR = 2 * N_CONSTRAINTS  # closest pair (2 slots)
+OUT_SHORTEST = OUT_PAIR + 2  # shortest leg length, m
+OUT_SIZE = OUT_SHORTEST + 1
+#: Size of :func:`check_one`'s result: margins, legs, pair (2), limiting constraint and leg.
+ONE_SIZE = 2 * N_CONSTRAINTS + 4
 
 
 @_helper
@@ -146,16 +160,36 @@ def _pose(
         m_a = model[ALPHA] - math.acos(min(max(m_a, -1.0), 1.0))
     if beta_equal:
         m_b = model[BETA] - math.acos(min(max(m_b, -1.0), 1.0))
-    out[0] = m_len
-    out[1] = m_a
-    out[2] = m_b
-    out[OUT_LEG] = leg_len
-    out[OUT_LEG + 1] = leg_a
-    out[OUT_LEG + 2] = leg_b
+    out[LEG_LENGTH] = m_len
+    out[BASE_JOINT] = m_a
+    out[PLATFORM_JOINT] = m_b
+    out[OUT_LEG + LEG_LENGTH] = leg_len
+    out[OUT_LEG + BASE_JOINT] = leg_a
+    out[OUT_LEG + PLATFORM_JOINT] = leg_b
     out[OUT_SHORTEST] = shortest
+    out[OUT_LEG + SINGULARITY] = 0
+    if model[SINGULARITY_ON] != 0.0:
+        rows = np.empty(72)
+        for k in range(6):
+            bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
+            _plucker_row(
+                rows,
+                k,
+                lx[k],
+                ly[k],
+                lz[k],
+                sq[k],
+                r00 * bx + r01 * by + r02 * bz,
+                r10 * bx + r11 * by + r12 * bz,
+                r20 * bx + r21 * by + r22 * bz,
+                model[RHO],
+            )
+        out[SINGULARITY] = _smallest_singular_value(rows) - model[SINGULARITY_MIN]
+    else:
+        out[SINGULARITY] = np.inf
     if not want_pair or model[INTERFERENCE] == 0.0:
-        out[3] = np.inf
-        out[OUT_LEG + 3] = 0
+        out[LEG_INTERFERENCE] = np.inf
+        out[OUT_LEG + LEG_INTERFERENCE] = 0
         out[OUT_PAIR] = 0
         out[OUT_PAIR + 1] = 0
         return
@@ -211,10 +245,124 @@ def _pose(
                 best = distance
                 best_pair = pair
             best_squared = min(squared, best_squared)
-    out[3] = best - model[DIAMETER]
-    out[OUT_LEG + 3] = PAIR_I[best_pair]
+    out[LEG_INTERFERENCE] = best - model[DIAMETER]
+    out[OUT_LEG + LEG_INTERFERENCE] = PAIR_I[best_pair]
     out[OUT_PAIR] = PAIR_I[best_pair]
     out[OUT_PAIR + 1] = PAIR_J[best_pair]
+
+
+# ------------------------------------------------------------------------------ singularity
+@_helper
+def _plucker_row(
+    rows: NDArray[np.float64],
+    k: int,
+    x: float,
+    y: float,
+    z: float,
+    squared: float,
+    rbx: float,
+    rby: float,
+    rbz: float,
+    rho: float,
+) -> None:
+    """Row k of M into ``rows[6k : 6k + 6]``: (n_k, (R·b_k) × n_k / ρ), n_k = L_k / ℓ_k."""
+    inverse = 1.0 / math.sqrt(squared)
+    nx, ny, nz = x * inverse, y * inverse, z * inverse
+    rows[6 * k] = nx
+    rows[6 * k + 1] = ny
+    rows[6 * k + 2] = nz
+    rows[6 * k + 3] = (rby * nz - rbz * ny) / rho
+    rows[6 * k + 4] = (rbz * nx - rbx * nz) / rho
+    rows[6 * k + 5] = (rbx * ny - rby * nx) / rho
+
+
+@_helper
+def _smallest_singular_value(rows: NDArray[np.float64]) -> float:
+    """σ_min of the 6×6 matrix M in ``rows[:36]`` (row-major); ``rows[36:72]`` is scratch.
+
+    The eigenvalues of G = MᵀM by cyclic Jacobi rotations (each annihilates one off-diagonal
+    entry; converges quadratically), until the off-diagonal part is below 1e-32 of ‖G‖_F²;
+    σ_min = √λ_min. Absolute error ≈ ε·‖M‖² / σ_min (1e-14 for σ_min ≥ 0.01): enough for a
+    margin compared with a limit σ_lim > 0. NaN rows (a zero-length leg) give NaN.
+    """
+    g = rows[36:72]
+    for i in range(6):
+        for j in range(i, 6):
+            total = 0.0
+            for k in range(6):
+                total += rows[6 * k + i] * rows[6 * k + j]
+            g[6 * i + j] = total
+            g[6 * j + i] = total
+    for _sweep in range(30):
+        diagonal = 0.0
+        off = 0.0
+        for i in range(6):
+            diagonal += g[7 * i] * g[7 * i]
+            for j in range(i + 1, 6):
+                off += g[6 * i + j] * g[6 * i + j]
+        if not off > 1e-32 * (diagonal + off):  # converged (or NaN)
+            break
+        for p in range(5):
+            for q in range(p + 1, 6):
+                apq = g[6 * p + q]
+                if apq == 0.0:
+                    continue
+                theta = (g[7 * q] - g[7 * p]) / (2.0 * apq)
+                t = 1.0 / (abs(theta) + math.sqrt(theta * theta + 1.0))
+                if theta < 0.0:
+                    t = -t
+                c = 1.0 / math.sqrt(t * t + 1.0)
+                sn = t * c
+                for k in range(6):
+                    gkp = g[6 * k + p]
+                    gkq = g[6 * k + q]
+                    g[6 * k + p] = c * gkp - sn * gkq
+                    g[6 * k + q] = sn * gkp + c * gkq
+                for k in range(6):
+                    gpk = g[6 * p + k]
+                    gqk = g[6 * q + k]
+                    g[6 * p + k] = c * gpk - sn * gqk
+                    g[6 * q + k] = sn * gpk + c * gqk
+    smallest = g[0]
+    for i in range(1, 6):
+        if g[7 * i] < smallest or g[7 * i] != g[7 * i]:
+            smallest = g[7 * i]
+    return math.sqrt(max(smallest, 0.0)) if smallest == smallest else smallest
+
+
+@_helper
+def _block_singularity(
+    model: NDArray[np.float64], work: NDArray[np.float64], count: int, rows: NDArray[np.float64]
+) -> None:
+    """The singularity margin of the poses of a block that take the vectorised path (the
+    others are computed whole by :func:`_pose`) into the _SIGMA row, from the leg and rotation
+    planes (before the outputs overwrite the rotation planes)."""
+    for n in range(count):
+        if work[(_MIN + _FIX) * BLOCK + n] != 0.0:
+            continue
+        for k in range(6):
+            leg = (_LEGS + 7 * k) * BLOCK + n
+            bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
+            rb = [0.0, 0.0, 0.0]
+            for i in range(3):
+                rb[i] = (
+                    work[(_R + 3 * i) * BLOCK + n] * bx
+                    + work[(_R + 3 * i + 1) * BLOCK + n] * by
+                    + work[(_R + 3 * i + 2) * BLOCK + n] * bz
+                )
+            _plucker_row(
+                rows,
+                k,
+                work[leg + _LX * BLOCK],
+                work[leg + _LY * BLOCK],
+                work[leg + _LZ * BLOCK],
+                work[leg + _SQ * BLOCK],
+                rb[0],
+                rb[1],
+                rb[2],
+                model[RHO],
+            )
+        work[_SIGMA * BLOCK + n] = _smallest_singular_value(rows) - model[SINGULARITY_MIN]
 
 
 # ------------------------------------------------------------------------------ sin and cos
@@ -305,7 +453,7 @@ def _limiting_constraint(model: NDArray[np.float64], out: NDArray[np.float64]) -
     """Index of the smallest relative margin (first on ties; NaN wins)."""
     best = out[0] / model[SCALE]
     index = 0
-    for c in range(1, 4):
+    for c in range(1, N_CONSTRAINTS):
         value = out[c] / model[SCALE + c]
         if value < best or (value != value and best == best):
             best = value
@@ -316,8 +464,10 @@ def _limiting_constraint(model: NDArray[np.float64], out: NDArray[np.float64]) -
 @_helper
 def _feasible(out: NDArray[np.float64]) -> bool:
     """Every margin ≥ 0 (NaN counts as violated)."""
-    feasible: bool = out[0] >= 0.0 and out[1] >= 0.0 and out[2] >= 0.0 and out[3] >= 0.0
-    return feasible
+    for c in range(N_CONSTRAINTS):  # noqa: SIM110 - a loop numba compiles, not a generator
+        if not out[c] >= 0.0:
+            return False
+    return True
 
 
 # ------------------------------------------------------------------------------ blocks of poses
@@ -329,7 +479,8 @@ _R = 6  # 9 rows: rotation matrix, row-major
 _PHI, _THETA, _PSI = 15, 16, 17
 _MIN = 18  # 9 rows: running minima, see the offsets below
 _LEGS = 27  # 7 rows per leg, see the offsets below
-_BLOCK_ROWS = _LEGS + 6 * 7
+_SIGMA = _LEGS + 6 * 7  # σ_min − σ_lim of each pose (when the singularity margin is on)
+_BLOCK_ROWS = _SIGMA + 1
 # Rows of the running minima (offsets from _MIN): margins or cosines and their leg or pair.
 _M_LEN, _LEG_LEN, _M_A, _LEG_A, _M_B, _LEG_B, _BEST, _PAIR, _FIX = range(9)
 # Rows of one leg (offsets from _LEGS + 7·k): vector, squared length, 1/ℓ², joint cosines.
@@ -505,6 +656,9 @@ def _check_block(
                 leg_j = _planes(work, _LEGS + 7 * j, 7)
                 _pair_plane(model, leg_i, leg_j, minima, count, pair)
                 pair += 1
+    singular = model[SINGULARITY_ON] != 0.0
+    if singular:
+        _block_singularity(model, work, count, np.empty(72))
     # Per pose: the joint-angle margins (arccos), the rare poses that need care, the outputs.
     alpha_equal = model[ALPHA_EQUAL] != 0.0
     beta_equal = model[BETA_EQUAL] != 0.0
@@ -515,37 +669,39 @@ def _check_block(
             for slot in range(OUT_SHORTEST):
                 work[(slot) * BLOCK + n] = out[slot]
             continue
-        work[(0) * BLOCK + n] = work[(_MIN + _M_LEN) * BLOCK + n]
-        work[OUT_LEG * BLOCK + n] = work[(_MIN + _LEG_LEN) * BLOCK + n]
+        work[LEG_LENGTH * BLOCK + n] = work[(_MIN + _M_LEN) * BLOCK + n]
+        work[(OUT_LEG + LEG_LENGTH) * BLOCK + n] = work[(_MIN + _LEG_LEN) * BLOCK + n]
         if alpha_equal:
-            work[(1) * BLOCK + n] = model[ALPHA] - math.acos(
+            work[BASE_JOINT * BLOCK + n] = model[ALPHA] - math.acos(
                 min(max(work[(_MIN + _M_A) * BLOCK + n], -1.0), 1.0)
             )
-            work[(OUT_LEG + 1) * BLOCK + n] = work[(_MIN + _LEG_A) * BLOCK + n]
+            work[(OUT_LEG + BASE_JOINT) * BLOCK + n] = work[(_MIN + _LEG_A) * BLOCK + n]
         else:
-            work[(1) * BLOCK + n], work[(OUT_LEG + 1) * BLOCK + n] = _per_leg_angle(
+            work[BASE_JOINT * BLOCK + n], work[(OUT_LEG + BASE_JOINT) * BLOCK + n] = _per_leg_angle(
                 model, ALPHA, work, _COS_A, n
             )
         if beta_equal:
-            work[(2) * BLOCK + n] = model[BETA] - math.acos(
+            work[PLATFORM_JOINT * BLOCK + n] = model[BETA] - math.acos(
                 min(max(work[(_MIN + _M_B) * BLOCK + n], -1.0), 1.0)
             )
-            work[(OUT_LEG + 2) * BLOCK + n] = work[(_MIN + _LEG_B) * BLOCK + n]
+            work[(OUT_LEG + PLATFORM_JOINT) * BLOCK + n] = work[(_MIN + _LEG_B) * BLOCK + n]
         else:
-            work[(2) * BLOCK + n], work[(OUT_LEG + 2) * BLOCK + n] = _per_leg_angle(
-                model, BETA, work, _COS_B, n
+            work[PLATFORM_JOINT * BLOCK + n], work[(OUT_LEG + PLATFORM_JOINT) * BLOCK + n] = (
+                _per_leg_angle(model, BETA, work, _COS_B, n)
             )
         if interference:
             pair = int(work[(_MIN + _PAIR) * BLOCK + n])
-            work[(3) * BLOCK + n] = work[(_MIN + _BEST) * BLOCK + n] - model[DIAMETER]
-            work[(OUT_LEG + 3) * BLOCK + n] = PAIR_I[pair]
+            work[LEG_INTERFERENCE * BLOCK + n] = work[(_MIN + _BEST) * BLOCK + n] - model[DIAMETER]
+            work[(OUT_LEG + LEG_INTERFERENCE) * BLOCK + n] = PAIR_I[pair]
             work[OUT_PAIR * BLOCK + n] = PAIR_I[pair]
             work[(OUT_PAIR + 1) * BLOCK + n] = PAIR_J[pair]
         else:
-            work[(3) * BLOCK + n] = np.inf
-            work[(OUT_LEG + 3) * BLOCK + n] = 0.0
+            work[LEG_INTERFERENCE * BLOCK + n] = np.inf
+            work[(OUT_LEG + LEG_INTERFERENCE) * BLOCK + n] = 0.0
             work[OUT_PAIR * BLOCK + n] = 0.0
             work[(OUT_PAIR + 1) * BLOCK + n] = 0.0
+        work[SINGULARITY * BLOCK + n] = work[_SIGMA * BLOCK + n] if singular else np.inf
+        work[(OUT_LEG + SINGULARITY) * BLOCK + n] = 0.0
 
 
 @_helper
@@ -580,9 +736,10 @@ def check_angles(
 ) -> int:
     """Check poses ``angles[start:stop]`` (N, 3) of T&T angles (rad) at ``position`` (3,), m.
 
-    Writes, for each pose n in [start, stop): ``margins[:, n]`` (4, N); ``ints[:4, n]`` (6, N),
-    the 1-based leg with the smallest margin of each constraint, ``ints[4, n]`` the constraint
-    with the smallest relative margin and ``ints[5, n]`` its leg; ``pairs[n]`` (N, 2), the
+    Writes, for each pose n in [start, stop): ``margins[:, n]`` (C, N) with C = N_CONSTRAINTS;
+    ``ints[:C, n]`` (C + 2, N), the 1-based leg with the smallest margin of each constraint,
+    ``ints[C, n]`` the constraint with the smallest relative margin and ``ints[C + 1, n]`` its
+    leg; ``pairs[n]`` (N, 2), the
     1-based closest pair; ``reachable[n]``. Legs and pairs of ``leg_interference`` are 0 when
     the check is disabled. Releases the GIL (threads split large batches).
 
@@ -613,16 +770,17 @@ def check_angles(
         _check_block(model, angles, position, first, count, work, scratch, out, r)
         for m in range(count):
             n = first + m
-            for c in range(4):
+            for c in range(N_CONSTRAINTS):
                 out[c] = work[c * BLOCK + m]
                 margins[c, n] = out[c]
                 ints[c, n] = int(work[(OUT_LEG + c) * BLOCK + m]) + 1
-            ints[3, n] *= enabled
+            ints[LEG_INTERFERENCE, n] *= enabled
+            ints[SINGULARITY, n] = 0  # a property of all legs together: no limiting leg
             pairs[n, 0] = (int(work[OUT_PAIR * BLOCK + m]) + 1) * enabled
             pairs[n, 1] = (int(work[(OUT_PAIR + 1) * BLOCK + m]) + 1) * enabled
             worst = _limiting_constraint(model, out)
-            ints[4, n] = worst
-            ints[5, n] = ints[worst, n]
+            ints[N_CONSTRAINTS, n] = worst
+            ints[N_CONSTRAINTS + 1, n] = ints[worst, n]
             reachable[n] = _feasible(out)
     return -1
 
@@ -640,9 +798,9 @@ def check_one(
 ) -> None:
     """One pose (φ, θ, ψ) rad at (px, py, pz) m, finite; the fast path of constraints.check_pose.
 
-    Writes ``result`` (12,): margins (4), 1-based limiting legs (4; the interference leg 0 when
-    the check is disabled), closest pair (2, 1-based; 0 when disabled), the limiting constraint
-    and its leg.
+    Writes ``result`` (ONE_SIZE,): margins (N_CONSTRAINTS), 1-based limiting legs
+    (N_CONSTRAINTS; the interference leg 0 when the check is disabled), closest pair (2, 1-based;
+    0 when disabled), the limiting constraint and its leg.
     """
     scratch = np.empty((5, 6))
     out = np.empty(OUT_SIZE)
@@ -650,15 +808,17 @@ def check_one(
     _tt_matrix(phi, theta, psi, r)
     _pose(model, r, px, py, pz, scratch, out, True)
     enabled = 1.0 if model[INTERFERENCE] != 0.0 else 0.0
-    for c in range(4):
+    count = N_CONSTRAINTS
+    for c in range(count):
         result[c] = out[c]
-        result[4 + c] = out[OUT_LEG + c] + 1.0
-    result[7] *= enabled
-    result[8] = (out[OUT_PAIR] + 1.0) * enabled
-    result[9] = (out[OUT_PAIR + 1] + 1.0) * enabled
+        result[count + c] = out[OUT_LEG + c] + 1.0
+    result[count + LEG_INTERFERENCE] *= enabled
+    result[count + SINGULARITY] = 0.0
+    result[2 * count] = (out[OUT_PAIR] + 1.0) * enabled
+    result[2 * count + 1] = (out[OUT_PAIR + 1] + 1.0) * enabled
     worst = _limiting_constraint(model, out)
-    result[10] = worst
-    result[11] = result[4 + worst]
+    result[2 * count + 2] = worst
+    result[2 * count + 3] = result[count + worst]
 
 
 @_jit
@@ -673,7 +833,8 @@ def margins_rotations(
 ) -> None:
     """Margins of N poses given as rotation matrices (N, 3, 3) at positions (M, 3), M ∈ {1, N}.
 
-    Writes ``margins`` (4, N), ``legs`` (4, N) and ``pairs`` (N, 2) as :func:`check_angles`.
+    Writes ``margins`` (C, N), ``legs`` (C, N) (C = N_CONSTRAINTS) and ``pairs`` (N, 2) as
+    :func:`check_angles`.
     """
     scratch = np.empty((5, 6))
     out = np.empty(OUT_SIZE)
@@ -687,7 +848,7 @@ def margins_rotations(
         _pose(
             model, r, positions[p, 0], positions[p, 1], positions[p, 2], scratch, out, interference
         )
-        for c in range(4):
+        for c in range(N_CONSTRAINTS):
             margins[c, n] = out[c]
             legs[c, n] = int(out[OUT_LEG + c])
         pairs[n, 0] = int(out[OUT_PAIR])

@@ -12,6 +12,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from .constraint_table import CONSTRAINTS, N_CONSTRAINTS, scales
+
 if TYPE_CHECKING:
     from .manipulator import Manipulator
 
@@ -33,12 +35,19 @@ DIAMETER = 156  # D, m
 INTERFERENCE = 157  # 1.0 when the interference check is on (D > 0)
 ALPHA_EQUAL = 158  # 1.0 when every base joint has the same maximum angle
 BETA_EQUAL = 159  # 1.0 when every platform joint has the same maximum angle
-SCALE = 160  # natural scale of each margin (4): see constraints.relative_margins
-RHO = 164  # max |b_i|, m (Lipschitz constants of the search)
-LENGTH_FLOOR = 165  # min ℓmin_i, m
-ESTIMATE_FLOOR = 166  # max(min ℓmin_i, 1e-3), m (fixed Lipschitz constants of the estimate)
-ORDER = 167  # the 15 pair indices, closest pair at the home pose first (as floats)
-MODEL_SIZE = 182
+SCALE = 160  # natural scale of each margin (N_CONSTRAINTS): see constraint_table.scales
+RHO = SCALE + N_CONSTRAINTS  # max |b_i|, m (Lipschitz constants of the search)
+LENGTH_FLOOR = RHO + 1  # min ℓmin_i, m
+ESTIMATE_FLOOR = RHO + 2  # max(min ℓmin_i, 1e-3), m (fixed Lipschitz constants of the estimate)
+ORDER = RHO + 3  # the 15 pair indices, closest pair at the home pose first (as floats)
+# Rate coefficients of each margin (N_CONSTRAINTS each), from the constraint table:
+# |dm/ds| ≤ speed·V + turn·V/ℓ_f + spin·Ω.
+RATE_SPEED = ORDER + 15
+RATE_TURN = RATE_SPEED + N_CONSTRAINTS
+RATE_SPIN = RATE_TURN + N_CONSTRAINTS
+SINGULARITY_MIN = RATE_SPIN + N_CONSTRAINTS  # σ_lim of the singularity margin
+SINGULARITY_ON = SINGULARITY_MIN + 1  # 1.0 when the singularity margin is evaluated
+MODEL_SIZE = SINGULARITY_ON + 1
 
 #: Leg pairs (i < j) in the order of numpy.triu_indices(6, 1).
 PAIR_I = np.array([i for i in range(6) for j in range(i + 1, 6)], dtype=np.int64)
@@ -46,22 +55,25 @@ PAIR_J = np.array([j for i in range(6) for j in range(i + 1, 6)], dtype=np.int64
 
 
 #: Packed models by ``id`` of their manipulator (see :func:`model_vector`).
-_MODELS: dict[int, NDArray[np.float64]] = {}
+_MODELS: dict[tuple[int, bool], NDArray[np.float64]] = {}
 
 
-def model_vector(manipulator: Manipulator) -> NDArray[np.float64]:
+def model_vector(manipulator: Manipulator, report_singularity: bool = False) -> NDArray[np.float64]:
     """The packed model of a manipulator (cached per manipulator object, for its lifetime).
 
     Parameters
     ----------
     manipulator : Manipulator
+    report_singularity : bool
+        Evaluate the singularity margin even when ``manipulator.singularity_min`` is 0 (a
+        report: σ_min itself, never negative). With σ_lim > 0 it is always evaluated.
 
     Returns
     -------
     ndarray, shape (MODEL_SIZE,)
         Read-only; layout given by the offsets of this module.
     """
-    key = id(manipulator)
+    key = (id(manipulator), bool(report_singularity))
     cached = _MODELS.get(key)
     if cached is not None:
         return cached
@@ -82,12 +94,10 @@ def model_vector(manipulator: Manipulator) -> NDArray[np.float64]:
     alpha, beta = manipulator.base_joint_max_angle, manipulator.platform_joint_max_angle
     model[ALPHA_EQUAL] = 1.0 if np.all(alpha == alpha[0]) else 0.0
     model[BETA_EQUAL] = 1.0 if np.all(beta == beta[0]) else 0.0
-    model[SCALE : SCALE + 4] = [
-        float(np.mean(manipulator.leg_length_max - manipulator.leg_length_min)) / 2.0,
-        float(np.mean(alpha)),
-        float(np.mean(beta)),
-        manipulator.leg_diameter if manipulator.leg_diameter > 0.0 else 1.0,
-    ]
+    model[SCALE : SCALE + N_CONSTRAINTS] = scales(manipulator)
+    model[RATE_SPEED : RATE_SPEED + N_CONSTRAINTS] = [row.speed for row in CONSTRAINTS]
+    model[RATE_TURN : RATE_TURN + N_CONSTRAINTS] = [row.turn for row in CONSTRAINTS]
+    model[RATE_SPIN : RATE_SPIN + N_CONSTRAINTS] = [row.spin for row in CONSTRAINTS]
     model[RHO] = float(np.max(np.linalg.norm(manipulator.platform_joints, axis=1)))
     model[LENGTH_FLOOR] = float(np.min(manipulator.leg_length_min))
     model[ESTIMATE_FLOOR] = max(model[LENGTH_FLOOR], 1e-3)
@@ -99,6 +109,8 @@ def model_vector(manipulator: Manipulator) -> NDArray[np.float64]:
         for i, j in zip(PAIR_I, PAIR_J, strict=True)
     ]
     model[ORDER : ORDER + 15] = np.argsort(home_distance, kind="stable")
+    model[SINGULARITY_MIN] = manipulator.singularity_min
+    model[SINGULARITY_ON] = 1.0 if manipulator.singularity_min > 0.0 or report_singularity else 0.0
     model.setflags(write=False)
     # The manipulator is frozen: nothing is written into it. The entry lives as long as the
     # object (its id is not reused before the finalizer has removed the entry).

@@ -18,18 +18,11 @@ so the maximum over the move is at an end: ``Ω = max over θ ∈ {θ₀, θ₁}
 ``|dB_i/ds| = |Δp + ω × R b_i| ≤ |Δp| + Ω·ρ =: V`` with ρ = max_i |b_i|. The base joints
 A_i are fixed, so each leg vector ``L_i = B_i − A_i`` moves at most at V.
 
-*Margins.* With ``ℓ_f`` a lower bound on every leg length over the interval considered, the
-margins are Lipschitz in s with constants (a minimum of Lipschitz functions keeps the constant;
-the angle between two unit vectors changes at most at the sum of their turning rates):
-
-==================== ====================== ==================================================
-constraint           bound on |dm/ds|       why
-==================== ====================== ==================================================
-``leg_length``       V                      |dℓ_i/ds| ≤ |dL_i/ds| ≤ V
-``base_joint``       V / ℓ_f                |dn_i/ds| ≤ |dL_i/ds| / ℓ_i; jA_i is fixed
-``platform_joint``   Ω + V / ℓ_f            R·jB_i turns at Ω, n_i at ≤ V / ℓ_f
-``leg_interference`` 2V                     each leg segment A_iB_i moves by ≤ V (Hausdorff)
-==================== ====================== ==================================================
+*Margins.* With ``ℓ_f`` a lower bound on every leg length over the interval considered, each
+margin is Lipschitz in s with the rate of its row of
+:mod:`hexapod_workspace.core.constraint_table`, ``speed·V + turn·V/ℓ_f + spin·Ω`` (V for
+``leg_length``, V / ℓ_f for ``base_joint``, Ω + V / ℓ_f for ``platform_joint``, 2V for
+``leg_interference``; the derivations are written there).
 
 *Interval certificate.* On an interval [a, b] of width w = b − a, with margins m(a), m(b) and
 constant L, ``m(s) ≥ max(m(a) − L(s − a), m(b) − L(b − s))`` whose minimum over the interval is
@@ -68,6 +61,7 @@ from typing import TypedDict
 import numpy as np
 from numpy.typing import NDArray
 
+from .constraint_table import LEG_LENGTH, N_CONSTRAINTS, rate_bounds
 from .constraints import (
     PoseMargins,
     pose_margins,
@@ -109,29 +103,27 @@ class _Certifier:
         speed: NDArray[np.float64],
         omega: NDArray[np.float64],
     ) -> NDArray[np.float64]:
-        """Certified lower bounds (4, n) of the margins over intervals of ``width`` (n,) in s,
-        from the margins (4, n) at both ends and the move's V and Ω (n,)."""
+        """Certified lower bounds (C, n) of the margins over intervals of ``width`` (n,) in s,
+        from the margins (C, n) at both ends and the move's V and Ω (n,); the rates are those
+        of the constraint table (:func:`~hexapod_workspace.core.constraint_table.rate_bounds`)."""
         travel = speed * width
-        lipschitz_travel = np.empty_like(start)
+        length_start, length_end = start[LEG_LENGTH], end[LEG_LENGTH]
         with np.errstate(invalid="ignore", over="ignore"):
-            lipschitz_travel[0] = travel
-            lipschitz_travel[3] = 2.0 * travel
             low_length = np.minimum(
-                np.minimum(start[0], end[0]), 0.5 * (start[0] + end[0] - travel)
+                np.minimum(length_start, length_end), 0.5 * (length_start + length_end - travel)
             )
-            floor = 0.5 * (2.0 * self.length_min + start[0] + end[0] - travel)
+            floor = 0.5 * (2.0 * self.length_min + length_start + length_end - travel)
             floor = np.where(low_length >= 0.0, np.maximum(floor, self.length_min), floor)
             turn = np.where(floor > 0.0, travel / np.where(floor > 0.0, floor, 1.0), np.inf)
-            lipschitz_travel[1] = turn
-            lipschitz_travel[2] = omega * width + turn
+            lipschitz_travel = rate_bounds(travel, turn, omega * width)
             low: NDArray[np.float64] = np.minimum(
                 np.minimum(start, end), 0.5 * (start + end - lipschitz_travel)
             )
-        low[0] = low_length
+        low[LEG_LENGTH] = low_length
         return low
 
     def relative(self, margins: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Smallest relative margin per column of ``margins`` (4, n); NaN → −inf."""
+        """Smallest relative margin per column of ``margins`` (C, n); NaN → −inf."""
         if margins.shape[1] == 0:
             return np.zeros(0)
         values = relative_margins(self.manipulator, margins).min(axis=0)
@@ -145,8 +137,8 @@ class _Samples(TypedDict):
 
     s: NDArray[np.float64]  # (n,) parameter along its move
     move: NDArray[np.int64]  # (n,) index of its move
-    margins: NDArray[np.float64]  # (4, n)
-    legs: NDArray[np.int64]  # (4, n) limiting leg per constraint, 0-based
+    margins: NDArray[np.float64]  # (C, n), C constraints
+    legs: NDArray[np.int64]  # (C, n) limiting leg per constraint, 0-based
     pairs: NDArray[np.int64]  # (n, 2) closest leg pair, 0-based
 
 
@@ -176,9 +168,9 @@ def _check_moves(
     end_pose: tuple[NDArray[np.int64], NDArray[np.int64]] | None = None,
     locate_minimum: bool = True,
 ) -> _MoveCheck:
-    """Certified check of K moves given their end margins (4, K), vectorised over moves.
+    """Certified check of K moves given their end margins (C, K), vectorised over moves.
 
-    ``start_pose``/``end_pose`` are optional (legs (4, K), pairs (K, 2)) of the ends, kept in
+    ``start_pose``/``end_pose`` are optional (legs (C, K), pairs (K, 2)) of the ends, kept in
     the sample table so that limiting legs at the ends can be reported. Without
     ``locate_minimum`` (the planner) only the smallest sampled margin is computed, not where it
     is (``min_index`` −1, ``min_s`` NaN): the same values, without sorting the sample table.
@@ -188,10 +180,10 @@ def _check_moves(
         h_tol = np.where(moves.rate > 0.0, tolerance / moves.rate, np.inf)
         h_max = np.where(moves.rate > 0.0, max_sample_angle / moves.rate, np.inf)
     ids = np.arange(count)
-    zeros4 = np.zeros((4, count), dtype=np.int64)
-    zeros2 = np.zeros((count, 2), dtype=np.int64)
-    start_legs, start_pairs = start_pose if start_pose is not None else (zeros4, zeros2)
-    end_legs, end_pairs = end_pose if end_pose is not None else (zeros4, zeros2)
+    no_legs = np.zeros((N_CONSTRAINTS, count), dtype=np.int64)
+    no_pairs = np.zeros((count, 2), dtype=np.int64)
+    start_legs, start_pairs = start_pose if start_pose is not None else (no_legs, no_pairs)
+    end_legs, end_pairs = end_pose if end_pose is not None else (no_legs, no_pairs)
     # Sample table: ends first (rows 0..K-1 start, K..2K-1 end), then interior samples.
     table_s = [np.zeros(count), np.ones(count)]
     table_move = [ids, ids]

@@ -46,6 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError, ResolutionError
 from . import planner_kernels
+from .constraint_table import N_CONSTRAINTS
 from .constraints import CONSTRAINT_NAMES, relative_margins
 from .manipulator import Manipulator
 from .path_certificate import (
@@ -266,7 +267,7 @@ class _Planner:
         flat = self.certifier.margins(
             self.rotations.reshape(-1, 3, 3), np.repeat(positions, size, axis=0)
         )
-        self.margins = flat.margins.reshape(4, count, size)
+        self.margins = flat.margins.reshape(N_CONSTRAINTS, count, size)
         self.relative_flat = relative_margins(manipulator, flat.margins)
         self.feasible = np.all(self.margins >= 0.0, axis=0)  # (N, G)
         self.levels = np.where(

@@ -57,7 +57,7 @@ class WaypointChecks:
 
     @property
     def margin_array(self) -> NDArray[np.float64]:
-        """The margins as one array, shape (4, N), rows in :data:`CONSTRAINT_NAMES` order."""
+        """The margins as one array, shape (C, N), rows in :data:`CONSTRAINT_NAMES` order."""
         return np.stack([self.margins[name] for name in CONSTRAINT_NAMES])
 
     @property
@@ -81,7 +81,7 @@ class SegmentChecks:
         (φ, θ, ψ) of that pose, rad (NaN when ok).
     violation_positions : ndarray, shape (M, 3)
         Its position, base frame, m (NaN when ok).
-    violation_margins : ndarray, shape (4, M)
+    violation_margins : ndarray, shape (C, M)
         Its margins (NaN when ok).
     limiting_constraint : ndarray, shape (M,), int
         At the first violation (most violated, relative units), else at the smallest margin.

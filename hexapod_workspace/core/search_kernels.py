@@ -17,6 +17,7 @@ from .jit import jit as _jit
 import numpy as np
 from numpy.typing import NDArray
 
+from .constraint_table import LEG_LENGTH, N_CONSTRAINTS
 from .margin_kernels import (
     _BLOCK_ROWS,
     BLOCK,
@@ -28,7 +29,7 @@ from .margin_kernels import (
     _pose,
     _tt_matrix,
 )
-from .model_layout import ESTIMATE_FLOOR, LENGTH_FLOOR, RHO
+from .model_layout import ESTIMATE_FLOOR, LENGTH_FLOOR, RATE_SPEED, RATE_SPIN, RATE_TURN, RHO
 
 __all__ = ["KIND_CYLINDRICAL", "KIND_TT", "MAX_STEP", "SAFETY", "search_rays", "torsion_scan"]
 
@@ -65,12 +66,34 @@ def _ray_angles(
 
 
 @_helper
+def _rate(model: NDArray[np.float64], c: int, speed: float, turn: float, spin: float) -> float:
+    """Lipschitz rate of margin ``c``: speed·V + turn·V/ℓ_f + spin·Ω with the coefficients of
+    its row of the constraint table (``speed`` = V, ``turn`` = V/ℓ_f, ``spin`` = Ω given;
+    terms with a zero coefficient are left out, so an infinite V/ℓ_f costs nothing there)."""
+    rate = 0.0
+    coefficient = model[RATE_SPEED + c]
+    if coefficient != 0.0:
+        rate += coefficient * speed
+    coefficient = model[RATE_TURN + c]
+    if coefficient != 0.0:
+        rate += coefficient * turn
+    coefficient = model[RATE_SPIN + c]
+    if coefficient != 0.0:
+        rate += coefficient * spin
+    return rate
+
+
+@_helper
 def _estimate(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
-    """Signed distance estimate min_c m_c / L_c with fixed Lipschitz constants, rad (NaN wins)."""
+    """Signed distance estimate min_c m_c / L_c with fixed Lipschitz constants, rad (NaN wins).
+
+    The constants are the ray rates of the constraint table (V = ρ, Ω = 1) with the fixed leg
+    floor ESTIMATE_FLOOR: a continuous estimate for the secant steps, not a certificate."""
     rho = model[RHO]
-    floor = model[ESTIMATE_FLOOR]
-    best: float = out[0] / rho
-    for value in (out[1] / (rho / floor), out[2] / (1.0 + rho / floor), out[3] / (2.0 * rho)):
+    turn = rho / model[ESTIMATE_FLOOR]
+    best: float = out[0] / _rate(model, 0, rho, turn, 1.0)
+    for c in range(1, N_CONSTRAINTS):
+        value = out[c] / _rate(model, c, rho, turn, 1.0)
         if value < best or value != value:
             best = value
     return best
@@ -91,11 +114,12 @@ def certified_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> floa
     """Length over which no margin can reach zero, from feasible margins (core.search)."""
     rho = model[RHO]
     length_min = model[LENGTH_FLOOR]
-    length_now = length_min + max(out[0], 0.0)
+    length_now = length_min + max(out[LEG_LENGTH], 0.0)
     floor = max(length_min, 0.5 * length_now)
-    step = _fmin(out[0] / rho, out[1] * floor / rho)
-    step = _fmin(step, out[2] / (1.0 + rho / floor))
-    step = _fmin(step, out[3] / (2.0 * rho))
+    turn = rho / floor
+    step = out[0] / _rate(model, 0, rho, turn, 1.0)
+    for c in range(1, N_CONSTRAINTS):
+        step = _fmin(step, out[c] / _rate(model, c, rho, turn, 1.0))
     step = _fmin(step, 0.5 * length_now / rho)
     step = _fmin(step, MAX_STEP)
     if not step > 0.0:  # numpy.fmax(step, 0) (a NaN step becomes 0)
@@ -111,9 +135,9 @@ def recovery_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> float
     rho: float = model[RHO]
     floor: float = 0.5 * out[OUT_SHORTEST]
     recover = 0.0
-    bounds = (rho, rho / floor, 1.0 + rho / floor, 2.0 * rho)
-    for c in range(4):
-        value = -out[c] / bounds[c] if out[c] < 0.0 else 0.0
+    turn = rho / floor
+    for c in range(N_CONSTRAINTS):
+        value = -out[c] / _rate(model, c, rho, turn, 1.0) if out[c] < 0.0 else 0.0
         if value > recover or value != value:
             recover = value
     return min(recover, floor / rho) * SAFETY
@@ -229,7 +253,7 @@ def search_rays(
             _check_block(model, angles, position, block, size, work, scratch, out, r)
             for m in range(size):
                 ray = rays[block + m]
-                for slot in range(4):
+                for slot in range(N_CONSTRAINTS):
                     out[slot] = work[slot * BLOCK + m]
                 ok = _feasible(out)
                 estimate = _estimate(model, out)

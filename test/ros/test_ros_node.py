@@ -31,6 +31,7 @@ from hexapod_workspace import (  # noqa: E402
     check,
     logs,
 )
+from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402
 
 NODE = "/hexapod_workspace"
 #: Small resolutions keep the workspace computations of the tests short.
@@ -185,7 +186,7 @@ def test_commanded_pose_gets_a_reachability_result(client, model):
         assert result.header.frame_id == model.frame_id
         assert result.check.reachable == bool(expected.reachable[k])
         assert list(result.check.violated) == expected.violated[k]
-        assert result.check.leg_length_margin == expected.margins["leg_length"][k]
+        assert margins_by_name(result.check)["leg_length"] == expected.margins["leg_length"][k]
         assert result.check.limiting_leg == expected.limiting_leg[k]
         assert result.orientation.theta == angles[k, 1]
         assert result.message == (
@@ -196,7 +197,7 @@ def test_commanded_pose_gets_a_reachability_result(client, model):
     failed = by_id["cmd-nan"]
     assert not failed.success
     assert "finite" in failed.message
-    assert math.isnan(failed.check.leg_length_margin)
+    assert math.isnan(margins_by_name(failed.check)["leg_length"])
 
 
 # ---------------------------------------------------------------------------- parameters
