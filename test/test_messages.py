@@ -232,3 +232,14 @@ def test_every_topic_type_is_in_the_typestore() -> None:
                 assert logs.message_definition(msgtype + part) is not None, name
         else:
             assert logs.message_definition(msgtype), name
+
+
+def test_pose_check_constants_are_the_constraint_table() -> None:
+    """The string constants of PoseCheck.msg name exactly the constraints of the table."""
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "msg_defs/msg/PoseCheck.msg").read_text()
+    constants = re.findall(r'^string ([A-Z_]+)="([a-z_]+)"', text, flags=re.MULTILINE)
+    assert [value for _, value in constants] == list(CONSTRAINT_NAMES)
+    assert all(name == value.upper() for name, value in constants)

@@ -169,7 +169,7 @@ def _pose(
     out[OUT_SHORTEST] = shortest
     out[OUT_LEG + SINGULARITY] = 0
     if model[SINGULARITY_ON] != 0.0:
-        rows = np.empty(72)
+        rows = np.empty(ROWS_SCRATCH)
         for k in range(6):
             bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
             _plucker_row(
@@ -252,6 +252,10 @@ def _pose(
 
 
 # ------------------------------------------------------------------------------ singularity
+#: Scratch of the singularity margin: M (36), G (36), its tridiagonal form (6 + 6).
+ROWS_SCRATCH = 84
+
+
 @_helper
 def _plucker_row(
     rows: NDArray[np.float64],
@@ -278,55 +282,114 @@ def _plucker_row(
 
 @_helper
 def _smallest_singular_value(rows: NDArray[np.float64]) -> float:
-    """σ_min of the 6×6 matrix M in ``rows[:36]`` (row-major); ``rows[36:72]`` is scratch.
+    """σ_min of the 6×6 matrix M in ``rows[:36]`` (row-major); ``rows[36:84]`` is scratch.
 
-    The eigenvalues of G = MᵀM by cyclic Jacobi rotations (each annihilates one off-diagonal
-    entry; converges quadratically), until the off-diagonal part is below 1e-32 of ‖G‖_F²;
-    σ_min = √λ_min. Absolute error ≈ ε·‖M‖² / σ_min (1e-14 for σ_min ≥ 0.01): enough for a
-    margin compared with a limit σ_lim > 0. NaN rows (a zero-length leg) give NaN.
+    σ_min = √λ_min(G), G = MᵀM, with the eigenvalues of G by Householder reduction to
+    tridiagonal form and the implicit QL algorithm with Wilkinson shifts (eigenvalues only:
+    Press et al., *Numerical Recipes*, 2nd ed., sections 11.2-11.3, ``tred2``/``tqli``; what
+    LAPACK's dsterf does), about 600 flops. Backward stable: λ_min to ε·‖G‖, so σ_min to
+    ≈ ε·‖M‖² / σ_min (1e-14 for σ_min ≥ 0.01), enough for a margin compared with a limit
+    σ_lim > 0; ``test/test_singularity.py`` compares it with numpy's SVD. NaN rows (a
+    zero-length leg) give NaN.
     """
-    g = rows[36:72]
+    a = rows[36:72]
     for i in range(6):
-        for j in range(i, 6):
+        for j in range(i + 1):
             total = 0.0
             for k in range(6):
                 total += rows[6 * k + i] * rows[6 * k + j]
-            g[6 * i + j] = total
-            g[6 * j + i] = total
-    for _sweep in range(30):
-        diagonal = 0.0
-        off = 0.0
-        for i in range(6):
-            diagonal += g[7 * i] * g[7 * i]
-            for j in range(i + 1, 6):
-                off += g[6 * i + j] * g[6 * i + j]
-        if not off > 1e-32 * (diagonal + off):  # converged (or NaN)
-            break
-        for p in range(5):
-            for q in range(p + 1, 6):
-                apq = g[6 * p + q]
-                if apq == 0.0:
-                    continue
-                theta = (g[7 * q] - g[7 * p]) / (2.0 * apq)
-                t = 1.0 / (abs(theta) + math.sqrt(theta * theta + 1.0))
-                if theta < 0.0:
-                    t = -t
-                c = 1.0 / math.sqrt(t * t + 1.0)
-                sn = t * c
-                for k in range(6):
-                    gkp = g[6 * k + p]
-                    gkq = g[6 * k + q]
-                    g[6 * k + p] = c * gkp - sn * gkq
-                    g[6 * k + q] = sn * gkp + c * gkq
-                for k in range(6):
-                    gpk = g[6 * p + k]
-                    gqk = g[6 * q + k]
-                    g[6 * p + k] = c * gpk - sn * gqk
-                    g[6 * q + k] = sn * gpk + c * gqk
-    smallest = g[0]
+            a[6 * i + j] = total
+            a[6 * j + i] = total
+    d = rows[72:78]
+    e = rows[78:84]
+    # Householder reduction of the lower triangle to tridiagonal form (d diagonal, e below).
+    for i in range(5, 0, -1):
+        low = i - 1
+        h = 0.0
+        if low > 0:
+            scale = 0.0
+            for k in range(low + 1):
+                scale += abs(a[6 * i + k])
+            if scale == 0.0:
+                e[i] = a[6 * i + low]
+            else:
+                for k in range(low + 1):
+                    a[6 * i + k] /= scale
+                    h += a[6 * i + k] * a[6 * i + k]
+                f = a[6 * i + low]
+                g = -math.sqrt(h) if f >= 0.0 else math.sqrt(h)
+                e[i] = scale * g
+                h -= f * g
+                a[6 * i + low] = f - g
+                f = 0.0
+                for j in range(low + 1):
+                    g = 0.0
+                    for k in range(j + 1):
+                        g += a[6 * j + k] * a[6 * i + k]
+                    for k in range(j + 1, low + 1):
+                        g += a[6 * k + j] * a[6 * i + k]
+                    e[j] = g / h
+                    f += e[j] * a[6 * i + j]
+                hh = f / (h + h)
+                for j in range(low + 1):
+                    f = a[6 * i + j]
+                    g = e[j] - hh * f
+                    e[j] = g
+                    for k in range(j + 1):
+                        a[6 * j + k] -= f * e[k] + g * a[6 * i + k]
+        else:
+            e[i] = a[6 * i + low]
+    for i in range(6):
+        d[i] = a[7 * i]
+    # Implicit QL with shifts on the tridiagonal matrix.
     for i in range(1, 6):
-        if g[7 * i] < smallest or g[7 * i] != g[7 * i]:
-            smallest = g[7 * i]
+        e[i - 1] = e[i]
+    e[5] = 0.0
+    for low in range(6):
+        for _iteration in range(60):
+            m = low
+            while m < 5:
+                dd = abs(d[m]) + abs(d[m + 1])
+                if abs(e[m]) + dd == dd:
+                    break
+                m += 1
+            if m == low:
+                break
+            g = (d[low + 1] - d[low]) / (2.0 * e[low])
+            r = math.sqrt(g * g + 1.0)
+            g = d[m] - d[low] + e[low] / (g + (r if g >= 0.0 else -r))
+            s = 1.0
+            c = 1.0
+            p = 0.0
+            i = m - 1
+            deflated = False
+            while i >= low:
+                f = s * e[i]
+                b = c * e[i]
+                r = math.sqrt(f * f + g * g)
+                e[i + 1] = r
+                if r == 0.0:
+                    d[i + 1] -= p
+                    e[m] = 0.0
+                    deflated = True
+                    break
+                s = f / r
+                c = g / r
+                g = d[i + 1] - p
+                r = (d[i] - g) * s + 2.0 * c * b
+                p = s * r
+                d[i + 1] = g + p
+                g = c * r - b
+                i -= 1
+            if deflated:
+                continue
+            d[low] -= p
+            e[low] = g
+            e[m] = 0.0
+    smallest = d[0]
+    for i in range(1, 6):
+        if d[i] < smallest or d[i] != d[i]:
+            smallest = d[i]
     return math.sqrt(max(smallest, 0.0)) if smallest == smallest else smallest
 
 
@@ -343,13 +406,21 @@ def _block_singularity(
         for k in range(6):
             leg = (_LEGS + 7 * k) * BLOCK + n
             bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
-            rb = [0.0, 0.0, 0.0]
-            for i in range(3):
-                rb[i] = (
-                    work[(_R + 3 * i) * BLOCK + n] * bx
-                    + work[(_R + 3 * i + 1) * BLOCK + n] * by
-                    + work[(_R + 3 * i + 2) * BLOCK + n] * bz
-                )
+            rbx = (
+                work[_R * BLOCK + n] * bx
+                + work[(_R + 1) * BLOCK + n] * by
+                + work[(_R + 2) * BLOCK + n] * bz
+            )
+            rby = (
+                work[(_R + 3) * BLOCK + n] * bx
+                + work[(_R + 4) * BLOCK + n] * by
+                + work[(_R + 5) * BLOCK + n] * bz
+            )
+            rbz = (
+                work[(_R + 6) * BLOCK + n] * bx
+                + work[(_R + 7) * BLOCK + n] * by
+                + work[(_R + 8) * BLOCK + n] * bz
+            )
             _plucker_row(
                 rows,
                 k,
@@ -357,9 +428,9 @@ def _block_singularity(
                 work[leg + _LY * BLOCK],
                 work[leg + _LZ * BLOCK],
                 work[leg + _SQ * BLOCK],
-                rb[0],
-                rb[1],
-                rb[2],
+                rbx,
+                rby,
+                rbz,
                 model[RHO],
             )
         work[_SIGMA * BLOCK + n] = _smallest_singular_value(rows) - model[SINGULARITY_MIN]
@@ -658,7 +729,7 @@ def _check_block(
                 pair += 1
     singular = model[SINGULARITY_ON] != 0.0
     if singular:
-        _block_singularity(model, work, count, np.empty(72))
+        _block_singularity(model, work, count, np.empty(ROWS_SCRATCH))
     # Per pose: the joint-angle margins (arccos), the rare poses that need care, the outputs.
     alpha_equal = model[ALPHA_EQUAL] != 0.0
     beta_equal = model[BETA_EQUAL] != 0.0

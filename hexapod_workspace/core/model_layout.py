@@ -40,12 +40,13 @@ RHO = SCALE + N_CONSTRAINTS  # max |b_i|, m (Lipschitz constants of the search)
 LENGTH_FLOOR = RHO + 1  # min ℓmin_i, m
 ESTIMATE_FLOOR = RHO + 2  # max(min ℓmin_i, 1e-3), m (fixed Lipschitz constants of the estimate)
 ORDER = RHO + 3  # the 15 pair indices, closest pair at the home pose first (as floats)
-# Rate coefficients of each margin (N_CONSTRAINTS each), from the constraint table:
-# |dm/ds| ≤ speed·V + turn·V/ℓ_f + spin·Ω.
-RATE_SPEED = ORDER + 15
-RATE_TURN = RATE_SPEED + N_CONSTRAINTS
-RATE_SPIN = RATE_TURN + N_CONSTRAINTS
-SINGULARITY_MIN = RATE_SPIN + N_CONSTRAINTS  # σ_lim of the singularity margin
+# Rates of each margin along the rays of the searches (N_CONSTRAINTS each), from the constraint
+# table's |dm/ds| ≤ speed·V + turn·V/ℓ_f + spin·Ω with V = ρ and Ω = 1:
+# rate = RAY_CONSTANT + RAY_TURN / ℓ_f (the second term only where RAY_TURN ≠ 0).
+RAY_CONSTANT = ORDER + 15  # speed·ρ + spin
+RAY_TURN = RAY_CONSTANT + N_CONSTRAINTS  # turn·ρ, m
+ESTIMATE_RATE = RAY_TURN + N_CONSTRAINTS  # the rate with ℓ_f = ESTIMATE_FLOOR
+SINGULARITY_MIN = ESTIMATE_RATE + N_CONSTRAINTS  # σ_lim of the singularity margin
 SINGULARITY_ON = SINGULARITY_MIN + 1  # 1.0 when the singularity margin is evaluated
 MODEL_SIZE = SINGULARITY_ON + 1
 
@@ -95,9 +96,6 @@ def model_vector(manipulator: Manipulator, report_singularity: bool = False) -> 
     model[ALPHA_EQUAL] = 1.0 if np.all(alpha == alpha[0]) else 0.0
     model[BETA_EQUAL] = 1.0 if np.all(beta == beta[0]) else 0.0
     model[SCALE : SCALE + N_CONSTRAINTS] = scales(manipulator)
-    model[RATE_SPEED : RATE_SPEED + N_CONSTRAINTS] = [row.speed for row in CONSTRAINTS]
-    model[RATE_TURN : RATE_TURN + N_CONSTRAINTS] = [row.turn for row in CONSTRAINTS]
-    model[RATE_SPIN : RATE_SPIN + N_CONSTRAINTS] = [row.spin for row in CONSTRAINTS]
     model[RHO] = float(np.max(np.linalg.norm(manipulator.platform_joints, axis=1)))
     model[LENGTH_FLOOR] = float(np.min(manipulator.leg_length_min))
     model[ESTIMATE_FLOOR] = max(model[LENGTH_FLOOR], 1e-3)
@@ -109,6 +107,13 @@ def model_vector(manipulator: Manipulator, report_singularity: bool = False) -> 
         for i, j in zip(PAIR_I, PAIR_J, strict=True)
     ]
     model[ORDER : ORDER + 15] = np.argsort(home_distance, kind="stable")
+    for c, row in enumerate(CONSTRAINTS):
+        rho = model[RHO]
+        model[RAY_CONSTANT + c] = row.speed * rho + row.spin
+        model[RAY_TURN + c] = row.turn * rho
+        model[ESTIMATE_RATE + c] = model[RAY_CONSTANT + c] + (
+            model[RAY_TURN + c] / model[ESTIMATE_FLOOR] if row.turn != 0.0 else 0.0
+        )
     model[SINGULARITY_MIN] = manipulator.singularity_min
     model[SINGULARITY_ON] = 1.0 if manipulator.singularity_min > 0.0 or report_singularity else 0.0
     model.setflags(write=False)

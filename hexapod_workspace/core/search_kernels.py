@@ -29,7 +29,7 @@ from .margin_kernels import (
     _pose,
     _tt_matrix,
 )
-from .model_layout import ESTIMATE_FLOOR, LENGTH_FLOOR, RATE_SPEED, RATE_SPIN, RATE_TURN, RHO
+from .model_layout import ESTIMATE_RATE, LENGTH_FLOOR, RAY_CONSTANT, RAY_TURN, RHO
 
 __all__ = ["KIND_CYLINDRICAL", "KIND_TT", "MAX_STEP", "SAFETY", "search_rays", "torsion_scan"]
 
@@ -66,20 +66,14 @@ def _ray_angles(
 
 
 @_helper
-def _rate(model: NDArray[np.float64], c: int, speed: float, turn: float, spin: float) -> float:
-    """Lipschitz rate of margin ``c``: speed·V + turn·V/ℓ_f + spin·Ω with the coefficients of
-    its row of the constraint table (``speed`` = V, ``turn`` = V/ℓ_f, ``spin`` = Ω given;
-    terms with a zero coefficient are left out, so an infinite V/ℓ_f costs nothing there)."""
-    rate = 0.0
-    coefficient = model[RATE_SPEED + c]
-    if coefficient != 0.0:
-        rate += coefficient * speed
-    coefficient = model[RATE_TURN + c]
-    if coefficient != 0.0:
-        rate += coefficient * turn
-    coefficient = model[RATE_SPIN + c]
-    if coefficient != 0.0:
-        rate += coefficient * spin
+def _rate(model: NDArray[np.float64], c: int, floor: float) -> float:
+    """Lipschitz rate of margin ``c`` along a ray (ω ≤ 1, joints at ≤ ρ) with legs at least
+    ``floor`` long: speed·ρ + turn·ρ/floor + spin, from its row of the constraint table (the
+    turn term left out where its coefficient is 0, so a zero floor costs nothing there)."""
+    rate: float = model[RAY_CONSTANT + c]
+    turn = model[RAY_TURN + c]
+    if turn != 0.0:
+        rate += turn / floor
     return rate
 
 
@@ -87,13 +81,12 @@ def _rate(model: NDArray[np.float64], c: int, speed: float, turn: float, spin: f
 def _estimate(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
     """Signed distance estimate min_c m_c / L_c with fixed Lipschitz constants, rad (NaN wins).
 
-    The constants are the ray rates of the constraint table (V = ρ, Ω = 1) with the fixed leg
-    floor ESTIMATE_FLOOR: a continuous estimate for the secant steps, not a certificate."""
-    rho = model[RHO]
-    turn = rho / model[ESTIMATE_FLOOR]
-    best: float = out[0] / _rate(model, 0, rho, turn, 1.0)
+    The constants are the ray rates of the constraint table with the fixed leg floor
+    ESTIMATE_FLOOR (precomputed in the model): a continuous estimate for the secant steps, not
+    a certificate."""
+    best: float = out[0] / model[ESTIMATE_RATE]
     for c in range(1, N_CONSTRAINTS):
-        value = out[c] / _rate(model, c, rho, turn, 1.0)
+        value = out[c] / model[ESTIMATE_RATE + c]
         if value < best or value != value:
             best = value
     return best
@@ -116,10 +109,9 @@ def certified_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> floa
     length_min = model[LENGTH_FLOOR]
     length_now = length_min + max(out[LEG_LENGTH], 0.0)
     floor = max(length_min, 0.5 * length_now)
-    turn = rho / floor
-    step = out[0] / _rate(model, 0, rho, turn, 1.0)
+    step = out[0] / _rate(model, 0, floor)
     for c in range(1, N_CONSTRAINTS):
-        step = _fmin(step, out[c] / _rate(model, c, rho, turn, 1.0))
+        step = _fmin(step, out[c] / _rate(model, c, floor))
     step = _fmin(step, 0.5 * length_now / rho)
     step = _fmin(step, MAX_STEP)
     if not step > 0.0:  # numpy.fmax(step, 0) (a NaN step becomes 0)
@@ -135,9 +127,8 @@ def recovery_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> float
     rho: float = model[RHO]
     floor: float = 0.5 * out[OUT_SHORTEST]
     recover = 0.0
-    turn = rho / floor
     for c in range(N_CONSTRAINTS):
-        value = -out[c] / _rate(model, c, rho, turn, 1.0) if out[c] < 0.0 else 0.0
+        value = -out[c] / _rate(model, c, floor) if out[c] < 0.0 else 0.0
         if value > recover or value != value:
             recover = value
     return min(recover, floor / rho) * SAFETY
