@@ -535,13 +535,11 @@ def check_pose(
     result = np.empty(kernels.ONE_SIZE)
     kernels.check_one(kernels.model_vector(manipulator), *angles, x, y, z, result)
     numbers = result.tolist()
-    margins = tuple(numbers[:N_CONSTRAINTS])
-    legs = numbers[N_CONSTRAINTS : 2 * N_CONSTRAINTS]
-    p_i, p_j, worst, leg = numbers[2 * N_CONSTRAINTS :]
+    p_i, p_j, worst, leg, reachable = numbers[2 * N_CONSTRAINTS :]
     return PoseCheck(
-        all(value >= 0.0 for value in margins),
-        margins,
-        tuple(int(value) for value in legs),
+        reachable != 0.0,
+        tuple(numbers[:N_CONSTRAINTS]),
+        tuple(map(int, numbers[N_CONSTRAINTS : 2 * N_CONSTRAINTS])),
         (int(p_i), int(p_j)),
         int(worst),
         int(leg),

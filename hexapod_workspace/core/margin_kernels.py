@@ -61,8 +61,9 @@ OUT_LEG = N_CONSTRAINTS  # limiting leg of each margin (N_CONSTRAINTS slots, as 
 OUT_PAIR = 2 * N_CONSTRAINTS  # closest pair (2 slots)
 OUT_SHORTEST = OUT_PAIR + 2  # shortest leg length, m
 OUT_SIZE = OUT_SHORTEST + 1
-#: Size of :func:`check_one`'s result: margins, legs, pair (2), limiting constraint and leg.
-ONE_SIZE = 2 * N_CONSTRAINTS + 4
+#: Size of :func:`check_one`'s result: margins, legs, pair (2), limiting constraint and leg,
+#: reachable (1.0 or 0.0).
+ONE_SIZE = 2 * N_CONSTRAINTS + 5
 
 
 @_helper
@@ -871,7 +872,7 @@ def check_one(
 
     Writes ``result`` (ONE_SIZE,): margins (N_CONSTRAINTS), 1-based limiting legs
     (N_CONSTRAINTS; the interference leg 0 when the check is disabled), closest pair (2, 1-based;
-    0 when disabled), the limiting constraint and its leg.
+    0 when disabled), the limiting constraint and its leg, and 1.0 when reachable (else 0.0).
     """
     scratch = np.empty((5, 6))
     out = np.empty(OUT_SIZE)
@@ -890,6 +891,7 @@ def check_one(
     worst = _limiting_constraint(model, out)
     result[2 * count + 2] = worst
     result[2 * count + 3] = result[count + worst]
+    result[2 * count + 4] = 1.0 if _feasible(out) else 0.0
 
 
 @_jit
