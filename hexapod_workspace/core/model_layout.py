@@ -56,7 +56,9 @@ PAIR_J = np.array([j for i in range(6) for j in range(i + 1, 6)], dtype=np.int64
 
 
 #: Packed models by ``id`` of their manipulator (see :func:`model_vector`).
-_MODELS: dict[tuple[int, bool], NDArray[np.float64]] = {}
+_MODELS: dict[int, NDArray[np.float64]] = {}
+#: The same with the singularity margin evaluated as a report (see :func:`model_vector`).
+_REPORT_MODELS: dict[int, NDArray[np.float64]] = {}
 
 
 def model_vector(manipulator: Manipulator, report_singularity: bool = False) -> NDArray[np.float64]:
@@ -74,8 +76,9 @@ def model_vector(manipulator: Manipulator, report_singularity: bool = False) -> 
     ndarray, shape (MODEL_SIZE,)
         Read-only; layout given by the offsets of this module.
     """
-    key = (id(manipulator), bool(report_singularity))
-    cached = _MODELS.get(key)
+    key = id(manipulator)  # one dictionary per kind: the per-call lookup stays an int's
+    models = _REPORT_MODELS if report_singularity else _MODELS
+    cached = models.get(key)
     if cached is not None:
         return cached
     model = np.zeros(MODEL_SIZE)
@@ -119,9 +122,9 @@ def model_vector(manipulator: Manipulator, report_singularity: bool = False) -> 
     model.setflags(write=False)
     # The manipulator is frozen: nothing is written into it. The entry lives as long as the
     # object (its id is not reused before the finalizer has removed the entry).
-    if key not in _MODELS:
-        _MODELS[key] = model
-        weakref.finalize(manipulator, _MODELS.pop, key, None)
+    if key not in models:
+        models[key] = model
+        weakref.finalize(manipulator, models.pop, key, None)
     return model
 
 
