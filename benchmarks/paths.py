@@ -35,7 +35,8 @@ import numpy as np  # noqa: E402
 from hexapod_workspace import Manipulator, check_path, plan_torsion  # noqa: E402
 from hexapod_workspace._resources import example_config_path  # noqa: E402
 from hexapod_workspace.core.constraints import pose_margins  # noqa: E402
-from hexapod_workspace.core.paths import DEFAULT_PATH_TOLERANCE, _Moves  # noqa: E402
+from hexapod_workspace.core.path_interpolation import _Moves  # noqa: E402
+from hexapod_workspace.core.paths import DEFAULT_PATH_TOLERANCE  # noqa: E402
 from hexapod_workspace.core.rotations import approach_vector, tt_to_matrix  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "test"))

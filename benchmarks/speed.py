@@ -46,11 +46,11 @@ from hexapod_workspace.core.constraints import check_pose  # noqa: E402
 POSITION = np.array([0.0, 0.0, -1.3])
 
 
-def load_baseline(directory: Path):
-    """The package as of BASELINE_COMMIT, imported as ``hexapod_workspace_baseline`` (or None)."""
+def load_baseline(directory: Path, commit: str = BASELINE_COMMIT):
+    """The package as of ``commit``, imported as ``hexapod_workspace_baseline`` (or None)."""
     try:
         archive = subprocess.run(
-            ["git", "-C", str(ROOT), "archive", BASELINE_COMMIT, "hexapod_workspace"],
+            ["git", "-C", str(ROOT), "archive", commit, "hexapod_workspace"],
             capture_output=True,
             check=True,
         ).stdout

@@ -1,6 +1,6 @@
 """The torsion planner's dynamic programmes in numpy: the oracle of the compiled ones.
 
-These are the programmes :class:`hexapod_workspace.core.paths._Planner` ran before they were
+These are the programmes :class:`hexapod_workspace.core.path_planner._Planner` ran before they were
 compiled (:mod:`hexapod_workspace.core.planner_kernels`), kept verbatim: the tests compare the
 kernels with them on seeded random tables, and ``benchmarks/paths.py`` times the planner with
 them in the same run. :func:`numpy_planner` swaps them into ``plan_torsion`` for a block.
@@ -15,7 +15,7 @@ from collections.abc import Iterator
 import numpy as np
 from numpy.typing import NDArray
 
-from hexapod_workspace.core import paths
+from hexapod_workspace.core import path_planner as paths
 from hexapod_workspace.core.planner_kernels import KNOWN, NO, NONE, UNKNOWN
 
 

@@ -120,7 +120,7 @@ def _angle(u: NDArray, v: NDArray) -> float:
 def pose_margins_literal(
     manipulator: Manipulator, angles: ArrayLike, position: ArrayLike
 ) -> dict[str, float]:
-    """The four margins of one pose, straight from the definitions.
+    """The margins of one pose, straight from the definitions.
 
     Parameters
     ----------
@@ -171,7 +171,23 @@ def pose_margins_literal(
         "base_joint": base,
         "platform_joint": platform,
         "leg_interference": interference,
+        "singularity": singularity_literal(manipulator, rotation, legs)
+        if manipulator.singularity_min > 0.0
+        else math.inf,
     }
+
+
+def singularity_literal(manipulator: Manipulator, rotation: NDArray, legs: list[NDArray]) -> float:
+    """σ_min(M) − singularity_min, M rows (n_i, (R b_i) × n_i / ρ), by numpy's SVD."""
+    rho = max(float(np.linalg.norm(b)) for b in manipulator.platform_joints)
+    rows = []
+    for i in range(6):
+        n = legs[i] / np.linalg.norm(legs[i])
+        rows.append(
+            np.concatenate([n, np.cross(rotation @ manipulator.platform_joints[i], n) / rho])
+        )
+    sigma = np.linalg.svd(np.array(rows), compute_uv=False)
+    return float(sigma.min()) - manipulator.singularity_min
 
 
 def paper_projected_workspace(
@@ -328,6 +344,10 @@ class BatchedMargins:
             leg = per_leg.argmin(axis=1)
             margin_out[:] = per_leg[rows, leg]
         leg_out[:] = leg
+
+
+#: Rows of :func:`batched_margins` (the machines it checks have no singularity limit).
+BATCHED_NAMES = ("leg_length", "base_joint", "platform_joint", "leg_interference")
 
 
 def batched_margins(

@@ -11,6 +11,7 @@ from recording_support import NAN, plain
 from hexapod_workspace import logs
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import constraints
+from hexapod_workspace.core.constraint_table import CONSTRAINT_NAMES
 from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.core.orientation import OrientationSlice, OrientationWorkspace
 from hexapod_workspace.core.projected import ProjectedWorkspace
@@ -79,7 +80,9 @@ def test_pose_check_fields_match_the_result(check_result: constraints.CheckResul
         assert fields == messages.pose_check_fields(check_result, index)
         assert fields["reachable"] == bool(check_result.reachable[index])
         assert fields["violated"] == check_result.violated[index]
-        assert fields["leg_length_margin"] == check_result.margins["leg_length"][index]
+        assert fields["constraint_names"] == list(CONSTRAINT_NAMES)
+        for name, margin in zip(fields["constraint_names"], fields["margins"], strict=True):
+            assert margin == check_result.margins[name][index]
         assert fields["limiting_leg"] == int(check_result.limiting_leg[index])
         assert roundtrip("hexapod_workspace_msgs/msg/PoseCheck", fields) == plain(fields)
 
@@ -118,9 +121,10 @@ def test_reachability_result_success_and_invalid(check_result: constraints.Check
         message="NaN in command",
     )
     assert bad["success"] is False and bad["message"] == "NaN in command"
-    assert math.isnan(bad["check"]["leg_length_margin"])
+    assert bad["check"]["constraint_names"] == list(CONSTRAINT_NAMES)
+    assert all(math.isnan(margin) for margin in bad["check"]["margins"])
     decoded = roundtrip("hexapod_workspace_msgs/msg/ReachabilityResult", bad)
-    assert decoded["check"]["base_joint_margin"] == NAN
+    assert decoded["check"]["margins"] == [NAN] * len(CONSTRAINT_NAMES)
     assert decoded == plain(bad)
 
 
@@ -228,3 +232,14 @@ def test_every_topic_type_is_in_the_typestore() -> None:
                 assert logs.message_definition(msgtype + part) is not None, name
         else:
             assert logs.message_definition(msgtype), name
+
+
+def test_pose_check_constants_are_the_constraint_table() -> None:
+    """The string constants of PoseCheck.msg name exactly the constraints of the table."""
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "msg_defs/msg/PoseCheck.msg").read_text()
+    constants = re.findall(r'^string ([A-Z_]+)="([a-z_]+)"', text, flags=re.MULTILINE)
+    assert [value for _, value in constants] == list(CONSTRAINT_NAMES)
+    assert all(name == value.upper() for name, value in constants)

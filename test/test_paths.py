@@ -14,9 +14,10 @@ import numpy as np
 import pytest
 from path_support import random_large_moves
 
-from hexapod_workspace import InputError, check, check_path, plan_torsion
+from hexapod_workspace import InputError, Manipulator, check, check_path, plan_torsion
 from hexapod_workspace.core.constraints import inverse_kinematics, pose_margins
-from hexapod_workspace.core.paths import _Certifier, _Moves
+from hexapod_workspace.core.path_certificate import _Certifier
+from hexapod_workspace.core.path_interpolation import _Moves
 from hexapod_workspace.core.rotations import (
     approach_vector,
     matrix_to_quaternion,
@@ -166,13 +167,25 @@ def test_angular_rate_and_lipschitz_bounds_hold(example, rng, interpolation):
         np.testing.assert_allclose(
             speed, np.broadcast_to(moves.omega[:, None], speed.shape), atol=1e-4
         )
-    # Margins: |Δm| ≤ L·Δs with the floor taken as the smallest leg along the move.
-    margins = pose_margins(example, rotations.reshape(-1, 3, 3), positions).margins
-    margins = margins.reshape(4, count, steps)
-    lengths = inverse_kinematics(example, rotations.reshape(-1, 3, 3), positions).lengths
+    # Margins: |Δm| ≤ L·Δs with the floor taken as the smallest leg along the move (the
+    # singularity margin evaluated: a limit > 0).
+    model = Manipulator.from_mapping(
+        {**example.to_parameters(), "limits.singularity_min": 0.01}, warn=False
+    )
+    margins = pose_margins(model, rotations.reshape(-1, 3, 3), positions).margins
+    margins = margins.reshape(margins.shape[0], count, steps)
+    lengths = inverse_kinematics(model, rotations.reshape(-1, 3, 3), positions).lengths
     floor = lengths.reshape(count, steps, 6).min(axis=(1, 2))
+    turn = moves.speed / floor
+    # Written out here from the derivations (constraint_table), not read from the table.
     lipschitz = np.stack(
-        [moves.speed, moves.speed / floor, moves.omega + moves.speed / floor, 2 * moves.speed]
+        [
+            moves.speed,
+            turn,
+            moves.omega + turn,
+            2 * moves.speed,
+            math.sqrt(12.0) * (turn + moves.omega),
+        ]
     )
     rates = np.abs(np.diff(margins, axis=2)).max(axis=2) * (steps - 1)
     assert np.all(rates <= lipschitz * (1 + 1e-3) + 1e-9)
@@ -235,6 +248,18 @@ def test_huge_angles_are_reduced_before_combining(example):
 def test_check_path_refuses_bad_input(example, kwargs, match):
     with pytest.raises(InputError, match=match):
         check_path(example, **kwargs)
+
+
+def test_check_path_refuses_what_check_refuses(example):
+    """Positions are bounded by their distance to the base origin, as in a pose check: a point
+    within ±1e6 m per coordinate but 1.27e6 m away is refused by both (issue 20, finding 1)."""
+    far = [9e5, 9e5, 0.0]
+    with pytest.raises(InputError, match="position"):
+        check(example, [0.0, 0.0, 0.0], far)
+    with pytest.raises(InputError, match="within 1e\\+06 m of the base origin, waypoint 1"):
+        check_path(example, [[0, 0, -1.3], far], angles=[[0, 0, 0]] * 2)
+    with pytest.raises(InputError, match="waypoint 1"):
+        plan_torsion(example, [[0, 0, -1.3], far], [[0, 0, 1]] * 2)
 
 
 # ============================================================================ planner
@@ -370,7 +395,7 @@ def test_plan_refuses_bad_axes(example, axes, match):
 
 
 def test_singular_ends_take_the_other_azimuth_and_keep_their_rotation():
-    from hexapod_workspace.core.paths import _align_singular
+    from hexapod_workspace.core.path_interpolation import _align_singular
 
     angles = np.array([[0.3, np.pi, 0.7], [0.2, 0.0, -0.4], [0.1, 0.5, 0.2]])
     other = np.array([[1.1, 0.5, 0.0], [-2.0, 0.3, 0.1], [3.0, 0.4, 0.0]])

@@ -20,9 +20,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import planner_reference as reference
 
 from hexapod_workspace import plan_torsion
-from hexapod_workspace.core import paths
+from hexapod_workspace.core import path_planner as paths
 from hexapod_workspace.core import planner_kernels as kernels
-from hexapod_workspace.core.paths import _best_first
+from hexapod_workspace.core.path_planner import _best_first
 from hexapod_workspace.core.rotations import approach_vector, wrap_angle
 
 OFF_AXIS = np.array([0.2, 0.2, -0.95])

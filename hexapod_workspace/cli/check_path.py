@@ -28,7 +28,7 @@ from ..core.constraints import CONSTRAINT_NAMES
 from ..core.manipulator import Manipulator
 from ..core.paths import (
     DEFAULT_PATH_TOLERANCE,
-    DEFAULT_PSI_STEP,
+    DEFAULT_PLAN_PSI_STEP,
     INTERPOLATIONS,
     PathCheck,
     TorsionPlan,
@@ -612,7 +612,7 @@ def check_path_arguments(sub: argparse.ArgumentParser) -> None:
     sub.add_argument(
         "--psi-step-deg",
         type=float,
-        default=math.degrees(DEFAULT_PSI_STEP),
+        default=math.degrees(DEFAULT_PLAN_PSI_STEP),
         metavar="S",
         help="planned torsion: grid step, degrees (default %(default)g); the planner is "
         "complete on this grid",

@@ -70,15 +70,17 @@ def check_command(
     *,
     as_json: bool = False,
     record: Path | None = None,
+    singularity: bool = False,
     out: IO[str],
     err: IO[str],
 ) -> int:
     """``check``: reachability of poses (φ, θ, ψ in degrees, any finite values).
 
+    ``singularity`` reports the singularity margin even when ``limits.singularity_min`` is 0.
     Returns 0 when every pose is reachable, 1 when some is not (the count on ``err``).
     """
     started = time.time_ns()
-    result = check(manipulator, poses_from_degrees(poses_deg))
+    result = check(manipulator, poses_from_degrees(poses_deg), singularity=singularity)
     _record(record, manipulator, [result], started, err)
     if as_json:
         reports.check_json(result, out, poses_deg)

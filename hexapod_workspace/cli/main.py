@@ -167,6 +167,12 @@ def _check_arguments(parser: argparse.ArgumentParser) -> None:
         help="CSV of lines phi_deg,theta_deg,psi_deg (header optional; ',' ';' tab or space "
         "separated); - reads standard input",
     )
+    parser.add_argument(
+        "--singularity",
+        action="store_true",
+        help="report the singularity margin (smallest singular value of the legs' Plucker "
+        "matrix) even when limits.singularity_min is 0 (then it never makes a pose unreachable)",
+    )
     _add_outputs(parser, None)
 
 
@@ -185,6 +191,7 @@ def _check_run(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
         np.concatenate(parts),
         as_json=options.json,
         record=record,
+        singularity=options.singularity,
         out=out,
         err=err,
     )

@@ -16,6 +16,7 @@ from typing import IO, TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..core.constraint_table import CONSTRAINTS
 from ..core.constraints import CONSTRAINT_NAMES, CheckResult
 from ..core.orientation import OrientationWorkspace, TorsionRange
 from ..core.projected import ProjectedWorkspace
@@ -122,12 +123,12 @@ def check_table(result: CheckResult, out: IO[str], degrees: NDArray[np.float64])
     """
     x, y, z = result.position
     out.write(f"position: ({x:.4f}, {y:.4f}, {z:.4f}) m\n")
+    names = " ".join(f"{row.column:>11}" for row in CONSTRAINTS)
+    units = " ".join(f"{'[' + row.report_unit + ']':>11}" for row in CONSTRAINTS)
     header = (
         f"{'':>9} {'':>9} {'':>9}  {'':<9}  {'margin to each limit (>= 0 holds, < 0 violated)'}",
-        f"{'phi':>9} {'theta':>9} {'psi':>9}  {'reachable':<9}  {'leg_length':>11} "
-        f"{'base_joint':>11} {'platform_j':>11} {'interfer.':>11}  {'limiting':>8}  violated",
-        f"{'[deg]':>9} {'[deg]':>9} {'[deg]':>9}  {'':<9}  {'[mm]':>11} {'[deg]':>11} "
-        f"{'[deg]':>11} {'[mm]':>11}  {'leg':>8}",
+        f"{'phi':>9} {'theta':>9} {'psi':>9}  {'reachable':<9}  {names}  {'limiting':>8}  violated",
+        f"{'[deg]':>9} {'[deg]':>9} {'[deg]':>9}  {'':<9}  {units}  {'leg':>8}",
     )
     out.write("".join(line.rstrip() + "\n" for line in header))
     degrees = np.asarray(degrees)
@@ -141,14 +142,11 @@ def check_table(result: CheckResult, out: IO[str], degrees: NDArray[np.float64])
     columns = [
         *angle_columns,
         np.where(result.reachable, "yes", "NO").tolist(),
-        (result.margins["leg_length"] * 1e3).tolist(),
-        np.degrees(result.margins["base_joint"]).tolist(),
-        np.degrees(result.margins["platform_joint"]).tolist(),
-        (result.margins["leg_interference"] * 1e3).tolist(),
+        *((result.margins[row.name] * row.report_factor).tolist() for row in CONSTRAINTS),
         result.limiting_leg.tolist(),
         [",".join(v) or "-" for v in result.violated],
     ]
-    template = angle_format + "  %-9s  %11.3f %11.3f %11.3f %11.3f  %8d  %s"
+    template = angle_format + "  %-9s  " + " ".join(["%11.3f"] * len(CONSTRAINTS)) + "  %8d  %s"
     _write_rows(out, template, columns, "\n")
     reachable = int(np.count_nonzero(result.reachable))
     out.write(f"\n{reachable}/{len(result)} poses reachable\n")

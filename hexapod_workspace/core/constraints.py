@@ -1,20 +1,12 @@
-"""Inverse kinematics, exact segment distance and the four constraint margins, batched.
+"""Inverse kinematics, exact segment distance and the constraint margins, batched.
 
 Inverse kinematics of leg i (README, *Conventions*): ``L_i = p + R·b_i − a_i``, length
 ``ℓ_i = |L_i|``, unit direction ``n_i = L_i / ℓ_i`` (from base joint A_i to platform joint B_i).
 
-Each constraint has a signed margin, ≥ 0 when it holds and < 0 when it is violated:
-
-==================== ================================================ =======
-name                 margin                                           unit
-==================== ================================================ =======
-``leg_length``       min_i min(ℓ_i − ℓmin_i, ℓmax_i − ℓ_i)            m
-``base_joint``       min_i (α_i − angle(jA_i, n_i))                    rad
-``platform_joint``   min_i (β_i − angle(R·jB_i, −n_i))                 rad
-``leg_interference`` min_{i<j} (dist(A_iB_i, A_jB_j) − D)              m
-==================== ================================================ =======
-
-``leg_interference`` is +inf when D = 0 (check disabled). The margins are evaluated by the
+Each constraint has a signed margin, ≥ 0 when it holds and < 0 when it is violated; the
+constraints, their units, scales and rate bounds are the rows of
+:mod:`hexapod_workspace.core.constraint_table` (``leg_interference`` is +inf when D = 0, check
+disabled). The margins are evaluated by the
 compiled kernels of :mod:`hexapod_workspace.core.kernels` (one pass per pose, no Python loop);
 large batches of :func:`check` are split over the available cores.
 """
@@ -33,6 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from . import kernels
+from .constraint_table import CONSTRAINT_NAMES, N_CONSTRAINTS
 from .resolution import MAX_POSITION_NORM, validate_position
 
 if TYPE_CHECKING:
@@ -46,6 +39,7 @@ __all__ = [
     "PoseMargins",
     "check",
     "check_pose",
+    "home_pose_violations",
     "inverse_kinematics",
     "pose_margins",
     "relative_margins",
@@ -53,13 +47,6 @@ __all__ = [
     "violated_names",
 ]
 
-#: The constraint names, in the order of :attr:`PoseMargins.margins` rows.
-CONSTRAINT_NAMES: tuple[str, ...] = (
-    "leg_length",
-    "base_joint",
-    "platform_joint",
-    "leg_interference",
-)
 #: Leg pairs (i < j, 0-based) checked for interference, in a fixed order.
 PAIRS_I, PAIRS_J = np.triu_indices(6, k=1)
 #: Largest batch :func:`check` accepts in one call.
@@ -235,9 +222,10 @@ class PoseMargins:
 
     Attributes
     ----------
-    margins : ndarray, shape (4, N)
-        Signed margins in the order of :data:`CONSTRAINT_NAMES` (m, rad, rad, m).
-    limiting_legs : ndarray, shape (4, N), int
+    margins : ndarray, shape (C, N)
+        Signed margins, rows in the order of :data:`CONSTRAINT_NAMES` (C constraints; units of
+        the constraint table).
+    limiting_legs : ndarray, shape (C, N), int
         0-based leg with the smallest margin of each constraint (for ``leg_interference`` the
         lower leg of the closest pair; 0 when the check is disabled).
     limiting_pairs : ndarray, shape (N, 2), int
@@ -262,7 +250,7 @@ def pose_margins(
     *,
     interference: bool = True,
 ) -> PoseMargins:
-    """The four margins of N poses given as rotation matrices.
+    """The constraint margins of N poses given as rotation matrices.
 
     Parameters
     ----------
@@ -273,7 +261,7 @@ def pose_margins(
         Tool-tip positions, base frame, m.
     interference : bool
         Evaluate ``leg_interference`` (False leaves it +inf, for callers that only need the
-        other three).
+        others).
 
     Returns
     -------
@@ -287,8 +275,8 @@ def pose_margins(
     if positions.strides[0] == 0:  # one position for every pose
         positions = positions[:1]
     positions = np.array(positions, order="C")  # a writable copy (broadcasts are read-only)
-    margins = np.empty((4, count))
-    legs = np.empty((4, count), dtype=np.int64)
+    margins = np.empty((N_CONSTRAINTS, count))
+    legs = np.empty((N_CONSTRAINTS, count), dtype=np.int64)
     pairs = np.empty((count, 2), dtype=np.int64)
     kernels.margins_rotations(
         kernels.model_vector(manipulator), rotations, positions, interference, margins, legs, pairs
@@ -342,7 +330,7 @@ class CheckResult:
 
 
 def violated_names(margins: NDArray[np.float64]) -> list[list[str]]:
-    """Names of the negative margins per column of ``margins``, shape (4, N); NaN is violated.
+    """Names of the negative margins per column of ``margins``, shape (C, N); NaN is violated.
 
     Returns
     -------
@@ -364,21 +352,26 @@ def relative_margins(manipulator: Manipulator, margins: NDArray[np.float64]) -> 
     Parameters
     ----------
     manipulator : Manipulator
-    margins : ndarray, shape (4, N)
+    margins : ndarray, shape (C, N)
         Margins in :data:`CONSTRAINT_NAMES` order.
 
     Returns
     -------
-    ndarray, shape (4, N)
-        Leg length over half the mean stroke, joint angles over the mean maximum angle,
-        interference over D (+inf when disabled). Dimensionless.
+    ndarray, shape (C, N)
+        Each margin over the scale of its row of the constraint table (leg length over half
+        the mean stroke, joint angles over the mean maximum angle, interference over D).
+        Dimensionless.
     """
-    scale = kernels.model_vector(manipulator)[kernels.SCALE : kernels.SCALE + 4]
+    scale = kernels.model_vector(manipulator)[kernels.SCALE : kernels.SCALE + N_CONSTRAINTS]
     return margins / scale[:, None]
 
 
 def check(
-    manipulator: Manipulator, angles: ArrayLike, position: ArrayLike | None = None
+    manipulator: Manipulator,
+    angles: ArrayLike,
+    position: ArrayLike | None = None,
+    *,
+    singularity: bool = False,
 ) -> CheckResult:
     """Check the reachability of N orientations at one position.
 
@@ -389,6 +382,11 @@ def check(
         Tilt-and-Torsion angles (φ, θ, ψ) in rad.
     position : array_like, shape (3,), optional
         Tool-tip position OC, base frame, m. Default: ``manipulator.position``.
+    singularity : bool
+        Report the singularity margin even when ``limits.singularity_min`` is 0 (then it is
+        σ_min of the homogenised Plücker matrix, never negative, so it changes no verdict).
+        Otherwise it is +inf there (not evaluated; ``null`` in the CLI's JSON). With
+        ``limits.singularity_min`` > 0 it is always evaluated and enforced.
 
     Returns
     -------
@@ -422,11 +420,11 @@ def check(
     if not angles.flags.writeable:
         angles = angles.copy()
 
-    margins = np.empty((4, count))
-    ints = np.empty((6, count), dtype=np.int64)
+    margins = np.empty((N_CONSTRAINTS, count))
+    ints = np.empty((N_CONSTRAINTS + 2, count), dtype=np.int64)
     pairs = np.empty((count, 2), dtype=np.int64)
     reachable = np.empty(count, dtype=np.bool_)
-    model = kernels.model_vector(manipulator)
+    model = kernels.model_vector(manipulator, report_singularity=singularity)
     outputs = (margins, ints, pairs, reachable)
     workers = _cores() if count >= PARALLEL_POSES else 1
     if workers == 1:
@@ -444,7 +442,7 @@ def check(
     if status == -2:  # not reached: validate_position refused it above
         msg = f"position: expected 3 finite values (x, y, z) in m, got {position.tolist()}"
         raise InputError(msg)
-    legs = ints[:4]
+    legs = ints[:N_CONSTRAINTS]
     return CheckResult(
         position=position,
         angles=angles,
@@ -452,9 +450,16 @@ def check(
         margins={name: margins[k] for k, name in enumerate(CONSTRAINT_NAMES)},
         limiting_legs={name: legs[k] for k, name in enumerate(CONSTRAINT_NAMES)},
         limiting_pair=pairs,
-        limiting_constraint=ints[4],
-        limiting_leg=ints[5],
+        limiting_constraint=ints[N_CONSTRAINTS],
+        limiting_leg=ints[N_CONSTRAINTS + 1],
     )
+
+
+def home_pose_violations(manipulator: Manipulator) -> list[str]:
+    """Names of the constraints violated at the home pose (``manipulator.home_position``,
+    identity orientation); empty when it is reachable. The loaders warn with it."""
+    result = check(manipulator, np.zeros((1, 3)), manipulator.home_position)
+    return result.violated[0]
 
 
 class PoseCheck(NamedTuple):
@@ -464,9 +469,9 @@ class PoseCheck(NamedTuple):
     ----------
     reachable : bool
         Every constraint holds.
-    margins : tuple of 4 float
-        Signed margins in :data:`CONSTRAINT_NAMES` order (m, rad, rad, m).
-    limiting_legs : tuple of 4 int
+    margins : tuple of float
+        Signed margins in :data:`CONSTRAINT_NAMES` order (units of the constraint table).
+    limiting_legs : tuple of int
         1-based leg with the smallest margin of each constraint (``leg_interference``: the
         lower leg of the closest pair; 0 when the check is disabled).
     limiting_pair : tuple of 2 int
@@ -478,8 +483,8 @@ class PoseCheck(NamedTuple):
     """
 
     reachable: bool
-    margins: tuple[float, float, float, float]
-    limiting_legs: tuple[int, int, int, int]
+    margins: tuple[float, ...]
+    limiting_legs: tuple[int, ...]
     limiting_pair: tuple[int, int]
     limiting_constraint: int
     limiting_leg: int
@@ -527,13 +532,14 @@ def check_pose(
             or math.sqrt(x * x + y * y + z * z) > MAX_POSITION_NORM
         ):
             validate_position(manipulator, values)  # raises, with the same reason as check()
-    result = np.empty(12)
+    result = np.empty(kernels.ONE_SIZE)
     kernels.check_one(kernels.model_vector(manipulator), *angles, x, y, z, result)
-    m_len, m_a, m_b, m_i, l_len, l_a, l_b, l_i, p_i, p_j, worst, leg = result.tolist()
+    numbers = result.tolist()
+    p_i, p_j, worst, leg, reachable = numbers[2 * N_CONSTRAINTS :]
     return PoseCheck(
-        m_len >= 0.0 and m_a >= 0.0 and m_b >= 0.0 and m_i >= 0.0,
-        (m_len, m_a, m_b, m_i),
-        (int(l_len), int(l_a), int(l_b), int(l_i)),
+        reachable != 0.0,
+        tuple(numbers[:N_CONSTRAINTS]),
+        tuple(map(int, numbers[N_CONSTRAINTS : 2 * N_CONSTRAINTS])),
         (int(p_i), int(p_j)),
         int(worst),
         int(leg),

@@ -17,7 +17,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import ConfigError, GeometryError
-from .constraints import check
 from .params import (
     CELL_PARAMETERS,
     NODE_PARAMETERS,
@@ -44,6 +43,7 @@ PARAMETER_DEFAULTS: dict[str, Any] = {
     "limits.base_joint_max_angle": None,
     "limits.platform_joint_max_angle": None,
     "limits.leg_diameter": 0.0,
+    "limits.singularity_min": 0.0,
     "pose.position": None,
 }
 _MODEL_GROUPS = ("geometry.", "limits.", "pose.")
@@ -125,6 +125,20 @@ def _axes(name: str, value: Any) -> NDArray[np.float64] | None:
     return unit
 
 
+def _singularity_min(value: Any) -> float:
+    """``limits.singularity_min``: one finite number in [0, 1] (σ_min of a matrix of unit
+    rows is at most √6, but a limit above 1 leaves no practical workspace)."""
+    name = "limits.singularity_min"
+    array = _numbers(name, value)
+    if array.size != 1:
+        msg = f"{name}: expected one number, got {array.size}"
+        raise GeometryError(msg)
+    if not 0.0 <= array[0] <= 1.0:
+        msg = f"{name}: expected a value in [0, 1] (0 disables the check), got {array[0]:g}"
+        raise GeometryError(msg)
+    return float(array[0])
+
+
 def _frozen(array: NDArray[np.float64]) -> NDArray[np.float64]:
     array = np.ascontiguousarray(array, dtype=np.float64)
     array.setflags(write=False)
@@ -160,6 +174,10 @@ class Manipulator:
         Name of the base frame in published results.
     axes_from_home : tuple of bool
         Whether the (base, platform) joint axes were derived from the home pose (not given).
+    singularity_min : float
+        σ_lim ≥ 0: the smallest singular value of the homogenised Plücker matrix of the legs
+        allowed (constraint ``singularity``, see :mod:`~hexapod_workspace.core.constraint_table`);
+        0 disables the constraint (dimensionless).
     """
 
     base_joints: NDArray[np.float64]
@@ -175,6 +193,7 @@ class Manipulator:
     position: NDArray[np.float64]
     frame_id: str = "base"
     axes_from_home: tuple[bool, bool] = field(default=(True, True))
+    singularity_min: float = 0.0
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -313,6 +332,7 @@ class Manipulator:
             position=_frozen(position),
             frame_id=frame_id,
             axes_from_home=(base_axes is None, platform_axes is None),
+            singularity_min=_singularity_min(values["limits.singularity_min"]),
         )
         if warn:
             reason = unusable_reason(manipulator)
@@ -408,6 +428,7 @@ class Manipulator:
             "limits.base_joint_max_angle": floats(self.base_joint_max_angle),
             "limits.platform_joint_max_angle": floats(self.platform_joint_max_angle),
             "limits.leg_diameter": float(self.leg_diameter),
+            "limits.singularity_min": float(self.singularity_min),
             "pose.position": floats(self.position),
         }
 
@@ -416,11 +437,6 @@ class Manipulator:
         from dataclasses import replace
 
         return replace(self, position=_frozen(_vector3("position", position)))
-
-    def home_pose_violations(self) -> list[str]:
-        """Names of the constraints violated at the home pose (home position, identity)."""
-        result = check(self, np.zeros((1, 3)), self.home_position)
-        return result.violated[0]
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Manipulator):
@@ -443,6 +459,7 @@ class Manipulator:
         return (
             arrays_equal
             and self.leg_diameter == other.leg_diameter
+            and self.singularity_min == other.singularity_min
             and self.frame_id == other.frame_id
             and self.axes_from_home == other.axes_from_home
         )

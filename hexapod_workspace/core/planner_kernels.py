@@ -1,8 +1,8 @@
 """Compiled dynamic programmes of the torsion planner (numba).
 
-:class:`hexapod_workspace.core.paths._Planner` searches waypoints × torsion grid; its tables are
-banded, shape (M, G, B) for M = N − 1 moves, G grid torsions and B torsion changes per move:
-``status`` (:data:`NO`, :data:`KNOWN`, :data:`UNKNOWN`), ``value`` (integer margin levels;
+:class:`hexapod_workspace.core.path_planner._Planner` searches waypoints × torsion grid; its
+tables are banded, shape (M, G, B) for M = N − 1 moves, G grid torsions and B torsion changes
+per move: ``status`` (:data:`NO`, :data:`KNOWN`, :data:`UNKNOWN`), ``value`` (integer margin levels;
 for unknown moves the optimistic level of their smaller end margin) and ``dest[g, b]`` (the
 torsion that offset b leads to from g). Without a torsion limit B = G, and these programmes
 run over G² pairs per move after every batch of certified checks; in numpy each pass over
@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 # Imported first: it points numba's cache directory somewhere writable before numba loads.
-from .kernels import CACHE_DIRECTORY
+from .jit import CACHE_DIRECTORY
 
 # isort: split
 import numba

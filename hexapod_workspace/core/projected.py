@@ -19,7 +19,7 @@ Two methods:
     not star-shaped about θ = 0) are not counted, so the result is a certified lower bound of
     the shadow, exact for workspaces whose constant-(φ, ψ) sections are intervals.
 
-Every reported point (φ, θ, ψ) satisfies all four constraints; the first violation along its
+Every reported point (φ, θ, ψ) satisfies every constraint; the first violation along its
 ray lies within the tolerance beyond it.
 """
 

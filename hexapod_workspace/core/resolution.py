@@ -25,21 +25,27 @@ if TYPE_CHECKING:
 __all__ = [
     "DEFAULT_N_PHI",
     "DEFAULT_N_RAYS",
+    "DEFAULT_PLAN_PSI_STEP",
     "DEFAULT_PSI_STEP",
     "DEFAULT_TOLERANCE",
+    "MAX_PLAN_PSI_STEP",
     "MAX_POINTS",
     "MAX_POSITION_NORM",
     "MAX_PSI_STEP",
     "MAX_RAYS",
     "MAX_SLICES",
     "MAX_TOLERANCE",
+    "MAX_WAYPOINTS",
+    "MIN_PLAN_PSI_STEP",
     "MIN_PSI_STEP",
     "MIN_RAYS",
     "MIN_TOLERANCE",
     "Method",
     "Progress",
     "WorkspaceKind",
+    "validate_plan_psi_step",
     "validate_position",
+    "validate_positions",
     "validate_psi_step",
     "validate_rays",
     "validate_tolerance",
@@ -96,6 +102,12 @@ MIN_RAYS, MAX_RAYS = 3, 7200
 MIN_TOLERANCE, MAX_TOLERANCE = 1e-12, 0.1
 #: Bounds on the slice step Δψ of the orientation workspace, rad.
 MIN_PSI_STEP, MAX_PSI_STEP = 1e-4, 0.5
+#: Bounds on the torsion grid step of the toolpath planner, rad (0.1° to 90°). Another fact
+#: than the slice step: the planner's grid is coarse (its moves are certified between grid
+#: torsions), the slices of a workspace are fine.
+MIN_PLAN_PSI_STEP, MAX_PLAN_PSI_STEP = math.radians(0.1), math.radians(90.0)
+#: Largest number of waypoints of one toolpath check or plan.
+MAX_WAYPOINTS = 1_000_000
 #: Largest number of slices one orientation workspace may produce (both directions together).
 MAX_SLICES = 20_000
 #: Largest number of boundary points (slices × rays) one orientation workspace may produce.
@@ -112,6 +124,8 @@ DEFAULT_N_PHI = 360
 DEFAULT_N_RAYS = 180
 #: Default slice step of the orientation workspace, rad (1°).
 DEFAULT_PSI_STEP = math.radians(1.0)
+#: Default torsion grid step of the toolpath planner, rad (5°).
+DEFAULT_PLAN_PSI_STEP = math.radians(5.0)
 #: Default boundary tolerance of every computation (API, CLI and node alike), rad.
 DEFAULT_TOLERANCE = 1e-6
 
@@ -147,6 +161,49 @@ def validate_tolerance(tolerance: float, name: str = "tolerance") -> float:
 def validate_psi_step(psi_step: float, name: str = "psi_step") -> float:
     """Check a slice step Δψ (rad) against [:data:`MIN_PSI_STEP`, :data:`MAX_PSI_STEP`]."""
     return _bounded(psi_step, MIN_PSI_STEP, MAX_PSI_STEP, name)
+
+
+def validate_plan_psi_step(psi_step: float, name: str = "psi_step") -> float:
+    """Check a planner torsion grid step (rad) against [:data:`MIN_PLAN_PSI_STEP`,
+    :data:`MAX_PLAN_PSI_STEP`]."""
+    number = float(psi_step)
+    if not (math.isfinite(number) and MIN_PLAN_PSI_STEP <= number <= MAX_PLAN_PSI_STEP):
+        msg = (
+            f"{name}: expected {MIN_PLAN_PSI_STEP:.4g} to {MAX_PLAN_PSI_STEP:.4g} rad, "
+            f"got {psi_step!r}"
+        )
+        raise ResolutionError(msg)
+    return number
+
+
+def validate_positions(positions: ArrayLike, minimum: int, maximum: int) -> NDArray[np.float64]:
+    """Positions of ``minimum`` to ``maximum`` waypoints, shape (N, 3), m, base frame, checked
+    as :func:`validate_position` checks one: finite and within :data:`MAX_POSITION_NORM` of
+    the base origin (so a toolpath accepts exactly the points a pose check accepts).
+
+    Raises
+    ------
+    InputError
+        Wrong shape or count, naming the first bad waypoint otherwise.
+    """
+    array = np.asarray(positions, dtype=np.float64)
+    if array.ndim != 2 or array.shape[1] != 3:
+        msg = f"positions: expected shape (N, 3) in m, got {array.shape}"
+        raise InputError(msg)
+    if not minimum <= array.shape[0] <= maximum:
+        msg = f"positions: expected {minimum} to {maximum} waypoints, got {array.shape[0]}"
+        raise InputError(msg)
+    with np.errstate(over="ignore", invalid="ignore"):
+        norms = np.linalg.norm(array, axis=1)
+    bad = ~(np.all(np.isfinite(array), axis=1) & (norms <= MAX_POSITION_NORM))
+    if np.any(bad):
+        row = int(np.flatnonzero(bad)[0])
+        msg = (
+            f"positions: expected finite values within {MAX_POSITION_NORM:g} m of the base "
+            f"origin, waypoint {row} is {array[row].tolist()}"
+        )
+        raise InputError(msg)
+    return array
 
 
 def validate_position(manipulator: Manipulator, position: ArrayLike | None) -> NDArray[np.float64]:

@@ -17,16 +17,10 @@ Along every ray used here the platform turns at an angular rate ω ≤ 1 rad per
 * a torsion ray ``(φ, θ, s)`` is a rotation about the tool axis (ω = 1).
 
 With ρ = max_i |b_i| (platform joint radius about the tool tip), each platform joint moves at
-most ρ per unit ``s`` and each margin changes at most at a known rate (a Lipschitz bound):
-
-==================== =========================== ==============================================
-constraint           bound on |d margin / ds|    why
-==================== =========================== ==============================================
-``leg_length``       ρ                           |dL_i/ds| = |ω × R b_i| ≤ ρ
-``base_joint``       ρ / ℓ_floor                 |dn_i/ds| ≤ |dL_i/ds| / ℓ_i
-``platform_joint``   1 + ρ / ℓ_floor             R·jB_i turns at ω ≤ 1, plus |dn_i/ds|
-``leg_interference`` 2ρ                          each segment moves by ≤ ρ (Hausdorff), two move
-==================== =========================== ==============================================
+most ρ per unit ``s`` and each margin changes at most at a known rate (a Lipschitz bound): the
+rate of its row of :mod:`hexapod_workspace.core.constraint_table` with V = ρ and Ω = 1 (ρ for
+``leg_length``, ρ / ℓ_floor for ``base_joint``, 1 + ρ / ℓ_floor for ``platform_joint``, 2ρ for
+``leg_interference``; the derivations are written there).
 
 ``ℓ_floor`` is a lower bound on the leg lengths over the step: the smallest ℓmin (valid because
 the step never lets the leg-length margin reach zero), and at least half of the current shortest
@@ -36,7 +30,7 @@ search takes certified steps, so it cannot skip a violated band, except where ev
 already within ``L_c · h_min`` of zero: there it steps by ``h_min`` (default 1e-3 rad) and
 bands narrower than ``h_min`` could be missed. Once a violated sample is met, bisection
 between the last feasible sample and it locates the crossing to the tolerance; the reported
-point is the feasible end, so every reported boundary point satisfies all four constraints.
+point is the feasible end, so every reported boundary point satisfies every constraint.
 """
 
 from __future__ import annotations
@@ -47,6 +41,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import kernels
+from .constraint_table import N_CONSTRAINTS
 from .manipulator import Manipulator
 
 __all__ = ["DEFAULT_MIN_STEP", "RAY_KINDS", "RaySearch", "RaySearchResult"]
@@ -125,12 +120,12 @@ class RaySearch:
         self.evaluations = 0
 
     def margins(self, angles: NDArray[np.float64]) -> NDArray[np.float64]:
-        """The four margins of poses (n, 3) at the search position; shape (4, n)."""
+        """The margins of poses (n, 3) at the search position; shape (C, n), C constraints."""
         angles = np.ascontiguousarray(angles, dtype=np.float64)
         if not angles.flags.writeable:  # one compiled specialisation: writable arrays
             angles = angles.copy()
         count = angles.shape[0]
-        margins = np.empty((4, count))
+        margins = np.empty((N_CONSTRAINTS, count))
         kernels.check_angles(
             self.model,
             angles,
@@ -138,7 +133,7 @@ class RaySearch:
             0,
             count,
             margins,
-            np.empty((6, count), dtype=np.int64),
+            np.empty((N_CONSTRAINTS + 2, count), dtype=np.int64),
             np.empty((count, 2), dtype=np.int64),
             np.empty(count, dtype=np.bool_),
         )

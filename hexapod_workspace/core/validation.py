@@ -111,7 +111,11 @@ def _unit_hint(manipulator: Manipulator) -> str:
 
 def unusable_reason(manipulator: Manipulator) -> str | None:
     """Why no verdict can be given for this model (see the module documentation), or None."""
-    problems = manipulator.home_pose_violations()
+    # The evaluator is imported here, not at module level: the model (manipulator.py imports
+    # this module) does not import the evaluator.
+    from .constraints import home_pose_violations
+
+    problems = home_pose_violations(manipulator)
     if problems:
         return (
             f"the home pose (geometry.home_position {manipulator.home_position.tolist()} m, "

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
+from ..core.constraint_table import CONSTRAINT_NAMES
 from ..core.orientation import OrientationWorkspace
 from ..core.projected import ProjectedWorkspace
 from ..core.resolution import WorkspaceKind
@@ -125,10 +126,8 @@ def pose_check_fields(result: CheckResult, index: int) -> dict[str, Any]:
     return {
         "reachable": bool(result.reachable[index]),
         "violated": list(result.violated[index]),
-        "leg_length_margin": float(margins["leg_length"][index]),
-        "base_joint_margin": float(margins["base_joint"][index]),
-        "platform_joint_margin": float(margins["platform_joint"][index]),
-        "leg_interference_margin": float(margins["leg_interference"][index]),
+        "constraint_names": list(margins),
+        "margins": [float(values[index]) for values in margins.values()],
         "limiting_leg": int(result.limiting_leg[index]),
     }
 
@@ -155,19 +154,16 @@ class PoseChecks(Protocol):
 def pose_checks_fields(result: PoseChecks) -> list[dict[str, Any]]:
     """PoseCheck dicts of every pose of a check result, in order."""
     violated = result.violated
-    columns = {
-        "leg_length_margin": result.margins["leg_length"].tolist(),
-        "base_joint_margin": result.margins["base_joint"].tolist(),
-        "platform_joint_margin": result.margins["platform_joint"].tolist(),
-        "leg_interference_margin": result.margins["leg_interference"].tolist(),
-    }
+    names = list(result.margins)
+    margins = np.stack([result.margins[name] for name in names], axis=1).tolist()
     reachable = result.reachable.tolist()
     limiting = np.asarray(result.limiting_leg).tolist()
     return [
         {
             "reachable": bool(reachable[i]),
             "violated": list(violated[i]),
-            **{name: float(values[i]) for name, values in columns.items()},
+            "constraint_names": names,
+            "margins": margins[i],
             "limiting_leg": int(limiting[i]),
         }
         for i in range(len(reachable))
@@ -179,10 +175,8 @@ def _failed_pose_check() -> dict[str, Any]:
     return {
         "reachable": False,
         "violated": [],
-        "leg_length_margin": nan,
-        "base_joint_margin": nan,
-        "platform_joint_margin": nan,
-        "leg_interference_margin": nan,
+        "constraint_names": list(CONSTRAINT_NAMES),
+        "margins": [nan] * len(CONSTRAINT_NAMES),
         "limiting_leg": 0,
     }
 

@@ -24,6 +24,7 @@ from rosidl_parser.definition import AbstractSequence, Array, BasicType, Namespa
 
 __all__ = [
     "angles_from_orientations",
+    "margins_by_name",
     "message_class",
     "position_from_point",
     "to_message",
@@ -156,3 +157,26 @@ def angles_from_orientations(orientations: Sequence[Any]) -> NDArray[np.float64]
 def position_from_point(point: Any) -> NDArray[np.float64]:
     """A ``geometry_msgs/msg/Point`` as an array of shape (3,), m, base frame."""
     return np.array((point.x, point.y, point.z), dtype=np.float64)
+
+
+def margins_by_name(pose_check: Any) -> dict[str, float]:
+    """The margins of a ``hexapod_workspace_msgs/msg/PoseCheck`` (message or field dict) by
+    constraint name: ``{"leg_length": m, "base_joint": rad, ...}``, in message order.
+
+    Raises
+    ------
+    ValueError
+        ``constraint_names`` and ``margins`` differ in length (a malformed message).
+    """
+    if isinstance(pose_check, Mapping):
+        names, values = pose_check["constraint_names"], pose_check["margins"]
+    else:
+        names, values = pose_check.constraint_names, pose_check.margins
+    names, values = list(names), [float(value) for value in values]
+    if len(names) != len(values):
+        msg = (
+            f"PoseCheck: expected as many margins as constraint_names, got {len(values)} "
+            f"margins for {len(names)} names"
+        )
+        raise ValueError(msg)
+    return dict(zip(names, values, strict=True))

@@ -88,10 +88,16 @@ MODEL_DESCRIPTIONS = {
     "limits.leg_diameter": (
         "Leg diameter D, m: legs (segments A_iB_i) must stay D apart; 0 disables the check."
     ),
+    "limits.singularity_min": (
+        "Smallest allowed singular value of the homogenised Plucker matrix of the legs, in "
+        "[0, 1]; 0 disables the singularity margin."
+    ),
     "pose.position": (
         "Default tool-tip position OC, base frame, m (3 floats): used by the Trigger services."
     ),
 }
+#: Ranges of the model's scalar parameters (the model validation says the same).
+_FLOAT_RANGES = {"limits.leg_diameter": (0.0, 10.0), "limits.singularity_min": (0.0, 1.0)}
 #: Axes that may be empty: an empty YAML list arrives as an unset parameter of any type.
 _OPTIONAL_AXES = ("geometry.base_joint_axes", "geometry.platform_joint_axes")
 
@@ -144,7 +150,7 @@ def parameter_specs() -> dict[str, Spec]:
             MODEL_DESCRIPTIONS[name],
             read_only=name == "frame_id",
             dynamic_typing=name in _OPTIONAL_AXES,  # the model validation refuses non-numbers
-            float_range=(0.0, 10.0) if name == "limits.leg_diameter" else None,
+            float_range=_FLOAT_RANGES.get(name),
         )
         for name, default in example.items()
     ]

@@ -35,7 +35,7 @@ from ..core.baseline import reported_baseline
 from ..core.manipulator import Manipulator
 from ..core.paths import (
     DEFAULT_PATH_TOLERANCE,
-    DEFAULT_PSI_STEP,
+    DEFAULT_PLAN_PSI_STEP,
     INTERPOLATIONS,
     PathCheck,
     TorsionPlan,
@@ -143,7 +143,7 @@ def check_path_response_fields(manipulator: Manipulator, request: Any) -> dict[s
         tolerance = _option(request.tolerance, "tolerance", DEFAULT_PATH_TOLERANCE)
         positions, quaternions = pose_arrays(request.poses)
         if request.free_torsion:
-            psi_step = _option(request.psi_step, "psi_step", DEFAULT_PSI_STEP)
+            psi_step = _option(request.psi_step, "psi_step", DEFAULT_PLAN_PSI_STEP)
             max_dpsi = None
             if request.limit_dpsi:
                 max_dpsi = float(request.max_dpsi)

@@ -21,6 +21,7 @@ from hexapod_workspace.core.resolution import WorkspaceKind  # noqa: E402
 from hexapod_workspace.logs import messages  # noqa: E402
 from hexapod_workspace.ros.conversions import (  # noqa: E402
     angles_from_orientations,
+    margins_by_name,
     position_from_point,
     to_message,
 )
@@ -56,7 +57,7 @@ def test_check_response_with_nested_pose_checks(example, rng):
     for k, pose_check in enumerate(response.results):
         assert pose_check.reachable == bool(result.reachable[k])
         assert list(pose_check.violated) == result.violated[k]
-        assert pose_check.platform_joint_margin == result.margins["platform_joint"][k]
+        assert margins_by_name(pose_check)["platform_joint"] == result.margins["platform_joint"][k]
         assert pose_check.limiting_leg == result.limiting_leg[k]
 
 

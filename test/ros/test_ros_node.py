@@ -31,6 +31,7 @@ from hexapod_workspace import (  # noqa: E402
     check,
     logs,
 )
+from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402
 
 NODE = "/hexapod_workspace"
 #: Small resolutions keep the workspace computations of the tests short.
@@ -71,8 +72,10 @@ def assert_matches_core(response: CheckPoses.Response, expected) -> None:
     got_reachable = np.array([r.reachable for r in response.results])
     np.testing.assert_array_equal(got_reachable, expected.reachable)
     assert [list(r.violated) for r in response.results] == expected.violated
+    for result in response.results:
+        assert list(result.constraint_names) == list(CONSTRAINT_NAMES)
     for name in CONSTRAINT_NAMES:
-        got = np.array([getattr(r, f"{name}_margin") for r in response.results])
+        got = np.array([margins_by_name(r)[name] for r in response.results])
         np.testing.assert_array_equal(got, expected.margins[name])
     got_legs = np.array([r.limiting_leg for r in response.results])
     np.testing.assert_array_equal(got_legs, expected.limiting_leg)
@@ -99,7 +102,7 @@ def test_check_poses_huge_angles_get_the_verdict_of_their_principal_values(clien
     response = client.call(CheckPoses, f"{NODE}/check_poses", check_request(huge))
     assert response.success, response.message
     for name in CONSTRAINT_NAMES:
-        got = np.array([getattr(r, f"{name}_margin") for r in response.results])
+        got = np.array([margins_by_name(r)[name] for r in response.results])
         np.testing.assert_allclose(got, expected.margins[name], atol=1e-12)
     assert [r.reachable for r in response.results] == expected.reachable.tolist()
 
@@ -185,7 +188,7 @@ def test_commanded_pose_gets_a_reachability_result(client, model):
         assert result.header.frame_id == model.frame_id
         assert result.check.reachable == bool(expected.reachable[k])
         assert list(result.check.violated) == expected.violated[k]
-        assert result.check.leg_length_margin == expected.margins["leg_length"][k]
+        assert margins_by_name(result.check)["leg_length"] == expected.margins["leg_length"][k]
         assert result.check.limiting_leg == expected.limiting_leg[k]
         assert result.orientation.theta == angles[k, 1]
         assert result.message == (
@@ -196,7 +199,7 @@ def test_commanded_pose_gets_a_reachability_result(client, model):
     failed = by_id["cmd-nan"]
     assert not failed.success
     assert "finite" in failed.message
-    assert math.isnan(failed.check.leg_length_margin)
+    assert math.isnan(margins_by_name(failed.check)["leg_length"])
 
 
 # ---------------------------------------------------------------------------- parameters

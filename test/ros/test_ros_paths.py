@@ -34,6 +34,7 @@ from hexapod_workspace.core.rotations import (  # noqa: E402
     quaternion_to_matrix,
     tt_to_matrix,
 )
+from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402
 
 NODE = "/hexapod_workspace"
 CURRENT_POSE_TOPIC = "/test_current_pose"
@@ -149,7 +150,7 @@ def test_check_poses_accepts_ros_poses(client, model):
         expected = check(model, angles[k], positions[k])
         assert result.reachable == expected.reachable[0]
         # The pose went through a quaternion and back to T&T angles: equal to rounding.
-        assert result.leg_length_margin == pytest.approx(
+        assert margins_by_name(result)["leg_length"] == pytest.approx(
             expected.margins["leg_length"][0], abs=1e-12
         )
     assert [r.reachable for r in response.results] == [True, False, False]

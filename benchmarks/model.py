@@ -1,0 +1,128 @@
+#!/usr/bin/env python3
+"""The open model (issue 17) against the code before it, ratios measured in the same run.
+
+The baseline is the package as of commit 3c6da1e (four constraints wired by hand, one leg
+architecture), extracted with ``git archive`` and imported as ``hexapod_workspace_baseline``
+(:func:`speed.load_baseline`), so both run here, on the same machine, in the same minute. Times
+are the best of several runs on one core (the machine is shared). Printed: per-pose time of a
+batch check, one-pose check, the exact projected workspace, the orientation workspace and a
+toolpath check, for the packaged 6-UPS example; the ratio is baseline time / new time (≥ 1:
+not slower). Then the cost of an enforced singularity margin (new code, limit 0.3 against 0):
+enforced time / free time.
+
+Usage: python benchmarks/model.py [--poses N]
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from speed import best_of, load_baseline, per_call, random_poses
+
+import hexapod_workspace as new
+from hexapod_workspace._resources import example_config_path
+from hexapod_workspace.core import kernels
+from hexapod_workspace.core.constraints import check_pose
+
+MODEL_BASELINE = "3c6da1e"
+POSITION = np.array([0.0, 0.0, -1.3])
+
+
+def figures(package, check_one, poses: np.ndarray) -> dict[str, float]:
+    """Seconds of each figure for one version of the package."""
+    # The packaged example, given as parameters the baseline knows (it predates
+    # limits.singularity_min, 0 here).
+    parameters = new.Manipulator.from_params_file(example_config_path()).to_parameters()
+    parameters.pop("limits.singularity_min")
+    machine = package.Manipulator.from_mapping(parameters)
+    rng = np.random.default_rng(3)
+    waypoints = POSITION + rng.normal(scale=0.05, size=(200, 3))
+    angles = random_poses(200, seed=4) * np.array([1.0, 0.5, 0.5])
+    return {
+        "check, per pose": best_of(7, lambda: package.check(machine, poses, POSITION))
+        / poses.shape[0],
+        "check_pose, per call": per_call(lambda: check_one(machine, 0.3, 0.2, 0.1, POSITION)),
+        "projected exact (360 rays)": best_of(
+            5, lambda: package.projected_workspace(machine, POSITION, method="exact")
+        ),
+        "orientation (180 rays, 1 deg)": best_of(
+            3, lambda: package.orientation_workspace(machine, POSITION)
+        ),
+        "check_path (199 moves)": best_of(
+            5, lambda: package.check_path(machine, waypoints, angles=angles)
+        ),
+    }
+
+
+def singularity_figures(poses: np.ndarray) -> list[tuple[str, float, float]]:
+    """(figure, seconds without, seconds with the singularity margin enforced), new code."""
+    free = new.Manipulator.from_params_file(example_config_path())
+    enforced = new.Manipulator.from_mapping(
+        {**free.to_parameters(), "limits.singularity_min": 0.3}, warn=False
+    )
+    rows = []
+    for name, run in (
+        ("check, per pose", lambda m: new.check(m, poses, POSITION)),
+        (
+            "projected exact (360 rays)",
+            lambda m: new.projected_workspace(m, POSITION, method="exact"),
+        ),
+    ):
+        without = min(best_of(5, functools.partial(run, free)) for _ in range(2))
+        with_it = min(best_of(5, functools.partial(run, enforced)) for _ in range(2))
+        scale = poses.shape[0] if name.endswith("per pose") else 1
+        rows.append((name, without / scale, with_it / scale))
+    return rows
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--poses", type=int, default=200_000)
+    options = parser.parse_args()
+    os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})  # one core
+    with tempfile.TemporaryDirectory() as directory:
+        old = load_baseline(Path(directory), MODEL_BASELINE)
+        if old is None:
+            sys.exit(f"cannot extract the baseline {MODEL_BASELINE} (git archive)")
+        from hexapod_workspace_baseline.core import kernels as old_kernels
+        from hexapod_workspace_baseline.core.constraints import check_pose as old_check_pose
+
+        kernels.warm_up()
+        old_kernels.warm_up()
+        poses = random_poses(options.poses)
+        # Interleaved: new, baseline, new, baseline, ...; the best of each.
+        runs = []
+        for _ in range(3):
+            runs.append(figures(new, check_pose, poses))
+            runs.append(figures(old, old_check_pose, poses))
+    print(f"load average {os.getloadavg()[0]:.2f}, one core, {options.poses} poses per batch")
+    print(f"  {'figure':<32} {'new':>12} {'baseline':>12} {'ratio':>7}")
+    for name in runs[0]:
+        now = min(run[name] for run in runs[0::2])
+        before = min(run[name] for run in runs[1::2])
+        unit, scale = ("µs", 1e6) if now < 1e-3 else ("ms", 1e3)
+        print(
+            f"  {name:<32} {now * scale:>9.3f} {unit} {before * scale:>9.3f} {unit}"
+            f" {before / now:>7.3f}"
+        )
+    print("singularity margin enforced (limit 0.3) against free (limit 0), new code:")
+    print(f"  {'figure':<32} {'free':>12} {'enforced':>12} {'ratio':>7}")
+    for name, without, with_it in singularity_figures(poses):
+        unit, scale = ("µs", 1e6) if without < 1e-3 else ("ms", 1e3)
+        print(
+            f"  {name:<32} {without * scale:>9.3f} {unit} {with_it * scale:>9.3f} {unit}"
+            f" {with_it / without:>7.2f}"
+        )
+
+
+if __name__ == "__main__":
+    main()

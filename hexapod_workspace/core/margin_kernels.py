@@ -1,0 +1,928 @@
+"""Margin kernels (numba): the constraint margins of one pose and of blocks of poses.
+
+Batches are evaluated 128 poses at a time as planes of one flat array, stage by stage
+(:func:`_check_block`), so that every loop vectorises; single poses and the rare poses that need
+care go through the scalar :func:`_pose`. Both follow the numpy reference of
+``test/reference.py`` operation by operation: margins agree to rounding. The model is the packed
+vector of :mod:`hexapod_workspace.core.model_layout`.
+"""
+
+from __future__ import annotations
+
+import math
+
+# Imported first: it points numba's cache directory somewhere writable before numba loads.
+from .jit import helper as _helper
+from .jit import inline as _inline
+from .jit import jit as _jit
+
+# isort: split
+import numpy as np
+from numpy.typing import NDArray
+
+from .constraint_table import (
+    BASE_JOINT,
+    LEG_INTERFERENCE,
+    LEG_LENGTH,
+    N_CONSTRAINTS,
+    PLATFORM_JOINT,
+    SINGULARITY,
+)
+from .model_layout import (
+    ALPHA,
+    ALPHA_EQUAL,
+    BETA,
+    BETA_EQUAL,
+    DIAMETER,
+    INTERFERENCE,
+    JA,
+    JB,
+    LMAX,
+    LMIN,
+    ORDER,
+    PAIR_I,
+    PAIR_J,
+    RHO,
+    RPAIR,
+    RR,
+    SCALE,
+    SINGULARITY_MIN,
+    SINGULARITY_ON,
+    A,
+    B,
+)
+
+__all__ = ["ONE_SIZE", "check_angles", "check_one", "margins_rotations"]
+
+# ------------------------------------------------------------------------------ one pose
+# Slots of the per-pose result vector ``out``.
+# Slots 0 .. N_CONSTRAINTS − 1: the margins, in constraint-table order.
+OUT_LEG = N_CONSTRAINTS  # limiting leg of each margin (N_CONSTRAINTS slots, as float)
+OUT_PAIR = 2 * N_CONSTRAINTS  # closest pair (2 slots)
+OUT_SHORTEST = OUT_PAIR + 2  # shortest leg length, m
+OUT_SIZE = OUT_SHORTEST + 1
+#: Size of :func:`check_one`'s result: margins, legs, pair (2), limiting constraint and leg,
+#: reachable (1.0 or 0.0).
+ONE_SIZE = 2 * N_CONSTRAINTS + 5
+
+
+@_helper
+def _clamp01(value: float) -> float:
+    """Clamp to [0, 1]; NaN stays NaN."""
+    if value < 0.0:
+        return 0.0
+    if value > 1.0:
+        return 1.0
+    return value
+
+
+@_helper
+def _pose(
+    model: NDArray[np.float64],
+    r: NDArray[np.float64],
+    px: float,
+    py: float,
+    pz: float,
+    scratch: NDArray[np.float64],
+    out: NDArray[np.float64],
+    want_pair: bool,
+) -> None:
+    """Margins of one pose into ``out`` (OUT_SIZE,).
+
+    ``r`` (9,) is the rotation matrix row-major, (px, py, pz) the position (m), ``scratch``
+    (5, 6) working memory (leg vector planes and squared lengths). Follows the numpy reference
+    (test/reference.py, BatchedMargins) operation by operation, so margins agree to rounding:
+    the smallest margin of each constraint and its leg (first one on ties; NaN, a zero-length
+    leg, wins), the closest pair by Ericson's clamped closest points.
+    ``want_pair`` False skips the interference check (margin +inf).
+    """
+    lx = scratch[0]
+    ly = scratch[1]
+    lz = scratch[2]
+    sq = scratch[3]
+    inverse_sq = scratch[4]
+    r00, r01, r02 = r[0], r[1], r[2]
+    r10, r11, r12 = r[3], r[4], r[5]
+    r20, r21, r22 = r[6], r[7], r[8]
+    m_len = np.inf
+    leg_len = 0
+    m_a = np.inf
+    leg_a = 0
+    m_b = np.inf
+    leg_b = 0
+    shortest = np.inf
+    alpha_equal = model[ALPHA_EQUAL] != 0.0
+    beta_equal = model[BETA_EQUAL] != 0.0
+    for k in range(6):
+        bx = model[B + 3 * k]
+        by = model[B + 3 * k + 1]
+        bz = model[B + 3 * k + 2]
+        x = (r00 * bx + r01 * by + r02 * bz) + (px - model[A + 3 * k])
+        y = (r10 * bx + r11 * by + r12 * bz) + (py - model[A + 3 * k + 1])
+        z = (r20 * bx + r21 * by + r22 * bz) + (pz - model[A + 3 * k + 2])
+        lx[k] = x
+        ly[k] = y
+        lz[k] = z
+        squared = x * x + y * y + z * z
+        sq[k] = squared
+        length = math.sqrt(squared)
+        if length < shortest:
+            shortest = length
+        inverse = 1.0 / length
+        inverse_sq[k] = inverse * inverse
+        value = min(length - model[LMIN + k], model[LMAX + k] - length)
+        if value < m_len or (value != value and m_len == m_len):
+            m_len = value
+            leg_len = k
+        # Base joint: angle between jA_i and n_i.
+        cos_a = (
+            model[JA + 3 * k] * x + model[JA + 3 * k + 1] * y + model[JA + 3 * k + 2] * z
+        ) * inverse
+        # Platform joint: angle between R·jB_i and −n_i.
+        jx = model[JB + 3 * k]
+        jy = model[JB + 3 * k + 1]
+        jz = model[JB + 3 * k + 2]
+        cos_b = (
+            (r00 * jx + r01 * jy + r02 * jz) * x
+            + (r10 * jx + r11 * jy + r12 * jz) * y
+            + (r20 * jx + r21 * jy + r22 * jz) * z
+        ) * -inverse
+        # Equal limits: the margin decreases with the angle, the smallest cosine limits (one
+        # arccos per pose, below); otherwise the margin itself per leg.
+        value = cos_a if alpha_equal else model[ALPHA + k] - math.acos(min(max(cos_a, -1.0), 1.0))
+        if value < m_a or (value != value and m_a == m_a):
+            m_a = value
+            leg_a = k
+        value = cos_b if beta_equal else model[BETA + k] - math.acos(min(max(cos_b, -1.0), 1.0))
+        if value < m_b or (value != value and m_b == m_b):
+            m_b = value
+            leg_b = k
+    if alpha_equal:
+        m_a = model[ALPHA] - math.acos(min(max(m_a, -1.0), 1.0))
+    if beta_equal:
+        m_b = model[BETA] - math.acos(min(max(m_b, -1.0), 1.0))
+    out[LEG_LENGTH] = m_len
+    out[BASE_JOINT] = m_a
+    out[PLATFORM_JOINT] = m_b
+    out[OUT_LEG + LEG_LENGTH] = leg_len
+    out[OUT_LEG + BASE_JOINT] = leg_a
+    out[OUT_LEG + PLATFORM_JOINT] = leg_b
+    out[OUT_SHORTEST] = shortest
+    out[OUT_LEG + SINGULARITY] = 0
+    if model[SINGULARITY_ON] != 0.0:
+        rows = np.empty(ROWS_SCRATCH)
+        for k in range(6):
+            bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
+            _plucker_row(
+                rows,
+                k,
+                lx[k],
+                ly[k],
+                lz[k],
+                sq[k],
+                r00 * bx + r01 * by + r02 * bz,
+                r10 * bx + r11 * by + r12 * bz,
+                r20 * bx + r21 * by + r22 * bz,
+                model[RHO],
+            )
+        out[SINGULARITY] = _smallest_singular_value(rows) - model[SINGULARITY_MIN]
+    else:
+        out[SINGULARITY] = np.inf
+    if not want_pair or model[INTERFERENCE] == 0.0:
+        out[LEG_INTERFERENCE] = np.inf
+        out[OUT_LEG + LEG_INTERFERENCE] = 0
+        out[OUT_PAIR] = 0
+        out[OUT_PAIR + 1] = 0
+        return
+    # Pairs in the model's order (closest at the home pose first). A pair is skipped when an
+    # exact lower bound of its distance cannot beat the best so far: projected on the unit
+    # vector u = r/|r| (r = A_i − A_j), the segments are at least
+    # (|r|² + min(0, c) − max(0, f)) / |r| apart (c = L_i·r, f = L_j·r). The slack covers
+    # rounding, so a skipped pair never holds the minimum.
+    best = np.inf
+    best_squared = np.inf
+    best_pair = 0
+    for rank in range(15):
+        pair = int(model[ORDER + rank])
+        i = PAIR_I[pair]
+        j = PAIR_J[pair]
+        rx = model[RPAIR + 3 * pair]
+        ry = model[RPAIR + 3 * pair + 1]
+        rz = model[RPAIR + 3 * pair + 2]
+        rr = model[RR + pair]
+        xi = lx[i]
+        yi = ly[i]
+        zi = lz[i]
+        xj = lx[j]
+        yj = ly[j]
+        zj = lz[j]
+        c = xi * rx + yi * ry + zi * rz
+        f = xj * rx + yj * ry + zj * rz
+        a = sq[i]
+        e = sq[j]
+        gap = rr + min(c, 0.0) - max(f, 0.0)
+        if gap > 0.0 and gap * gap >= rr * (best_squared + 1e-12 * (rr + a + e)):
+            continue
+        b = xi * xj + yi * yj + zi * zj
+        denom = a * e - b * b
+        if denom > 1e-14 * a * e:
+            s = min(max((b * f - c * e) / denom, 0.0), 1.0)
+            t = min(max((b * s + f) * inverse_sq[j], 0.0), 1.0)
+            s = min(max((b * t - c) * inverse_sq[i], 0.0), 1.0)
+        else:
+            # Parallel or point-like segments (or NaN): start from s = 0.
+            t = 0.0 if e <= 1e-300 else _clamp01(f / e)
+            s = 0.0 if a <= 1e-300 else _clamp01((b * t - c) / a)
+        squared = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
+        # Compare distances, not their squares, where it matters: pairs whose squares differ
+        # in the last bit can have equal distances, and then the lower pair index limits.
+        if squared <= best_squared or squared != squared:
+            distance = math.sqrt(max(squared, 0.0))
+            if (
+                distance < best
+                or (distance == best and pair < best_pair)
+                or (distance != distance and best == best)
+            ):
+                best = distance
+                best_pair = pair
+            best_squared = min(squared, best_squared)
+    out[LEG_INTERFERENCE] = best - model[DIAMETER]
+    out[OUT_LEG + LEG_INTERFERENCE] = PAIR_I[best_pair]
+    out[OUT_PAIR] = PAIR_I[best_pair]
+    out[OUT_PAIR + 1] = PAIR_J[best_pair]
+
+
+# ------------------------------------------------------------------------------ singularity
+#: Scratch of the singularity margin: M (36), G (36), its tridiagonal form (6 + 6).
+ROWS_SCRATCH = 84
+
+
+@_helper
+def _plucker_row(
+    rows: NDArray[np.float64],
+    k: int,
+    x: float,
+    y: float,
+    z: float,
+    squared: float,
+    rbx: float,
+    rby: float,
+    rbz: float,
+    rho: float,
+) -> None:
+    """Row k of M into ``rows[6k : 6k + 6]``: (n_k, (R·b_k) × n_k / ρ), n_k = L_k / ℓ_k."""
+    inverse = 1.0 / math.sqrt(squared)
+    nx, ny, nz = x * inverse, y * inverse, z * inverse
+    rows[6 * k] = nx
+    rows[6 * k + 1] = ny
+    rows[6 * k + 2] = nz
+    rows[6 * k + 3] = (rby * nz - rbz * ny) / rho
+    rows[6 * k + 4] = (rbz * nx - rbx * nz) / rho
+    rows[6 * k + 5] = (rbx * ny - rby * nx) / rho
+
+
+@_helper
+def _smallest_singular_value(rows: NDArray[np.float64]) -> float:
+    """σ_min of the 6×6 matrix M in ``rows[:36]`` (row-major); ``rows[36:84]`` is scratch.
+
+    σ_min = √λ_min(G), G = MᵀM, with the eigenvalues of G by Householder reduction to
+    tridiagonal form and the implicit QL algorithm with Wilkinson shifts (eigenvalues only:
+    Press et al., *Numerical Recipes*, 2nd ed., sections 11.2-11.3, ``tred2``/``tqli``; what
+    LAPACK's dsterf does), about 600 flops. Backward stable: λ_min to ε·‖G‖, so σ_min to
+    ≈ ε·‖M‖² / σ_min (1e-14 for σ_min ≥ 0.01), enough for a margin compared with a limit
+    σ_lim > 0; ``test/test_singularity.py`` compares it with numpy's SVD. NaN rows (a
+    zero-length leg) give NaN.
+    """
+    a = rows[36:72]
+    for i in range(6):
+        for j in range(i + 1):
+            total = 0.0
+            for k in range(6):
+                total += rows[6 * k + i] * rows[6 * k + j]
+            a[6 * i + j] = total
+            a[6 * j + i] = total
+    d = rows[72:78]
+    e = rows[78:84]
+    # Householder reduction of the lower triangle to tridiagonal form (d diagonal, e below).
+    for i in range(5, 0, -1):
+        low = i - 1
+        h = 0.0
+        if low > 0:
+            scale = 0.0
+            for k in range(low + 1):
+                scale += abs(a[6 * i + k])
+            if scale == 0.0:
+                e[i] = a[6 * i + low]
+            else:
+                for k in range(low + 1):
+                    a[6 * i + k] /= scale
+                    h += a[6 * i + k] * a[6 * i + k]
+                f = a[6 * i + low]
+                g = -math.sqrt(h) if f >= 0.0 else math.sqrt(h)
+                e[i] = scale * g
+                h -= f * g
+                a[6 * i + low] = f - g
+                f = 0.0
+                for j in range(low + 1):
+                    g = 0.0
+                    for k in range(j + 1):
+                        g += a[6 * j + k] * a[6 * i + k]
+                    for k in range(j + 1, low + 1):
+                        g += a[6 * k + j] * a[6 * i + k]
+                    e[j] = g / h
+                    f += e[j] * a[6 * i + j]
+                hh = f / (h + h)
+                for j in range(low + 1):
+                    f = a[6 * i + j]
+                    g = e[j] - hh * f
+                    e[j] = g
+                    for k in range(j + 1):
+                        a[6 * j + k] -= f * e[k] + g * a[6 * i + k]
+        else:
+            e[i] = a[6 * i + low]
+    for i in range(6):
+        d[i] = a[7 * i]
+    # Implicit QL with shifts on the tridiagonal matrix.
+    for i in range(1, 6):
+        e[i - 1] = e[i]
+    e[5] = 0.0
+    for low in range(6):
+        for _iteration in range(60):
+            m = low
+            while m < 5:
+                dd = abs(d[m]) + abs(d[m + 1])
+                if abs(e[m]) + dd == dd:
+                    break
+                m += 1
+            if m == low:
+                break
+            g = (d[low + 1] - d[low]) / (2.0 * e[low])
+            r = math.sqrt(g * g + 1.0)
+            g = d[m] - d[low] + e[low] / (g + (r if g >= 0.0 else -r))
+            s = 1.0
+            c = 1.0
+            p = 0.0
+            i = m - 1
+            deflated = False
+            while i >= low:
+                f = s * e[i]
+                b = c * e[i]
+                r = math.sqrt(f * f + g * g)
+                e[i + 1] = r
+                if r == 0.0:
+                    d[i + 1] -= p
+                    e[m] = 0.0
+                    deflated = True
+                    break
+                s = f / r
+                c = g / r
+                g = d[i + 1] - p
+                r = (d[i] - g) * s + 2.0 * c * b
+                p = s * r
+                d[i + 1] = g + p
+                g = c * r - b
+                i -= 1
+            if deflated:
+                continue
+            d[low] -= p
+            e[low] = g
+            e[m] = 0.0
+    smallest = d[0]
+    for i in range(1, 6):
+        if d[i] < smallest or d[i] != d[i]:
+            smallest = d[i]
+    return math.sqrt(max(smallest, 0.0)) if smallest == smallest else smallest
+
+
+@_helper
+def _block_singularity(
+    model: NDArray[np.float64], work: NDArray[np.float64], count: int, rows: NDArray[np.float64]
+) -> None:
+    """The singularity margin of the poses of a block that take the vectorised path (the
+    others are computed whole by :func:`_pose`) into the _SIGMA row, from the leg and rotation
+    planes (before the outputs overwrite the rotation planes)."""
+    for n in range(count):
+        if work[(_MIN + _FIX) * BLOCK + n] != 0.0:
+            continue
+        for k in range(6):
+            leg = (_LEGS + 7 * k) * BLOCK + n
+            bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
+            rbx = (
+                work[_R * BLOCK + n] * bx
+                + work[(_R + 1) * BLOCK + n] * by
+                + work[(_R + 2) * BLOCK + n] * bz
+            )
+            rby = (
+                work[(_R + 3) * BLOCK + n] * bx
+                + work[(_R + 4) * BLOCK + n] * by
+                + work[(_R + 5) * BLOCK + n] * bz
+            )
+            rbz = (
+                work[(_R + 6) * BLOCK + n] * bx
+                + work[(_R + 7) * BLOCK + n] * by
+                + work[(_R + 8) * BLOCK + n] * bz
+            )
+            _plucker_row(
+                rows,
+                k,
+                work[leg + _LX * BLOCK],
+                work[leg + _LY * BLOCK],
+                work[leg + _LZ * BLOCK],
+                work[leg + _SQ * BLOCK],
+                rbx,
+                rby,
+                rbz,
+                model[RHO],
+            )
+        work[_SIGMA * BLOCK + n] = _smallest_singular_value(rows) - model[SINGULARITY_MIN]
+
+
+# ------------------------------------------------------------------------------ sin and cos
+# Cody–Waite reduction by π/2 in three parts of 33 bits (exact products for |k| < 2**20) and the
+# Cephes polynomials on [−π/4, π/4]: within 1 ulp of libm, and branch-free, so that loops over a
+# block of poses vectorise. Arguments beyond FAST_TRIG_LIMIT use libm (see _check_block).
+PIO2_1 = 1.57079632673412561417e00
+PIO2_2 = 6.07710050630396597660e-11
+PIO2_3 = 2.02226624879595063154e-21
+TWO_OVER_PI = 0.6366197723675814
+FAST_TRIG_LIMIT = 1e5
+SIN_0, SIN_1, SIN_2 = (
+    1.58962301576546568060e-10,
+    -2.50507477628578072866e-8,
+    2.75573136213857245213e-6,
+)
+SIN_3, SIN_4, SIN_5 = (
+    -1.98412698295895385996e-4,
+    8.33333333332211858878e-3,
+    -1.66666666666666307295e-1,
+)
+COS_0, COS_1, COS_2 = (
+    -1.13585365213876817300e-11,
+    2.08757008419747316778e-9,
+    -2.75573141792967388112e-7,
+)
+COS_3, COS_4, COS_5 = (
+    2.48015872888517045348e-5,
+    -1.38888888888730564116e-3,
+    4.16666666666665929218e-2,
+)
+
+
+@_inline
+def _sincos(x: float) -> tuple[float, float]:
+    """(sin x, cos x) for |x| ≤ FAST_TRIG_LIMIT, branch-free."""
+    k = math.floor(x * TWO_OVER_PI + 0.5)
+    r = ((x - k * PIO2_1) - k * PIO2_2) - k * PIO2_3
+    z = r * r
+    sine = r + r * z * (((((SIN_0 * z + SIN_1) * z + SIN_2) * z + SIN_3) * z + SIN_4) * z + SIN_5)
+    cosine = (
+        1.0
+        - 0.5 * z
+        + z * z * (((((COS_0 * z + COS_1) * z + COS_2) * z + COS_3) * z + COS_4) * z + COS_5)
+    )
+    quadrant = k - 4.0 * math.floor(k * 0.25)
+    odd = quadrant == 1.0 or quadrant == 3.0
+    sin_value = cosine if odd else sine
+    cos_value = sine if odd else cosine
+    sin_value = -sin_value if quadrant >= 2.0 else sin_value
+    cos_value = -cos_value if (quadrant == 1.0 or quadrant == 2.0) else cos_value
+    return sin_value, cos_value
+
+
+@_helper
+def _tt_matrix(phi: float, theta: float, psi: float, r: NDArray[np.float64]) -> None:
+    """R(φ, θ, ψ) = Rz(φ)·Ry(θ)·Rz(ψ − φ) into r (9,), row-major (as rotations.tt_to_matrix).
+
+    Huge angles are first reduced to their principal values (libm reduces exactly): ψ − φ of
+    two huge angles would be rounded to another orientation than the one they denote.
+    """
+    if max(abs(phi), abs(theta), abs(psi)) > FAST_TRIG_LIMIT:
+        phi = math.atan2(math.sin(phi), math.cos(phi))
+        theta = math.atan2(math.sin(theta), math.cos(theta))
+        psi = math.atan2(math.sin(psi), math.cos(psi))
+    gamma = psi - phi
+    if max(abs(phi), abs(theta), abs(gamma)) <= FAST_TRIG_LIMIT:
+        sa, ca = _sincos(phi)
+        sb, cb = _sincos(theta)
+        sg, cg = _sincos(gamma)
+    else:
+        ca, sa = math.cos(phi), math.sin(phi)
+        cb, sb = math.cos(theta), math.sin(theta)
+        cg, sg = math.cos(gamma), math.sin(gamma)
+    r[0] = ca * cb * cg - sa * sg
+    r[1] = -ca * cb * sg - sa * cg
+    r[2] = ca * sb
+    r[3] = sa * cb * cg + ca * sg
+    r[4] = -sa * cb * sg + ca * cg
+    r[5] = sa * sb
+    r[6] = -sb * cg
+    r[7] = sb * sg
+    r[8] = cb
+
+
+@_helper
+def _limiting_constraint(model: NDArray[np.float64], out: NDArray[np.float64]) -> int:
+    """Index of the smallest relative margin (first on ties; NaN wins)."""
+    best = out[0] / model[SCALE]
+    index = 0
+    for c in range(1, N_CONSTRAINTS):
+        value = out[c] / model[SCALE + c]
+        if value < best or (value != value and best == best):
+            best = value
+            index = c
+    return index
+
+
+@_helper
+def _feasible(out: NDArray[np.float64]) -> bool:
+    """Every margin ≥ 0 (NaN counts as violated)."""
+    for c in range(N_CONSTRAINTS):  # noqa: SIM110 - a loop numba compiles, not a generator
+        if not out[c] >= 0.0:
+            return False
+    return True
+
+
+# ------------------------------------------------------------------------------ blocks of poses
+#: Poses per block of the vectorised check (its working planes stay in the L1/L2 cache).
+BLOCK = 128
+# Rows of the block scratch (each a plane of BLOCK poses, in one flat array).
+_CA, _SA, _CB, _SB, _CG, _SG = 0, 1, 2, 3, 4, 5
+_R = 6  # 9 rows: rotation matrix, row-major
+_PHI, _THETA, _PSI = 15, 16, 17
+_MIN = 18  # 9 rows: running minima, see the offsets below
+_LEGS = 27  # 7 rows per leg, see the offsets below
+_SIGMA = _LEGS + 6 * 7  # σ_min − σ_lim of each pose (when the singularity margin is on)
+_BLOCK_ROWS = _SIGMA + 1
+# Rows of the running minima (offsets from _MIN): margins or cosines and their leg or pair.
+_M_LEN, _LEG_LEN, _M_A, _LEG_A, _M_B, _LEG_B, _BEST, _PAIR, _FIX = range(9)
+# Rows of one leg (offsets from _LEGS + 7·k): vector, squared length, 1/ℓ², joint cosines.
+_LX, _LY, _LZ, _SQ, _INV, _COS_A, _COS_B = range(7)
+
+
+@_helper
+def _planes(work: NDArray[np.float64], row: int, rows: int) -> NDArray[np.float64]:
+    """The planes [row, row + rows) of a block scratch, as one flat view."""
+    return work[row * BLOCK : (row + rows) * BLOCK]
+
+
+# The leg and pair stages take their planes as separate views with constant row offsets inside:
+# the compiler then needs only a few run-time overlap checks between views, and vectorises.
+@_helper
+def _leg_planes(
+    model: NDArray[np.float64],
+    rotation: NDArray[np.float64],
+    leg: NDArray[np.float64],
+    minima: NDArray[np.float64],
+    count: int,
+    k: int,
+    px: float,
+    py: float,
+    pz: float,
+) -> None:
+    """Leg k over a block: vector, squared length, 1/ℓ², joint cosines; updates the running
+    minima of the leg-length margin and of both cosines with their legs (first leg on ties)."""
+    bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
+    ox, oy, oz = px - model[A + 3 * k], py - model[A + 3 * k + 1], pz - model[A + 3 * k + 2]
+    jax, jay, jaz = model[JA + 3 * k], model[JA + 3 * k + 1], model[JA + 3 * k + 2]
+    jbx, jby, jbz = model[JB + 3 * k], model[JB + 3 * k + 1], model[JB + 3 * k + 2]
+    lmin, lmax, kf = model[LMIN + k], model[LMAX + k], float(k)
+    for n in range(count):
+        r00, r01, r02 = rotation[n], rotation[BLOCK + n], rotation[2 * BLOCK + n]
+        r10, r11, r12 = rotation[3 * BLOCK + n], rotation[4 * BLOCK + n], rotation[5 * BLOCK + n]
+        r20, r21, r22 = rotation[6 * BLOCK + n], rotation[7 * BLOCK + n], rotation[8 * BLOCK + n]
+        x = (r00 * bx + r01 * by + r02 * bz) + ox
+        y = (r10 * bx + r11 * by + r12 * bz) + oy
+        z = (r20 * bx + r21 * by + r22 * bz) + oz
+        leg[_LX * BLOCK + n] = x
+        leg[_LY * BLOCK + n] = y
+        leg[_LZ * BLOCK + n] = z
+        squared = x * x + y * y + z * z
+        leg[_SQ * BLOCK + n] = squared
+        length = math.sqrt(squared)
+        inverse = 1.0 / length
+        leg[_INV * BLOCK + n] = inverse * inverse
+        value = min(length - lmin, lmax - length)
+        # Running minimum and its leg, one select per statement (so that the loop vectorises).
+        smallest = minima[_M_LEN * BLOCK + n]
+        minima[_LEG_LEN * BLOCK + n] = kf if value < smallest else minima[_LEG_LEN * BLOCK + n]
+        minima[_M_LEN * BLOCK + n] = min(value, smallest)
+        cos_a = (jax * x + jay * y + jaz * z) * inverse
+        cos_b = (
+            (r00 * jbx + r01 * jby + r02 * jbz) * x
+            + (r10 * jbx + r11 * jby + r12 * jbz) * y
+            + (r20 * jbx + r21 * jby + r22 * jbz) * z
+        ) * -inverse
+        leg[_COS_A * BLOCK + n] = cos_a
+        leg[_COS_B * BLOCK + n] = cos_b
+        smallest = minima[_M_A * BLOCK + n]
+        minima[_LEG_A * BLOCK + n] = kf if cos_a < smallest else minima[_LEG_A * BLOCK + n]
+        minima[_M_A * BLOCK + n] = min(cos_a, smallest)
+        smallest = minima[_M_B * BLOCK + n]
+        minima[_LEG_B * BLOCK + n] = kf if cos_b < smallest else minima[_LEG_B * BLOCK + n]
+        minima[_M_B * BLOCK + n] = min(cos_b, smallest)
+        degenerate = 0.0 if squared > 1e-300 else 1.0
+        minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], degenerate)
+
+
+@_helper
+def _pair_plane(
+    model: NDArray[np.float64],
+    leg_i: NDArray[np.float64],
+    leg_j: NDArray[np.float64],
+    minima: NDArray[np.float64],
+    count: int,
+    pair: int,
+) -> None:
+    """Segment distance of two legs (pair index ``pair``) over a block (Ericson's clamped
+    closest points, as the reference); updates the running minimum and its pair (first pair on
+    ties) and flags parallel or point-like legs for the exact path."""
+    rx = model[RPAIR + 3 * pair]
+    ry = model[RPAIR + 3 * pair + 1]
+    rz = model[RPAIR + 3 * pair + 2]
+    rr, pf = model[RR + pair], float(pair)
+    for n in range(count):
+        xi, yi, zi = leg_i[_LX * BLOCK + n], leg_i[_LY * BLOCK + n], leg_i[_LZ * BLOCK + n]
+        xj, yj, zj = leg_j[_LX * BLOCK + n], leg_j[_LY * BLOCK + n], leg_j[_LZ * BLOCK + n]
+        a, e = leg_i[_SQ * BLOCK + n], leg_j[_SQ * BLOCK + n]
+        b = xi * xj + yi * yj + zi * zj
+        c = xi * rx + yi * ry + zi * rz
+        f = xj * rx + yj * ry + zj * rz
+        denom = a * e - b * b
+        s = min(max((b * f - c * e) / denom, 0.0), 1.0)
+        t = min(max((b * s + f) * leg_j[_INV * BLOCK + n], 0.0), 1.0)
+        s = min(max((b * t - c) * leg_i[_INV * BLOCK + n], 0.0), 1.0)
+        squared = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
+        distance = math.sqrt(max(squared, 0.0))
+        smallest = minima[_BEST * BLOCK + n]
+        minima[_PAIR * BLOCK + n] = pf if distance < smallest else minima[_PAIR * BLOCK + n]
+        minima[_BEST * BLOCK + n] = min(distance, smallest)
+        regular = 0.0 if denom > 1e-14 * a * e else 1.0
+        minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], regular)
+
+
+@_helper
+def _check_block(
+    model: NDArray[np.float64],
+    angles: NDArray[np.float64],
+    position: NDArray[np.float64],
+    first: int,
+    count: int,
+    work: NDArray[np.float64],
+    scratch: NDArray[np.float64],
+    out: NDArray[np.float64],
+    r: NDArray[np.float64],
+) -> None:
+    """Margins of poses angles[first : first + count] (count ≤ BLOCK) into ``work`` planes.
+
+    Every stage is a loop over the poses of the block without branches, which the compiler
+    vectorises; poses that need care (a zero-length leg, parallel or point-like legs, huge
+    angles) are flagged in the _FIX row and recomputed one by one by :func:`_pose` (with libm's
+    sin and cos for huge angles). Leaves in ``work``: margins in rows 0..3, legs in 4..7, pair
+    in 8..9 (as floats).
+    """
+    px, py, pz = position[0], position[1], position[2]
+    for n in range(count):  # strided reads: a loop of its own (it does not vectorise)
+        work[_PHI * BLOCK + n] = angles[first + n, 0]
+        work[_THETA * BLOCK + n] = angles[first + n, 1]
+        work[_PSI * BLOCK + n] = angles[first + n, 2]
+    for n in range(count):
+        phi = work[_PHI * BLOCK + n]
+        theta = work[_THETA * BLOCK + n]
+        gamma = work[_PSI * BLOCK + n] - phi
+        work[_SA * BLOCK + n], work[_CA * BLOCK + n] = _sincos(phi)
+        work[_SB * BLOCK + n], work[_CB * BLOCK + n] = _sincos(theta)
+        work[_SG * BLOCK + n], work[_CG * BLOCK + n] = _sincos(gamma)
+        largest = max(abs(phi), abs(theta), abs(work[_PSI * BLOCK + n]), abs(gamma))
+        work[(_MIN + _FIX) * BLOCK + n] = 1.0 if largest > FAST_TRIG_LIMIT else 0.0
+        work[(_MIN + _M_LEN) * BLOCK + n] = np.inf
+        work[(_MIN + _M_A) * BLOCK + n] = np.inf
+        work[(_MIN + _M_B) * BLOCK + n] = np.inf
+        work[(_MIN + _LEG_LEN) * BLOCK + n] = 0.0
+        work[(_MIN + _LEG_A) * BLOCK + n] = 0.0
+        work[(_MIN + _LEG_B) * BLOCK + n] = 0.0
+        work[(_MIN + _BEST) * BLOCK + n] = np.inf
+        work[(_MIN + _PAIR) * BLOCK + n] = 0.0
+    for n in range(count):
+        ca, sa = work[_CA * BLOCK + n], work[_SA * BLOCK + n]
+        cb, sb = work[_CB * BLOCK + n], work[_SB * BLOCK + n]
+        cg, sg = work[_CG * BLOCK + n], work[_SG * BLOCK + n]
+        work[_R * BLOCK + n] = ca * cb * cg - sa * sg
+        work[(_R + 1) * BLOCK + n] = -ca * cb * sg - sa * cg
+        work[(_R + 2) * BLOCK + n] = ca * sb
+        work[(_R + 3) * BLOCK + n] = sa * cb * cg + ca * sg
+        work[(_R + 4) * BLOCK + n] = -sa * cb * sg + ca * cg
+        work[(_R + 5) * BLOCK + n] = sa * sb
+        work[(_R + 6) * BLOCK + n] = -sb * cg
+        work[(_R + 7) * BLOCK + n] = sb * sg
+        work[(_R + 8) * BLOCK + n] = cb
+    rotation = _planes(work, _R, 9)
+    minima = _planes(work, _MIN, 9)
+    for k in range(6):
+        _leg_planes(model, rotation, _planes(work, _LEGS + 7 * k, 7), minima, count, k, px, py, pz)
+    interference = model[INTERFERENCE] != 0.0
+    if interference:
+        pair = 0
+        for i in range(5):  # pairs in index order: the first pair wins ties, as the reference
+            for j in range(i + 1, 6):
+                leg_i = _planes(work, _LEGS + 7 * i, 7)
+                leg_j = _planes(work, _LEGS + 7 * j, 7)
+                _pair_plane(model, leg_i, leg_j, minima, count, pair)
+                pair += 1
+    singular = model[SINGULARITY_ON] != 0.0
+    if singular:
+        _block_singularity(model, work, count, np.empty(ROWS_SCRATCH))
+    # Per pose: the joint-angle margins (arccos), the rare poses that need care, the outputs.
+    alpha_equal = model[ALPHA_EQUAL] != 0.0
+    beta_equal = model[BETA_EQUAL] != 0.0
+    for n in range(count):
+        if work[(_MIN + _FIX) * BLOCK + n] != 0.0:
+            _tt_matrix(angles[first + n, 0], angles[first + n, 1], angles[first + n, 2], r)
+            _pose(model, r, px, py, pz, scratch, out, True)
+            for slot in range(OUT_SHORTEST):
+                work[(slot) * BLOCK + n] = out[slot]
+            continue
+        work[LEG_LENGTH * BLOCK + n] = work[(_MIN + _M_LEN) * BLOCK + n]
+        work[(OUT_LEG + LEG_LENGTH) * BLOCK + n] = work[(_MIN + _LEG_LEN) * BLOCK + n]
+        if alpha_equal:
+            work[BASE_JOINT * BLOCK + n] = model[ALPHA] - math.acos(
+                min(max(work[(_MIN + _M_A) * BLOCK + n], -1.0), 1.0)
+            )
+            work[(OUT_LEG + BASE_JOINT) * BLOCK + n] = work[(_MIN + _LEG_A) * BLOCK + n]
+        else:
+            work[BASE_JOINT * BLOCK + n], work[(OUT_LEG + BASE_JOINT) * BLOCK + n] = _per_leg_angle(
+                model, ALPHA, work, _COS_A, n
+            )
+        if beta_equal:
+            work[PLATFORM_JOINT * BLOCK + n] = model[BETA] - math.acos(
+                min(max(work[(_MIN + _M_B) * BLOCK + n], -1.0), 1.0)
+            )
+            work[(OUT_LEG + PLATFORM_JOINT) * BLOCK + n] = work[(_MIN + _LEG_B) * BLOCK + n]
+        else:
+            work[PLATFORM_JOINT * BLOCK + n], work[(OUT_LEG + PLATFORM_JOINT) * BLOCK + n] = (
+                _per_leg_angle(model, BETA, work, _COS_B, n)
+            )
+        if interference:
+            pair = int(work[(_MIN + _PAIR) * BLOCK + n])
+            work[LEG_INTERFERENCE * BLOCK + n] = work[(_MIN + _BEST) * BLOCK + n] - model[DIAMETER]
+            work[(OUT_LEG + LEG_INTERFERENCE) * BLOCK + n] = PAIR_I[pair]
+            work[OUT_PAIR * BLOCK + n] = PAIR_I[pair]
+            work[(OUT_PAIR + 1) * BLOCK + n] = PAIR_J[pair]
+        else:
+            work[LEG_INTERFERENCE * BLOCK + n] = np.inf
+            work[(OUT_LEG + LEG_INTERFERENCE) * BLOCK + n] = 0.0
+            work[OUT_PAIR * BLOCK + n] = 0.0
+            work[(OUT_PAIR + 1) * BLOCK + n] = 0.0
+        work[SINGULARITY * BLOCK + n] = work[_SIGMA * BLOCK + n] if singular else np.inf
+        work[(OUT_LEG + SINGULARITY) * BLOCK + n] = 0.0
+
+
+@_helper
+def _per_leg_angle(
+    model: NDArray[np.float64], limits: int, work: NDArray[np.float64], row: int, n: int
+) -> tuple[float, float]:
+    """min_i (limit_i − arccos(cos_i)) and its leg, for per-leg joint limits (``row`` is the
+    cosine row within each leg's planes)."""
+    best = np.inf
+    leg = 0.0
+    for k in range(6):
+        cosine = work[(_LEGS + 7 * k + row) * BLOCK + n]
+        value = model[limits + k] - math.acos(min(max(cosine, -1.0), 1.0))
+        if value < best:
+            best = value
+            leg = float(k)
+    return best, leg
+
+
+# ------------------------------------------------------------------------------ batches
+@_jit
+def check_angles(
+    model: NDArray[np.float64],
+    angles: NDArray[np.float64],
+    position: NDArray[np.float64],
+    start: int,
+    stop: int,
+    margins: NDArray[np.float64],
+    ints: NDArray[np.int64],
+    pairs: NDArray[np.int64],
+    reachable: NDArray[np.bool_],
+) -> int:
+    """Check poses ``angles[start:stop]`` (N, 3) of T&T angles (rad) at ``position`` (3,), m.
+
+    Writes, for each pose n in [start, stop): ``margins[:, n]`` (C, N) with C = N_CONSTRAINTS;
+    ``ints[:C, n]`` (C + 2, N), the 1-based leg with the smallest margin of each constraint,
+    ``ints[C, n]`` the constraint with the smallest relative margin and ``ints[C + 1, n]`` its
+    leg; ``pairs[n]`` (N, 2), the
+    1-based closest pair; ``reachable[n]``. Legs and pairs of ``leg_interference`` are 0 when
+    the check is disabled. Releases the GIL (threads split large batches).
+
+    Returns
+    -------
+    int
+        −1 when every input is finite (and the outputs are written); otherwise nothing is
+        written and it is the first pose in [start, stop) with a non-finite angle, or −2 when
+        the angles are finite and the position is not.
+    """
+    for n in range(start, stop):
+        if not (
+            math.isfinite(angles[n, 0])
+            and math.isfinite(angles[n, 1])
+            and math.isfinite(angles[n, 2])
+        ):
+            return n
+    for k in range(3):
+        if not math.isfinite(position[k]):
+            return -2
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    work = np.empty(_BLOCK_ROWS * BLOCK)
+    enabled = 1 if model[INTERFERENCE] != 0.0 else 0
+    for first in range(start, stop, BLOCK):
+        count = min(BLOCK, stop - first)
+        _check_block(model, angles, position, first, count, work, scratch, out, r)
+        for m in range(count):
+            n = first + m
+            for c in range(N_CONSTRAINTS):
+                out[c] = work[c * BLOCK + m]
+                margins[c, n] = out[c]
+                ints[c, n] = int(work[(OUT_LEG + c) * BLOCK + m]) + 1
+            ints[LEG_INTERFERENCE, n] *= enabled
+            ints[SINGULARITY, n] = 0  # a property of all legs together: no limiting leg
+            pairs[n, 0] = (int(work[OUT_PAIR * BLOCK + m]) + 1) * enabled
+            pairs[n, 1] = (int(work[(OUT_PAIR + 1) * BLOCK + m]) + 1) * enabled
+            worst = _limiting_constraint(model, out)
+            ints[N_CONSTRAINTS, n] = worst
+            ints[N_CONSTRAINTS + 1, n] = ints[worst, n]
+            reachable[n] = _feasible(out)
+    return -1
+
+
+@_jit
+def check_one(
+    model: NDArray[np.float64],
+    phi: float,
+    theta: float,
+    psi: float,
+    px: float,
+    py: float,
+    pz: float,
+    result: NDArray[np.float64],
+) -> None:
+    """One pose (φ, θ, ψ) rad at (px, py, pz) m, finite; the fast path of constraints.check_pose.
+
+    Writes ``result`` (ONE_SIZE,): margins (N_CONSTRAINTS), 1-based limiting legs
+    (N_CONSTRAINTS; the interference leg 0 when the check is disabled), closest pair (2, 1-based;
+    0 when disabled), the limiting constraint and its leg, and 1.0 when reachable (else 0.0).
+    """
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    _tt_matrix(phi, theta, psi, r)
+    _pose(model, r, px, py, pz, scratch, out, True)
+    enabled = 1.0 if model[INTERFERENCE] != 0.0 else 0.0
+    count = N_CONSTRAINTS
+    for c in range(count):
+        result[c] = out[c]
+        result[count + c] = out[OUT_LEG + c] + 1.0
+    result[count + LEG_INTERFERENCE] *= enabled
+    result[count + SINGULARITY] = 0.0
+    result[2 * count] = (out[OUT_PAIR] + 1.0) * enabled
+    result[2 * count + 1] = (out[OUT_PAIR + 1] + 1.0) * enabled
+    worst = _limiting_constraint(model, out)
+    result[2 * count + 2] = worst
+    result[2 * count + 3] = result[count + worst]
+    result[2 * count + 4] = 1.0 if _feasible(out) else 0.0
+
+
+@_jit
+def margins_rotations(
+    model: NDArray[np.float64],
+    rotations: NDArray[np.float64],
+    positions: NDArray[np.float64],
+    interference: bool,
+    margins: NDArray[np.float64],
+    legs: NDArray[np.int64],
+    pairs: NDArray[np.int64],
+) -> None:
+    """Margins of N poses given as rotation matrices (N, 3, 3) at positions (M, 3), M ∈ {1, N}.
+
+    Writes ``margins`` (C, N), ``legs`` (C, N) (C = N_CONSTRAINTS) and ``pairs`` (N, 2) as
+    :func:`check_angles`.
+    """
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    shared = positions.shape[0] == 1
+    for n in range(rotations.shape[0]):
+        for i in range(3):
+            for j in range(3):
+                r[3 * i + j] = rotations[n, i, j]
+        p = 0 if shared else n
+        _pose(
+            model, r, positions[p, 0], positions[p, 1], positions[p, 2], scratch, out, interference
+        )
+        for c in range(N_CONSTRAINTS):
+            margins[c, n] = out[c]
+            legs[c, n] = int(out[OUT_LEG + c])
+        pairs[n, 0] = int(out[OUT_PAIR])
+        pairs[n, 1] = int(out[OUT_PAIR + 1])

@@ -1,0 +1,375 @@
+"""Search kernels (numba): the certified march + secant/bisection of
+:mod:`hexapod_workspace.core.search` along whole families of rays, and the torsion scan.
+
+Every ray's probes are evaluated together with the block kernel of
+:mod:`hexapod_workspace.core.margin_kernels`, so that a search pays no per-call overhead per step.
+"""
+
+from __future__ import annotations
+
+import math
+
+# Imported first: it points numba's cache directory somewhere writable before numba loads.
+from .jit import helper as _helper
+from .jit import jit as _jit
+
+# isort: split
+import numpy as np
+from numpy.typing import NDArray
+
+from .constraint_table import LEG_LENGTH, N_CONSTRAINTS
+from .margin_kernels import (
+    _BLOCK_ROWS,
+    BLOCK,
+    OUT_SHORTEST,
+    OUT_SIZE,
+    _check_block,
+    _feasible,
+    _limiting_constraint,
+    _pose,
+    _tt_matrix,
+)
+from .model_layout import ESTIMATE_RATE, LENGTH_FLOOR, RAY_CONSTANT, RAY_TURN, RHO
+
+__all__ = ["KIND_CYLINDRICAL", "KIND_TT", "MAX_STEP", "SAFETY", "search_rays", "torsion_scan"]
+
+# Search constants, shared with core.search (which documents them).
+MAX_STEP = 1.0
+SAFETY = 1.0 - 1e-9
+#: Ray kinds: angles along a ray are origin + s·direction in T&T coordinates (φ, θ, ψ), or in
+#: the cylindrical picture (x, y, ψ) with x = θ cos φ, y = θ sin φ.
+KIND_TT, KIND_CYLINDRICAL = 0, 1
+
+
+# ------------------------------------------------------------------------------ ray searches
+@_helper
+def _ray_angles(
+    kind: int,
+    origin: NDArray[np.float64],
+    direction: NDArray[np.float64],
+    s: float,
+    angles: NDArray[np.float64],
+    row: int,
+) -> None:
+    """T&T angles of the ray origin + s·direction (KIND_TT or KIND_CYLINDRICAL) into angles[row]."""
+    if kind == KIND_TT:
+        angles[row, 0] = origin[0] + s * direction[0]
+        angles[row, 1] = origin[1] + s * direction[1]
+        angles[row, 2] = origin[2] + s * direction[2]
+    else:
+        x = origin[0] + s * direction[0]
+        y = origin[1] + s * direction[1]
+        theta = math.hypot(x, y)
+        angles[row, 0] = math.atan2(y, x) if theta > 0.0 else 0.0
+        angles[row, 1] = theta
+        angles[row, 2] = origin[2] + s * direction[2]
+
+
+@_helper
+def _rate(model: NDArray[np.float64], c: int, floor: float) -> float:
+    """Lipschitz rate of margin ``c`` along a ray (ω ≤ 1, joints at ≤ ρ) with legs at least
+    ``floor`` long: speed·ρ + turn·ρ/floor + spin, from its row of the constraint table (the
+    turn term left out where its coefficient is 0, so a zero floor costs nothing there)."""
+    rate: float = model[RAY_CONSTANT + c]
+    turn = model[RAY_TURN + c]
+    if turn != 0.0:
+        rate += turn / floor
+    return rate
+
+
+@_helper
+def _estimate(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
+    """Signed distance estimate min_c m_c / L_c with fixed Lipschitz constants, rad (NaN wins).
+
+    The constants are the ray rates of the constraint table with the fixed leg floor
+    ESTIMATE_FLOOR (precomputed in the model): a continuous estimate for the secant steps, not
+    a certificate."""
+    best: float = out[0] / model[ESTIMATE_RATE]
+    for c in range(1, N_CONSTRAINTS):
+        value = out[c] / model[ESTIMATE_RATE + c]
+        if value < best or value != value:
+            best = value
+    return best
+
+
+@_helper
+def _fmin(a: float, b: float) -> float:
+    """numpy.fmin: the smaller, ignoring a NaN."""
+    if a != a:
+        return b
+    if b != b:
+        return a
+    return a if a < b else b
+
+
+@_helper
+def certified_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
+    """Length over which no margin can reach zero, from feasible margins (core.search)."""
+    rho = model[RHO]
+    length_min = model[LENGTH_FLOOR]
+    length_now = length_min + max(out[LEG_LENGTH], 0.0)
+    floor = max(length_min, 0.5 * length_now)
+    step = out[0] / _rate(model, 0, floor)
+    for c in range(1, N_CONSTRAINTS):
+        step = _fmin(step, out[c] / _rate(model, c, floor))
+    step = _fmin(step, 0.5 * length_now / rho)
+    step = _fmin(step, MAX_STEP)
+    if not step > 0.0:  # numpy.fmax(step, 0) (a NaN step becomes 0)
+        step = 0.0
+    return step * SAFETY
+
+
+@_helper
+def recovery_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
+    """Length over which a violated pose stays violated: the most violated constraint, in
+    Lipschitz units, cannot climb back to zero within |m_c| / L_c; joint-angle bounds use half
+    the current shortest leg, and the step keeps every leg at least that long."""
+    rho: float = model[RHO]
+    floor: float = 0.5 * out[OUT_SHORTEST]
+    recover = 0.0
+    for c in range(N_CONSTRAINTS):
+        value = -out[c] / _rate(model, c, floor) if out[c] < 0.0 else 0.0
+        if value > recover or value != value:
+            recover = value
+    return min(recover, floor / rho) * SAFETY
+
+
+# Phases of a ray in search_rays.
+_MARCH, _GUESS, _PLUS, _DONE = 0, 1, 2, 3
+
+
+@_jit
+def search_rays(
+    model: NDArray[np.float64],
+    position: NDArray[np.float64],
+    kind: int,
+    origins: NDArray[np.float64],
+    directions: NDArray[np.float64],
+    s_start: NDArray[np.float64],
+    s_end: NDArray[np.float64],
+    tolerance: float,
+    min_step: float,
+    feasible: NDArray[np.float64],
+    violated: NDArray[np.float64],
+    limiting: NDArray[np.int64],
+    start_feasible: NDArray[np.bool_],
+) -> int:
+    """First violation along rays (the algorithm of core.search, all rays in lockstep).
+
+    Each round takes the next probe of every unfinished ray and evaluates them together with
+    the vectorised block kernel; per ray, the sequence of probes is that of a search along it
+    alone: a march with certified steps, then secant guesses on the distance estimate
+    (bisection when a secant step fails to halve the bracket), two probes around each guess,
+    the second only when the first is feasible.
+
+    Parameters
+    ----------
+    model : ndarray, shape (MODEL_SIZE,)
+    position : ndarray, shape (3,)
+        m, base frame.
+    kind : int
+        KIND_TT or KIND_CYLINDRICAL.
+    origins, directions : ndarray, shape (n, 3)
+        Ray i is origins[i] + s·directions[i].
+    s_start, s_end : ndarray, shape (n,)
+        Parameter range of each ray, rad.
+    tolerance, min_step : float
+        Bracket width at which the search stops; shortest march step (rad).
+    feasible, violated, limiting, start_feasible : ndarray, shape (n,)
+        Outputs, see core.search.RaySearchResult.
+
+    Returns
+    -------
+    int
+        Poses evaluated.
+    """
+    count = origins.shape[0]
+    phase = np.zeros(count, dtype=np.int64)
+    s = s_start.copy()
+    low_value = np.zeros(count)
+    high_value = np.zeros(count)
+    minus_value = np.zeros(count)
+    minus = np.zeros(count)
+    plus = np.zeros(count)
+    width = np.zeros(count)
+    bisect = np.zeros(count, dtype=np.bool_)
+    first = np.ones(count, dtype=np.bool_)
+    for ray in range(count):
+        feasible[ray] = np.nan
+        violated[ray] = np.inf
+        limiting[ray] = -1
+        start_feasible[ray] = True
+    rays = np.empty(count, dtype=np.int64)
+    angles = np.empty((count, 3))
+    work = np.empty(_BLOCK_ROWS * BLOCK)
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    half = 0.25 * tolerance
+    evaluations = 0
+    while True:
+        # The next probe of every unfinished ray.
+        probes = 0
+        for ray in range(count):
+            state = phase[ray]
+            if state == _DONE:
+                continue
+            if state == _MARCH:
+                probe = s[ray]
+            elif state == _GUESS:
+                low, high = feasible[ray], violated[ray]
+                if not high - low > tolerance:
+                    phase[ray] = _DONE
+                    continue
+                width[ray] = high - low
+                secant = low + low_value[ray] / (low_value[ray] - high_value[ray]) * width[ray]
+                if bisect[ray] or not math.isfinite(secant):
+                    guess = low + 0.5 * width[ray]
+                else:
+                    guess = secant
+                guess = min(max(guess, low + half), high - half)
+                minus[ray] = guess - half
+                plus[ray] = guess + half
+                probe = minus[ray]
+            else:
+                probe = plus[ray]
+            _ray_angles(kind, origins[ray], directions[ray], probe, angles, probes)
+            rays[probes] = ray
+            probes += 1
+        if probes == 0:
+            break
+        evaluations += probes
+        for block in range(0, probes, BLOCK):
+            size = min(BLOCK, probes - block)
+            _check_block(model, angles, position, block, size, work, scratch, out, r)
+            for m in range(size):
+                ray = rays[block + m]
+                for slot in range(N_CONSTRAINTS):
+                    out[slot] = work[slot * BLOCK + m]
+                ok = _feasible(out)
+                estimate = _estimate(model, out)
+                state = phase[ray]
+                if state == _MARCH:
+                    if not ok:
+                        violated[ray] = s[ray]
+                        high_value[ray] = estimate
+                        limiting[ray] = _limiting_constraint(model, out)
+                        if first[ray]:
+                            start_feasible[ray] = False
+                            phase[ray] = _DONE
+                        else:
+                            phase[ray] = _GUESS
+                        continue
+                    first[ray] = False
+                    feasible[ray] = s[ray]
+                    low_value[ray] = estimate
+                    step = max(certified_step(model, out), min_step)
+                    if s[ray] >= s_end[ray]:
+                        phase[ray] = _DONE
+                    else:
+                        s[ray] = min(s[ray] + step, s_end[ray])
+                elif state == _GUESS:  # the probe below the guess
+                    if not ok:
+                        violated[ray] = minus[ray]
+                        high_value[ray] = estimate
+                        limiting[ray] = _limiting_constraint(model, out)
+                        bisect[ray] = (violated[ray] - feasible[ray]) > 0.5 * width[ray]
+                    else:
+                        minus_value[ray] = estimate
+                        phase[ray] = _PLUS
+                else:  # the probe above the guess
+                    if not ok:
+                        feasible[ray] = minus[ray]
+                        low_value[ray] = minus_value[ray]
+                        violated[ray] = plus[ray]
+                        high_value[ray] = estimate
+                        limiting[ray] = _limiting_constraint(model, out)
+                    else:
+                        feasible[ray] = plus[ray]
+                        low_value[ray] = estimate
+                    bisect[ray] = (violated[ray] - feasible[ray]) > 0.5 * width[ray]
+                    phase[ray] = _GUESS
+    return evaluations
+
+
+@_jit
+def torsion_scan(
+    model: NDArray[np.float64],
+    position: NDArray[np.float64],
+    phi: float,
+    theta: float,
+    min_step: float,
+    max_step: float,
+    tolerance: float,
+    edges: NDArray[np.float64],
+    rising: NDArray[np.bool_],
+) -> tuple[int, bool]:
+    """Feasible-torsion transitions over ψ ∈ [−π, π] for one tool direction (φ, θ).
+
+    Scans with certified steps (recovery steps from violated samples), clipped to
+    [min_step, max_step], then bisects every transition, all of them together, until the widest
+    bracket is within the tolerance (as core.orientation.torsion_range did).
+
+    Parameters
+    ----------
+    edges, rising : ndarray, shape (K,)
+        Outputs: the feasible end of each transition, and whether it goes infeasible → feasible.
+        K must be at least the number of transitions (ceil(2π / min_step) + 1 is enough).
+
+    Returns
+    -------
+    count : int
+        Number of transitions written (−1 − count when the outputs were too short).
+    start_ok : bool
+        Whether ψ = −π is feasible.
+    """
+    scratch = np.empty((5, 6))
+    out = np.empty(OUT_SIZE)
+    r = np.empty(9)
+    capacity = edges.shape[0]
+    low = np.empty(capacity)
+    high = np.empty(capacity)
+    count = 0
+    psi = -math.pi
+    previous_ok = False
+    start_ok = False
+    first = True
+    previous = psi
+    while True:
+        _tt_matrix(phi, theta, psi, r)
+        _pose(model, r, position[0], position[1], position[2], scratch, out, True)
+        ok = _feasible(out)
+        if first:
+            start_ok = ok
+        elif ok != previous_ok:
+            if count >= capacity:
+                return -1 - count, start_ok
+            low[count] = previous
+            high[count] = psi
+            rising[count] = ok
+            count += 1
+        first = False
+        previous_ok = ok
+        previous = psi
+        if psi >= math.pi:
+            break
+        step = certified_step(model, out) if ok else recovery_step(model, out)
+        psi = min(psi + min(max(step, min_step), max_step), math.pi)
+    while count > 0:
+        widest = 0.0
+        for k in range(count):
+            widest = max(widest, high[k] - low[k])
+        if not widest > tolerance:
+            break
+        for k in range(count):
+            middle = 0.5 * (low[k] + high[k])
+            _tt_matrix(phi, theta, middle, r)
+            _pose(model, r, position[0], position[1], position[2], scratch, out, True)
+            # Keep the transition inside [low, high]: the side matching the start state moves.
+            if _feasible(out) != rising[k]:
+                low[k] = middle
+            else:
+                high[k] = middle
+    for k in range(count):
+        edges[k] = high[k] if rising[k] else low[k]
+    return count, start_ok
