@@ -141,10 +141,14 @@ def node_environment() -> dict[str, str]:
 
 @contextlib.contextmanager
 def running_node(
-    directory: Path, overrides: dict[str, Any] | None = None, extra_args: list[str] | None = None
+    directory: Path,
+    overrides: dict[str, Any] | None = None,
+    extra_args: list[str] | None = None,
+    node_options: list[str] | None = None,
 ) -> Iterator[NodeProcess]:
     """Start workspace_node with a parameters file in ``directory``; stop it on exit.
 
+    ``extra_args`` follow ``--ros-args``; ``node_options`` (``--autostart=false``) precede it.
     The node records into ``directory / "logs"``. Needs ROS_DOMAIN_ID set (``ros_domain``).
     """
     assert "ROS_DOMAIN_ID" in os.environ, "use the ros_domain fixture first"
@@ -153,7 +157,13 @@ def running_node(
         directory / "params.yaml", {"recording.directory": str(record_dir), **(overrides or {})}
     )
     log_path = directory / "node.log"
-    command = [str(NODE_EXECUTABLE), "--ros-args", "--params-file", str(params)]
+    command = [
+        str(NODE_EXECUTABLE),
+        *(node_options or []),
+        "--ros-args",
+        "--params-file",
+        str(params),
+    ]
     with log_path.open("wb") as log:
         process = subprocess.Popen(
             [*command, *(extra_args or [])],
