@@ -24,9 +24,19 @@ Topics
     CommandedPose gets exactly one ``~/reachability`` (ReachabilityResult); one that waited
     longer than ``check.max_command_age`` is answered ``success`` false, "overloaded".
     Publishes, transient local, ``~/orientation_workspace`` and ``~/projected_workspace``
-    (sensor_msgs/msg/PointCloud2, float32 x, y, z, phi, theta, psi), ``~/workspace_summary``
+    (sensor_msgs/msg/PointCloud2, float32 x, y, z, phi, theta, psi; sent by the worker
+    process's node ``<node>_clouds``, :mod:`~hexapod_workspace.ros.clouds`), ``~/workspace_summary``
     (WorkspaceSummary), ``~/reachability`` (depth 1000); ``/diagnostics``
     (diagnostic_msgs/DiagnosticArray, 1 Hz).
+
+Lifecycle
+    A managed node (``lifecycle_msgs`` services ``~/change_state``, ``~/get_state``, ...):
+    :mod:`~hexapod_workspace.ros.lifecycle` says what configure, activate, deactivate, cleanup
+    and shutdown do; while not active every command is answered ``success`` false, "inactive".
+    ``autostart`` (default) configures and activates at start.
+Services (flat)
+    ``~/check_poses_flat`` (CheckPosesFlat): the batch check in flat arrays
+    (:mod:`~hexapod_workspace.ros.flat`).
 
 Threads: the executor (single-threaded: every callback is short), the job queue
 (:mod:`~hexapod_workspace.ros.jobs`; the computation runs in a worker process, so it does not

@@ -228,3 +228,17 @@ def logs_example_path():
     from hexapod_workspace._resources import example_config_path
 
     return example_config_path()
+
+
+def test_autostart_option_is_read_before_ros_args_only():
+    from hexapod_workspace.errors import ConfigError
+    from hexapod_workspace.ros.lifecycle import autostart_from_argv
+
+    argv = ["workspace_node", "--autostart=false", "--ros-args", "-p", "a:=1"]
+    assert autostart_from_argv(argv) == (False, ["workspace_node", "--ros-args", "-p", "a:=1"])
+    assert autostart_from_argv(["workspace_node", "--autostart=TRUE"]) == (True, ["workspace_node"])
+    assert autostart_from_argv(["workspace_node"]) == (True, ["workspace_node"])
+    after = ["workspace_node", "--ros-args", "--autostart=false"]  # ROS's, not ours
+    assert autostart_from_argv(after) == (True, after)
+    with pytest.raises(ConfigError, match="--autostart: expected true or false, got 'maybe'"):
+        autostart_from_argv(["workspace_node", "--autostart=maybe"])
