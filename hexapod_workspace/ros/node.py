@@ -464,10 +464,13 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         self.worker.close()
 
     def destroy_node(self) -> None:
-        """Stop the jobs and the worker, finish the MCAP log, then destroy the node."""
+        """Stop the jobs and the worker, finish the MCAP log, then destroy the node and its
+        lifecycle state machine (rclpy leaves the latter to the garbage collector, which may
+        run after the context is shut down: a segfault was seen in the test process)."""
         self.stop_worker()
         self.recorder.shutdown()
         super().destroy_node()
+        self._state_machine.destroy_when_not_in_use()
 
 
 def _inactive_answer(service_class: Any) -> Callable[[str], Any]:
