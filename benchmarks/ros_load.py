@@ -366,6 +366,7 @@ class Computations:
 def run(args: argparse.Namespace, node: subprocess.Popen, out_dir: Path) -> int:
     import rclpy
 
+    load_before = os.getloadavg()
     rclpy.init()
     try:
         idle = idle_phase(args.samples)
@@ -434,6 +435,13 @@ def run(args: argparse.Namespace, node: subprocess.Popen, out_dir: Path) -> int:
         and latency["p99"] <= GOAL_P99_MS
         and floor_ratio <= GOAL_FLOOR_RATIO
         and core_ratio <= GOAL_CORE_RATIO
+    )
+    load_after = os.getloadavg()
+    print(
+        "load average (1, 5, 15 min; other jobs on the machine included): before "
+        + "/".join(f"{v:.2f}" for v in load_before)
+        + ", after "
+        + "/".join(f"{v:.2f}" for v in load_after)
     )
     print(f"goals: {'met' if ok else 'MISSED'}")
     return 0 if ok else 1

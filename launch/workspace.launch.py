@@ -8,6 +8,10 @@ Arguments
 params_file
     ROS 2 parameters file of the node (default: the packaged example GPM,
     ``share/hexapod_workspace/config/example_gpm.yaml``).
+autostart
+    ``true`` (default) configures and activates the managed node at once; ``false`` leaves it
+    unconfigured until a ``lifecycle_msgs`` ``configure`` and ``activate`` (``ros2 lifecycle
+    set /hexapod_workspace configure``).
 rviz
     ``true`` also starts rviz2 with ``share/hexapod_workspace/config/workspace.rviz``.
 
@@ -39,6 +43,11 @@ def generate_launch_description() -> LaunchDescription:
                 description="Parameters file of workspace_node (geometry, limits, pose, ...).",
             ),
             DeclareLaunchArgument(
+                "autostart",
+                default_value="true",
+                description="Configure and activate the lifecycle node at start.",
+            ),
+            DeclareLaunchArgument(
                 "rviz", default_value="false", description="Start rviz2 with the layout."
             ),
             Node(
@@ -47,6 +56,7 @@ def generate_launch_description() -> LaunchDescription:
                 name="hexapod_workspace",
                 output="screen",
                 emulate_tty=True,
+                arguments=[["--autostart=", LaunchConfiguration("autostart")]],
                 parameters=[params_file],
             ),
             Node(

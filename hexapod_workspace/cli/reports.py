@@ -349,7 +349,6 @@ def _workspace_json(index: int, record: WorkspaceRecord, start_ns: int) -> dict[
 
 def _check_json(index: int, call: PoseCheckCall, start_ns: int) -> dict[str, Any]:
     response = call.response or {}
-    results = response.get("results", [])
     return {
         "index": index,
         "time_s": (call.log_time_ns - start_ns) / 1e9,
@@ -360,7 +359,7 @@ def _check_json(index: int, call: PoseCheckCall, start_ns: int) -> dict[str, Any
         "answered": call.response is not None,
         "success": response.get("success"),
         "message": response.get("message"),
-        "n_reachable": sum(bool(r["reachable"]) for r in results),
+        "n_reachable": call.n_reachable,
     }
 
 

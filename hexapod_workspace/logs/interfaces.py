@@ -132,6 +132,13 @@ INTERFACES: tuple[Interface, ...] = (
         "a batch of (phi, theta, psi) at one position: verdicts, margins, limiting legs",
     ),
     Interface(
+        "check_poses_flat",
+        "service",
+        f"{_MSGS}/srv/CheckPosesFlat",
+        "the same check in flat arrays (angles N x 3, margins N x K with the constraint names "
+        "once), for large batches",
+    ),
+    Interface(
         "compute_workspace",
         "action",
         # Recorded in the form of the service of the same name (rosbag2 records no actions).

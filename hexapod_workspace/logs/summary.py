@@ -32,6 +32,8 @@ _REACHABILITY = "hexapod_workspace_msgs/msg/ReachabilityResult"
 _WORKSPACE_RESPONSE = "hexapod_workspace_msgs/srv/ComputeWorkspace_Response"
 _CHECK_REQUEST = "hexapod_workspace_msgs/srv/CheckPoses_Request"
 _CHECK_RESPONSE = "hexapod_workspace_msgs/srv/CheckPoses_Response"
+_FLAT_REQUEST = "hexapod_workspace_msgs/srv/CheckPosesFlat_Request"
+_FLAT_RESPONSE = "hexapod_workspace_msgs/srv/CheckPosesFlat_Response"
 _TRIGGER_RESPONSE = "std_srvs/srv/Trigger_Response"
 _PATH_REQUEST = "hexapod_workspace_msgs/srv/CheckPath_Request"
 _PATH_RESPONSE = "hexapod_workspace_msgs/srv/CheckPath_Response"
@@ -75,7 +77,8 @@ class WorkspaceRecord:
 
 @dataclass
 class PoseCheckCall:
-    """One recorded CheckPoses call (request and its response, paired in order).
+    """One recorded CheckPoses or CheckPosesFlat call (request and its response, paired in
+    order); ``response`` holds the fields of either form.
 
     ``position`` is None for the ``geometry_msgs/Pose`` form (each pose has its own position,
     ``angles`` is then None) and for a response without its request; ``n_poses`` counts the
@@ -105,6 +108,14 @@ class AtlasRecord:
     log_time_ns: int
     topic: str
     columns: dict[str, np.ndarray]
+
+    @property
+    def n_reachable(self) -> int:
+        """Poses answered reachable (nested ``results`` or flat ``reachable``)."""
+        response = self.response or {}
+        if "results" in response:
+            return sum(bool(r["reachable"]) for r in response["results"])
+        return int(np.count_nonzero(np.asarray(response.get("reachable", []), dtype=bool)))
 
 
 @dataclass
@@ -182,15 +193,20 @@ def summarize_log(
                 waiting.points = points
             elif points is not None:
                 clouds[stamp] = points
-        elif msgtype == _CHECK_REQUEST:
+        elif msgtype in (_CHECK_REQUEST, _FLAT_REQUEST):
             fields = message_to_fields(item.message)
-            position, poses = fields["position"], fields.get("poses") or []
+            position = fields["position"]
+            poses = [] if msgtype == _FLAT_REQUEST else fields.get("poses") or []
             if poses:  # the geometry_msgs/Pose form: each pose at its own position
                 call = PoseCheckCall(item.log_time_ns, item.topic, n_poses=len(poses))
             else:
-                angles = np.array(
-                    [[o["phi"], o["theta"], o["psi"]] for o in fields["orientations"]], dtype=float
-                ).reshape(-1, 3)
+                if msgtype == _FLAT_REQUEST:
+                    angles = np.asarray(fields["angles"], dtype=float).reshape(-1, 3)
+                else:
+                    angles = np.array(
+                        [[o["phi"], o["theta"], o["psi"]] for o in fields["orientations"]],
+                        dtype=float,
+                    ).reshape(-1, 3)
                 call = PoseCheckCall(
                     item.log_time_ns,
                     item.topic,
@@ -200,7 +216,7 @@ def summarize_log(
                 )
             summary.checks.append(call)
             pending_requests.setdefault(_service_of(item.topic), []).append(call)
-        elif msgtype == _CHECK_RESPONSE:
+        elif msgtype in (_CHECK_RESPONSE, _FLAT_RESPONSE):
             queue = pending_requests.get(_service_of(item.topic), [])
             if queue:
                 call = queue.pop(0)

@@ -17,6 +17,7 @@ service part                       recorded as
 =================================  ==================================
 ``pkg/srv/CheckPoses_Request``     ``pkg/msg/CheckPosesRequest``
 ``pkg/srv/CheckPoses_Response``    ``pkg/msg/CheckPosesResponse``
+``pkg/srv/CheckPosesFlat_...``     ``pkg/msg/CheckPosesFlat...`` (same suffix)
 ``pkg/srv/ComputeWorkspace_...``   ``pkg/msg/ComputeWorkspace...`` (same suffix)
 ``std_srvs/srv/Trigger_Request``   ``std_msgs/msg/Empty``
 ``std_srvs/srv/Trigger_Response``  ``pkg/msg/TriggerResponse``
@@ -93,6 +94,12 @@ _DTYPES = {
 RECORDED_TYPES = {
     f"{INTERFACE_PACKAGE}/srv/CheckPoses_Request": f"{INTERFACE_PACKAGE}/msg/CheckPosesRequest",
     f"{INTERFACE_PACKAGE}/srv/CheckPoses_Response": f"{INTERFACE_PACKAGE}/msg/CheckPosesResponse",
+    f"{INTERFACE_PACKAGE}/srv/CheckPosesFlat_Request": (
+        f"{INTERFACE_PACKAGE}/msg/CheckPosesFlatRequest"
+    ),
+    f"{INTERFACE_PACKAGE}/srv/CheckPosesFlat_Response": (
+        f"{INTERFACE_PACKAGE}/msg/CheckPosesFlatResponse"
+    ),
     f"{INTERFACE_PACKAGE}/srv/ComputeWorkspace_Request": (
         f"{INTERFACE_PACKAGE}/msg/ComputeWorkspaceRequest"
     ),

@@ -23,6 +23,7 @@ _ROS_MODULES = {
     "rclpy",
     "rcl_interfaces",
     "action_msgs",
+    "lifecycle_msgs",
     "diagnostic_msgs",
     "rosidl_parser",
     "sensor_msgs",

@@ -63,6 +63,10 @@ class CommandStream:
             node.recorder.write(topic, command)
         state = node.state
         now_ns = node.get_clock().now().nanoseconds
+        inactive = node.inactive_reason()
+        if inactive is not None:  # not active (lifecycle): every command gets the refusal
+            self._refuse_all(batch, inactive, now_ns, state)
+            return
         limit_ns = state.settings.max_command_age * 1e9
         positions = np.full((len(batch), 3), np.nan)
         angles = np.full((len(batch), 3), np.nan)
@@ -110,6 +114,29 @@ class CommandStream:
                 )
             node.publish(self._publisher, to_message(ReachabilityResult, fields))
         stats.commands_answered += len(batch)
+
+    def _refuse_all(self, batch: list[CommandedPose], reason: str, now_ns: int, state: Any) -> None:
+        """Answer every command of ``batch`` ``success`` false with ``reason``."""
+        frame_id = state.manipulator.frame_id if state is not None else ""
+        for command in batch:
+            try:
+                position, target = commanded_target(command)
+                angles = target[0]
+            except InputError:
+                position, angles = np.full(3, np.nan), np.full(3, np.nan)
+            fields = messages.reachability_result_fields(
+                None,
+                index=0,
+                message=reason,
+                position=position,
+                angles=angles,
+                stamp_ns=now_ns,
+                frame_id=frame_id,
+                request_id=command.request_id,
+            )
+            self._node.publish(self._publisher, to_message(ReachabilityResult, fields))
+        self._node.stats.commands_refused += len(batch)
+        self._node.stats.commands_answered += len(batch)
 
     def _check_group(
         self, state: Any, position: Any, angles: Any, members: Any, verdicts: dict

@@ -15,7 +15,16 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 
 from .recorder import RecorderStatus
 
-__all__ = ["Counters", "diagnostic_array"]
+__all__ = ["Counters", "Lifecycle", "diagnostic_array"]
+
+
+@dataclass(frozen=True)
+class Lifecycle:
+    """The node's lifecycle state as the diagnostics report it."""
+
+    state: str  # unconfigured, inactive, active, finalized (or a transition's label)
+    active: bool
+    configure_error: str = ""  # why the last configure failed ("" when it did not)
 
 
 @dataclass
@@ -42,9 +51,14 @@ def diagnostic_array(
     jobs_depth: int,
     worker_alive: bool,
     recorder: RecorderStatus,
+    lifecycle: Lifecycle | None = None,
 ) -> DiagnosticArray:
-    """The node's DiagnosticArray: one status, level from what happened since the last call."""
+    """The node's DiagnosticArray: one status, level from what happened since the last call.
+
+    Not active: WARN ("inactive ..."), or ERROR with the reason when configure failed."""
+    lifecycle = lifecycle or Lifecycle("active", True)
     now = {
+        "lifecycle state": lifecycle.state,
         "commands received": counters.commands_received,
         "commands answered": counters.commands_answered,
         "commands refused": counters.commands_refused,
@@ -78,6 +92,12 @@ def diagnostic_array(
         level, message = DiagnosticStatus.ERROR, counters.last_error
     if jobs_depth and not worker_alive:
         level, message = DiagnosticStatus.ERROR, "the workspace worker process is not running"
+    if not lifecycle.active:
+        level = DiagnosticStatus.WARN
+        message = f"inactive: lifecycle state {lifecycle.state}, commands answered 'inactive'"
+        if lifecycle.configure_error and lifecycle.state == "unconfigured":
+            level = DiagnosticStatus.ERROR
+            message = f"unconfigured: configure failed: {lifecycle.configure_error}"
     status = DiagnosticStatus(
         level=level,
         name=name,

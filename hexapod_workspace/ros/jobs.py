@@ -4,8 +4,9 @@ Every workspace request (the ``~/compute_workspace`` action, the Trigger service
 topic) becomes a :class:`Ticket` in one first-in first-out queue. The queue's thread sends one
 job at a time to :class:`~hexapod_workspace.ros.worker.WorkspaceWorker`, forwards its progress,
 and hands the outcome to the ``finish`` function of the node (which builds, publishes and
-records the messages in this thread, so the executor never waits for a computation nor for the
-conversion of a large cloud). A ticket can be canceled while queued (it never runs) or while
+records the summary and the action's bounded cloud in this thread, so the executor never waits
+for a computation; the full cloud is published by the worker process and only recorded here,
+through ``on_published``). A ticket can be canceled while queued (it never runs) or while
 running (the worker stops within :data:`~hexapod_workspace.ros.worker.CANCEL_GRACE` s).
 """
 
@@ -76,6 +77,9 @@ class JobQueue:
         thread.
     on_error : callable
         ``on_error(job, error)`` for a failed (or canceled) job: returns the ``outcome`` too.
+    on_published : callable, optional
+        ``on_published(cloud)`` for each cloud the worker published
+        (:class:`~hexapod_workspace.ros.clouds.PublishedCloud`), in the queue's thread.
     """
 
     def __init__(
@@ -83,10 +87,12 @@ class JobQueue:
         worker: WorkspaceWorker,
         finish: Callable[[WorkspaceJob, Any], Any],
         on_error: Callable[[WorkspaceJob, BaseException], Any],
+        on_published: Callable[[Any], None] | None = None,
     ) -> None:
         self._worker = worker
         self._finish_job = finish
         self._on_error = on_error
+        self._on_published = on_published
         self._condition = threading.Condition()
         self._pending: collections.deque[Ticket] = collections.deque()
         self._running: Ticket | None = None
@@ -123,6 +129,15 @@ class JobQueue:
         self.canceled += 1
         error = CanceledError("canceled")
         ticket._finish(self._failure(ticket.job, error), error)
+
+    def cancel_all(self) -> int:
+        """Cancel the queued tickets and the running one (the node is deactivated); returns
+        how many were canceled. The queue keeps serving later submissions."""
+        with self._condition:
+            tickets = [*([self._running] if self._running is not None else []), *self._pending]
+        for ticket in tickets:
+            self.cancel(ticket)
+        return len(tickets)
 
     def stop(self, timeout: float = 10.0) -> None:
         """Cancel everything and end the thread."""
@@ -167,6 +182,7 @@ class JobQueue:
                 job,
                 progress=lambda fraction: ticket.report(0.95 * fraction),
                 canceled=ticket.canceled,
+                published=self._on_published,
             )
             ticket.report(0.95, PUBLISHING)
             outcome = self._finish_job(job, fields)

@@ -24,9 +24,19 @@ Topics
     CommandedPose gets exactly one ``~/reachability`` (ReachabilityResult); one that waited
     longer than ``check.max_command_age`` is answered ``success`` false, "overloaded".
     Publishes, transient local, ``~/orientation_workspace`` and ``~/projected_workspace``
-    (sensor_msgs/msg/PointCloud2, float32 x, y, z, phi, theta, psi), ``~/workspace_summary``
+    (sensor_msgs/msg/PointCloud2, float32 x, y, z, phi, theta, psi; sent by the worker
+    process's node ``<node>_clouds``, :mod:`~hexapod_workspace.ros.clouds`), ``~/workspace_summary``
     (WorkspaceSummary), ``~/reachability`` (depth 1000); ``/diagnostics``
     (diagnostic_msgs/DiagnosticArray, 1 Hz).
+
+Lifecycle
+    A managed node (``lifecycle_msgs`` services ``~/change_state``, ``~/get_state``, ...):
+    :mod:`~hexapod_workspace.ros.lifecycle` says what configure, activate, deactivate, cleanup
+    and shutdown do; while not active every command is answered ``success`` false, "inactive".
+    ``autostart`` (default) configures and activates at start.
+Services (flat)
+    ``~/check_poses_flat`` (CheckPosesFlat): the batch check in flat arrays
+    (:mod:`~hexapod_workspace.ros.flat`).
 
 Threads: the executor (single-threaded: every callback is short), the job queue
 (:mod:`~hexapod_workspace.ros.jobs`; the computation runs in a worker process, so it does not
@@ -60,8 +70,8 @@ from rcl_interfaces.msg import SetParametersResult
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
 from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.lifecycle import LifecycleNode
 from rclpy.logging import get_logger
-from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
@@ -83,6 +93,8 @@ from hexapod_workspace.logs.interfaces import relative_name
 from . import health
 from .commands import CommandStream
 from .conversions import angles_from_orientations, position_from_point, to_message, type_name
+from .flat import attach as attach_flat
+from .lifecycle import ManagedTransitions, autostart_from_argv
 from .parameters import (
     MODEL_GROUPS,
     State,
@@ -110,7 +122,9 @@ def _attach_atlas(node: WorkspaceNode) -> object:
     hint when the ``atlas`` extra is missing)."""
     from .atlas_action import attach_atlas_action
 
-    return attach_atlas_action(node, lambda: node.state.manipulator, recorder=node.recorder)
+    return attach_atlas_action(
+        node, lambda: node.configured_state.manipulator, recorder=node.recorder
+    )
 
 
 #: Functions ``attach(node)`` run by :func:`main` after the node is built (one per extension).
@@ -151,21 +165,27 @@ def _warm_up() -> float:
     return time.perf_counter() - started
 
 
-class WorkspaceNode(Node):
-    """The ``hexapod_workspace`` node (see the module docstring).
+class WorkspaceNode(ManagedTransitions, LifecycleNode):
+    """The ``hexapod_workspace`` node (see the module docstring), a managed (lifecycle) node:
+    :mod:`~hexapod_workspace.ros.lifecycle` says what each transition does.
 
     Parameters
     ----------
     extensions : iterable of callables, optional
         ``attach(node)`` for each extension, called once the node is wired.
+    autostart : bool
+        Configure and activate before returning (default), so the node serves at once;
+        False leaves it unconfigured (every command answered "inactive").
     **kwargs
-        Passed to :class:`rclpy.node.Node` (``parameter_overrides``, ``context``, ...).
+        Passed to :class:`rclpy.lifecycle.LifecycleNode` (``parameter_overrides``,
+        ``context``, ...).
 
     Raises
     ------
     ConfigError
-        The parameters (file or overrides) do not describe a valid manipulator, or a value has
-        the wrong type (the message names the parameter and the value).
+        A value has the wrong type; with ``autostart``, also when the parameters (file or
+        overrides) do not describe a valid manipulator (the message names the parameter and
+        the value).
     """
 
     def __init__(
@@ -173,6 +193,7 @@ class WorkspaceNode(Node):
         *,
         extensions: Iterable[Callable[[Any], object]] = (),
         override_names: Iterable[str] = (),
+        autostart: bool = True,
         **kwargs: Any,
     ) -> None:
         super().__init__(NODE_NAME, **kwargs)
@@ -181,9 +202,11 @@ class WorkspaceNode(Node):
         self.stats = health.Counters()
         self.recorder = Recorder(self.get_logger())
         self._specs = parameter_specs()
+        self.guard_change_state()
+        #: the model and settings: built by configure (None while unconfigured)
+        self.state: State | None = None
         try:
             self._declare_parameters()
-            self.state: State = state_from(self._parameter_values())
         except Exception:
             self.recorder.shutdown()
             super().destroy_node()
@@ -202,6 +225,7 @@ class WorkspaceNode(Node):
         self.recorded_service(
             CheckPoses, _name("check_poses"), self._on_check_poses, self.check_group
         )
+        attach_flat(self, _name("check_poses_flat"))  # the flat form (ros/flat.py)
         self._commanded = self.recorded_subscription(
             CommandedPose, _name("commanded_pose"), lambda c: self._commands.on_command(c)
         )
@@ -212,23 +236,40 @@ class WorkspaceNode(Node):
         self._diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self.create_timer(1.0, self._publish_diagnostics)
         # ~/check_path, Pose inputs and the current-pose parameter (hexapod_workspace.ros.paths)
-        self.paths = attach_paths(self, lambda: self.state.manipulator, self.recorder)
-        extensions = list(extensions)
-        for attach in extensions:
+        self.paths = attach_paths(self, lambda: self.configured_state.manipulator, self.recorder)
+        self._extensions = list(extensions)
+        for attach in self._extensions:
             attach(self)
-        settings = self.state.settings
-        if settings.recording_enabled:
-            self.recorder.open(settings.recording_directory, settings.recording_rotation)
-        self.worker.start()  # it warms its own kernels up meanwhile
-        self.get_logger().info(f"core kernels ready in {_warm_up():.1f} s")
-        atlas = ", compute_atlas (action)" if _attach_atlas in extensions else ""
+        self._warn_unknown_overrides()
+        if autostart:
+            try:
+                self.autostart()  # configure + activate (ros/lifecycle.py)
+            except Exception:
+                self.destroy_node()
+                raise
+
+    def interfaces_line(self) -> str:
+        """What the active node serves and listens on, for its log."""
+        atlas = ", compute_atlas (action)" if _attach_atlas in self._extensions else ""
         current = self.paths.subscription
-        self.get_logger().info(
-            f"ready: {self.get_fully_qualified_name()} serving check_poses, check_path, "
-            f"compute_workspace (action){atlas}, compute_orientation_workspace, "
+        return (
+            f"{self.get_fully_qualified_name()} serving check_poses, check_poses_flat, "
+            f"check_path, compute_workspace (action){atlas}, compute_orientation_workspace, "
             "compute_projected_workspace; listening on commanded_pose, workspace_request"
             + (f", {current.topic_name} (current pose)" if current is not None else "")
         )
+
+    @property
+    def configured_state(self) -> State:
+        """:attr:`state`; ``InputError`` "inactive: ..." while the node is unconfigured."""
+        if self.state is None:
+            raise InputError(self.inactive_reason() or "inactive: the node is unconfigured")
+        return self.state
+
+    @staticmethod
+    def warm_up() -> float:
+        """Load the core's kernels; seconds taken (configure calls it)."""
+        return _warm_up()
 
     # ------------------------------------------------------------------ wiring helpers
     def recorded_publisher(self, message_class: type, topic: str, depth: int = 1) -> Any:
@@ -253,18 +294,24 @@ class WorkspaceNode(Node):
         self, service_class: Any, name: str, callback: Callable, group: Any = None
     ) -> Any:
         """A service whose requests and responses are recorded (``<name>/request``,
-        ``<name>/response``); ``callback(request, response)`` may be a coroutine."""
+        ``<name>/response``); ``callback(request, response)`` may be a coroutine. While the
+        node is not active the callback is not called: the answer is ``success`` false with
+        the "inactive: ..." reason in ``message``."""
         request_topic, response_topic = self.record_service_channels(service_class, name)
+
+        inactive = _inactive_answer(service_class)
 
         async def recorded_async(request: Any, response: Any) -> Any:
             self.recorder.write(request_topic, request)
-            answer = await callback(request, response)
+            reason = self.inactive_reason()
+            answer = await callback(request, response) if reason is None else inactive(reason)
             self.recorder.write(response_topic, answer)
             return answer
 
         def recorded(request: Any, response: Any) -> Any:
             self.recorder.write(request_topic, request)
-            answer = callback(request, response)
+            reason = self.inactive_reason()
+            answer = callback(request, response) if reason is None else inactive(reason)
             self.recorder.write(response_topic, answer)
             return answer
 
@@ -343,7 +390,10 @@ class WorkspaceNode(Node):
         return super().set_parameters_atomically(parameter_list)
 
     def _validate_parameters(self, parameters: list[Parameter]) -> SetParametersResult:
-        """Accept an update only when the would-be full parameter set is valid."""
+        """Accept an update only when the would-be full parameter set is valid (while
+        unconfigured, configure validates the whole set)."""
+        if not self.configured:
+            return SetParametersResult(successful=True)
         values = self._parameter_values()
         values.update({p.name: p.value for p in parameters if p.name in values})
         try:
@@ -355,9 +405,12 @@ class WorkspaceNode(Node):
         return SetParametersResult(successful=True)
 
     def _apply_parameters(self, parameters: list[Parameter]) -> None:
-        """Swap in the new model and settings after an accepted update."""
+        """Swap in the new model and settings after an accepted update (configured only)."""
         names = [p.name for p in parameters if p.name in self._specs]
         if not names:  # an extension declaring its own parameter (motion.current_pose_topic)
+            return
+        if self.state is None or not self.configured:
+            self.get_logger().info(f"parameters set: {', '.join(names)}")
             return
         previous, state = self.state, state_from(self._parameter_values())
         self.state = state
@@ -376,7 +429,7 @@ class WorkspaceNode(Node):
     ) -> CheckPoses.Response:
         self.stats.check_calls += 1
         try:
-            fields = self._check_fields(self.state, request)
+            fields = self._check_fields(self.configured_state, request)
         except Exception as error:
             fields = messages.check_poses_response_fields(
                 None, success=False, message=self.internal_error(error)
@@ -411,14 +464,16 @@ class WorkspaceNode(Node):
 
     # ------------------------------------------------------------------ health
     def _publish_diagnostics(self) -> None:
+        frame_id = self.state.manipulator.frame_id if self.state is not None else ""
         array = health.diagnostic_array(
             name=self.get_fully_qualified_name(),
-            hardware_id=self.state.manipulator.frame_id or self.get_name(),
+            hardware_id=frame_id or self.get_name(),
             stamp=self.get_clock().now().to_msg(),
             counters=self.stats,
             jobs_depth=self.jobs.depth,
             worker_alive=self.worker.alive,
             recorder=self.recorder.status(),
+            lifecycle=health.Lifecycle(self.lifecycle_state, self.active, self.configure_error),
         )
         self._diagnostics.publish(array)
 
@@ -436,7 +491,9 @@ class WorkspaceNode(Node):
 
     def destroy_node(self) -> None:
         """Stop the jobs and the worker, finish the MCAP log (logging where it went), then
-        destroy the node."""
+        destroy the node and its lifecycle state machine (rclpy leaves the latter to the
+        garbage collector, which may run after the context is shut down: a segfault was seen
+        in the test process)."""
         self.stop_worker()
         path = self.recorder.status().path
         self.recorder.shutdown()
@@ -444,6 +501,20 @@ class WorkspaceNode(Node):
             f"stopped; the log is {path}" if path else "stopped (recording was off)"
         )
         super().destroy_node()
+        self._state_machine.destroy_when_not_in_use()
+
+
+def _inactive_answer(service_class: Any) -> Callable[[str], Any]:
+    """The refusal of ``service_class`` while the node is not active: its Response with
+    ``success`` false and the reason in ``message`` (every service of the node has both)."""
+
+    def answer(reason: str) -> Any:
+        response = service_class.Response()
+        response.success = False
+        response.message = reason
+        return response
+
+    return answer
 
 
 def _is_coroutine(callback: Callable) -> bool:
@@ -459,6 +530,11 @@ def main(args: list[str] | None = None) -> int:
         Process exit status: 0 after a clean shutdown, 1 when the parameters are invalid.
     """
     sys.setswitchinterval(SWITCH_INTERVAL)
+    try:
+        autostart, args = autostart_from_argv(sys.argv if args is None else args)
+    except ConfigError as error:
+        get_logger(NODE_NAME).fatal(str(error))
+        return 2
     rclpy.init(args=args)
     node = None
     executor = None
@@ -466,9 +542,8 @@ def main(args: list[str] | None = None) -> int:
     try:
         node = WorkspaceNode(
             extensions=EXTENSIONS,
-            override_names=command_line_override_names(
-                sys.argv if args is None else args, NODE_NAME
-            ),
+            override_names=command_line_override_names(args, NODE_NAME),
+            autostart=autostart,
         )
         executor = SingleThreadedExecutor()
         executor.add_node(node)

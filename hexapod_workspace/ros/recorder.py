@@ -83,6 +83,13 @@ class Rotation:
 
 
 @dataclass(frozen=True)
+class _Serialized:
+    """A message queued as its CDR bytes."""
+
+    data: bytes
+
+
+@dataclass(frozen=True)
 class RecorderStatus:
     """What the diagnostics report about recording (a snapshot)."""
 
@@ -131,14 +138,20 @@ class Recorder:
         """Declare a topic recorded in every log (before the first :meth:`open`)."""
         self._channels[topic] = (msgtype, qos)
 
-    def write(self, topic: str, message: Any) -> None:
-        """Queue one rclpy message for ``topic`` when recording (never blocks, never raises)."""
+    def write(self, topic: str, message: Any, log_time_ns: int | None = None) -> None:
+        """Queue one rclpy message for ``topic`` when recording (never blocks, never raises);
+        logged at ``log_time_ns`` (default now, ns since the epoch)."""
         if not self._accepting:
             return
         if self._queue.qsize() >= MAX_QUEUED:
             self._lost += 1
             return
-        self._queue.put((topic, message, time.time_ns()))
+        self._queue.put((topic, message, time.time_ns() if log_time_ns is None else log_time_ns))
+
+    def write_serialized(self, topic: str, data: bytes, log_time_ns: int) -> None:
+        """Queue CDR bytes already serialised (e.g. by the worker process that published them)
+        for ``topic``; written as they are (never blocks, never raises)."""
+        self.write(topic, _Serialized(data), log_time_ns)
 
     def open(
         self, directory: Path, rotation: Rotation | None = None, timeout: float = 10.0
@@ -206,7 +219,7 @@ class Recorder:
             item[1].set()
         elif self._writer is not None:
             topic, message, stamp_ns = item
-            data = serialize_message(message)
+            data = message.data if isinstance(message, _Serialized) else serialize_message(message)
             try:
                 self._writer.write(topic, data, log_time_ns=stamp_ns)
             except RecordingError as error:

@@ -1,10 +1,17 @@
-"""Workspace computations in a worker process of the node (ROS-free: numpy and the core only).
+"""Workspace computations in a worker process of the node (numpy and the core; rclpy only to
+publish the clouds).
 
 A 3-D orientation workspace takes seconds of mostly-Python work. Run in a thread of the node, it
 would share the interpreter lock with the pose checks and delay them; run here, in a spawned
 process, it leaves the node's interpreter to the checks. The node sends one
 :class:`WorkspaceJob` at a time and gets back the ROS-free field dicts of the summary and of the
 boundary cloud (:mod:`hexapod_workspace.logs.messages`), ready to become rclpy messages.
+
+Given :class:`~hexapod_workspace.ros.clouds.CloudTopics`, the worker also publishes each full
+boundary cloud itself (:class:`~hexapod_workspace.ros.clouds.CloudPublisher`: building,
+serialising and publishing a large cloud stays out of the node's interpreter), hands its CDR
+bytes back for the node's log (``published``), and returns a cloud of at most
+``WorkspaceJob.result_points`` points for the action's result.
 """
 
 from __future__ import annotations
@@ -27,8 +34,10 @@ from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.core.orientation import OrientationWorkspace, orientation_workspace
 from hexapod_workspace.core.projected import ProjectedWorkspace, projected_workspace
 from hexapod_workspace.core.resolution import WorkspaceKind
-from hexapod_workspace.errors import HexapodWorkspaceError
+from hexapod_workspace.errors import HexapodWorkspaceError, UnreachableReferenceError
 from hexapod_workspace.logs import messages
+
+from .clouds import CloudTopics, PublishedCloud, decimated_cloud_fields
 
 __all__ = [
     "CANCEL_GRACE",
@@ -78,6 +87,8 @@ class WorkspaceJob:
         Stamp of the summary and of the cloud, ns since the epoch.
     frame_id, request_id : str
         Header frame and the request's id, copied into the results.
+    result_points : int
+        Most points of the returned cloud when the worker publishes the full one (0 = all).
     """
 
     manipulator: Manipulator
@@ -89,6 +100,7 @@ class WorkspaceJob:
     stamp_ns: int
     frame_id: str
     request_id: str = ""
+    result_points: int = 0
 
 
 def compute_fields(
@@ -150,11 +162,38 @@ def _reporter(connection: Connection, cancel: Any) -> Callable[[float], None]:
     return progress
 
 
-def _serve(connection: Connection, cancel: Any) -> None:
-    """Worker process main loop: one job in; ``("progress", fraction)`` messages, then
-    ``("ok", result)``, ``("error", exc)`` or ``("canceled", None)`` out. ``cancel`` (an event
-    the node sets) stops the job at its next progress report."""
+def _published(
+    publisher: Any, job: WorkspaceJob, fields: tuple[dict[str, Any], dict[str, Any]]
+) -> tuple[tuple[dict[str, Any], dict[str, Any]], PublishedCloud]:
+    """Publish the full cloud of ``fields``; return the fields with the cloud bounded to
+    ``job.result_points`` and what was published."""
+    summary, cloud = fields
+    published = publisher.publish(job.kind, cloud)
+    return (summary, decimated_cloud_fields(cloud, job.result_points)), published
+
+
+def _cloud_publisher(topics: CloudTopics | None) -> tuple[Any, str]:
+    """The worker's cloud publisher (None without topics) and why it could not start ("")."""
+    if topics is None:
+        return None, ""
+    try:
+        from .clouds import CloudPublisher
+
+        return CloudPublisher(topics), ""
+    except Exception as error:  # reported with every job (the worker keeps computing)
+        return None, f"the worker cannot publish clouds: {type(error).__name__}: {error}"
+
+
+def _serve(connection: Connection, cancel: Any, topics: CloudTopics | None = None) -> None:
+    """Worker process main loop: one job in; ``("progress", fraction)`` and ``("published",
+    PublishedCloud)`` messages, then ``("ok", result)``, ``("error", exc)`` or
+    ``("canceled", None)`` out. ``cancel`` (an event the node sets) stops the job at its next
+    progress report."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the node decides when the worker stops
+    # The publisher's DDS threads start first, at normal priority (Linux: a thread's niceness
+    # is its own and new threads inherit their creator's): discovery and delivery of the clouds
+    # do not wait behind the computation on a busy machine.
+    publisher, broken = _cloud_publisher(topics)
     with contextlib.suppress(OSError):
         os.nice(WORKER_NICENESS)  # throughput work: the node's checks are scheduled first
     kernels.warm_up()  # compiled (or loaded) before the first job arrives
@@ -162,9 +201,24 @@ def _serve(connection: Connection, cancel: Any) -> None:
         try:
             job = connection.recv()
         except (EOFError, OSError):
+            if publisher is not None:
+                publisher.close()
             return
         try:
-            reply: tuple[str, Any] = ("ok", compute_fields(job, _reporter(connection, cancel)))
+            if broken:
+                raise WorkerError(broken)
+            fields = compute_fields(job, _reporter(connection, cancel))
+            if publisher is not None:
+                fields, published = _published(publisher, job, fields)
+                connection.send(("published", published))
+            reply: tuple[str, Any] = ("ok", fields)
+        except UnreachableReferenceError as error:  # the empty workspace: an empty cloud
+            if publisher is not None:
+                empty = messages.pointcloud_fields(
+                    np.zeros((0, 6)), frame_id=job.frame_id, stamp_ns=job.stamp_ns
+                )
+                connection.send(("published", publisher.publish(job.kind, empty)))
+            reply = ("error", error)
         except CanceledError:
             reply = ("canceled", None)
         except HexapodWorkspaceError as error:
@@ -181,8 +235,12 @@ class WorkspaceWorker:
     :meth:`start`) and replaced when it dies; :meth:`close` terminates it for good.
     """
 
-    def __init__(self, cancel_grace: float = CANCEL_GRACE) -> None:
+    def __init__(
+        self, cancel_grace: float = CANCEL_GRACE, cloud_topics: CloudTopics | None = None
+    ) -> None:
         self.cancel_grace = float(cancel_grace)
+        #: where the worker publishes the clouds (None: it does not); read at each (re)start
+        self.cloud_topics = cloud_topics
         self._context = multiprocessing.get_context("spawn")
         self._lock = threading.Lock()
         self._process: Any = None
@@ -191,8 +249,10 @@ class WorkspaceWorker:
         self._closed = False
 
     def start(self) -> None:
-        """Start the worker process now (it then imports the core while the node starts)."""
+        """Start the worker process now (it then imports the core while the node starts);
+        after :meth:`close`, start again (the node is configured again)."""
         with self._lock:
+            self._closed = False
             self._ensure_started()
 
     def _ensure_started(self) -> Connection:
@@ -204,7 +264,7 @@ class WorkspaceWorker:
             parent, child = self._context.Pipe()
             process = self._context.Process(
                 target=_serve,
-                args=(child, self._cancel),
+                args=(child, self._cancel, self.cloud_topics),
                 name="hexapod_workspace_worker",
                 daemon=True,
             )
@@ -224,6 +284,7 @@ class WorkspaceWorker:
         job: WorkspaceJob,
         progress: Callable[[float], None] | None = None,
         canceled: threading.Event | None = None,
+        published: Callable[[PublishedCloud], None] | None = None,
     ) -> tuple[dict[str, Any], dict[str, Any]]:
         """Run ``job`` in the worker; block until done.
 
@@ -235,11 +296,15 @@ class WorkspaceWorker:
         canceled : threading.Event, optional
             Set by another thread to cancel: the job stops at its next progress report, or the
             worker process is terminated after ``cancel_grace`` s (:data:`CANCEL_GRACE`).
+        published : callable, optional
+            Called (in this thread) with each cloud the worker published (with
+            :attr:`cloud_topics`), before the job's result or error.
 
         Returns
         -------
         (dict, dict)
-            WorkspaceSummary and PointCloud2 field dicts.
+            WorkspaceSummary and PointCloud2 field dicts (the cloud bounded to
+            ``job.result_points`` when the worker published the full one).
 
         Raises
         ------
@@ -257,7 +322,7 @@ class WorkspaceWorker:
                 self._cancel.clear()
                 try:
                     connection.send(job)
-                    status, payload = self._wait(connection, progress, canceled)
+                    status, payload = self._wait(connection, progress, canceled, published)
                     break
                 except (EOFError, OSError) as error:
                     self._stop_locked()
@@ -277,8 +342,10 @@ class WorkspaceWorker:
         connection: Connection,
         progress: Callable[[float], None] | None,
         canceled: threading.Event | None,
+        published: Callable[[PublishedCloud], None] | None = None,
     ) -> tuple[str, Any]:
-        """Receive until the job's reply; forward progress; enforce a cancel (under the lock)."""
+        """Receive until the job's reply; forward progress and published clouds; enforce a
+        cancel (under the lock)."""
         cancel_time = None
         while True:
             if canceled is not None and canceled.is_set() and cancel_time is None:
@@ -290,9 +357,12 @@ class WorkspaceWorker:
             if not connection.poll(0.02):
                 continue
             status, payload = connection.recv()
-            if status != "progress":
+            if status == "published":
+                if published is not None:
+                    published(payload)
+            elif status != "progress":
                 return status, payload
-            if progress is not None:
+            elif progress is not None:
                 progress(payload)
 
     def _stop_locked(self) -> None:

@@ -4,13 +4,15 @@ the request topic, all through one first-in first-out
 
 A request is checked here (a refusal names the field and the value) and becomes a
 :class:`~hexapod_workspace.ros.worker.WorkspaceJob` with the node's resolution parameters filled
-in. The job queue's thread runs it in the worker process, publishes (and records) the summary and
-the cloud, and completes the request: the action's execute coroutine and the Trigger services
-await it without holding the executor. Goals are always accepted and queue with the other
-requests; an invalid goal is aborted with the reason in ``result.message``; a canceled goal,
-queued or running, ends CANCELED with the message "canceled". The action is recorded in the form
-of ComputeWorkspace.srv (same fields as the Goal and the Result; rosbag2 in Jazzy records no
-actions) on ``<action>/request`` and ``<action>/response``.
+in. The job queue's thread runs it in the worker process, which publishes the full boundary
+cloud itself (:mod:`~hexapod_workspace.ros.clouds`; the node records its bytes), then publishes
+(and records) the summary and completes the request with a cloud of at most
+:data:`~hexapod_workspace.ros.clouds.RESULT_MAX_POINTS` points: the action's execute coroutine
+and the Trigger services await it without holding the executor. Goals are always accepted and
+queue with the other requests; an invalid goal is aborted with the reason in ``result.message``;
+a canceled goal, queued or running, ends CANCELED with the message "canceled". The action is
+recorded in the form of ComputeWorkspace.srv (same fields as the Goal and the Result; rosbag2 in
+Jazzy records no actions) on ``<action>/request`` and ``<action>/response``.
 """
 
 from __future__ import annotations
@@ -29,9 +31,10 @@ from std_srvs.srv import Trigger
 
 from hexapod_workspace.core.resolution import WorkspaceKind
 from hexapod_workspace.errors import InputError, UnreachableReferenceError
-from hexapod_workspace.logs import messages
+from hexapod_workspace.logs import messages, qos_profile_text
 
-from .conversions import position_from_point, to_message
+from .clouds import RESULT_MAX_POINTS, CloudTopics
+from .conversions import position_from_point, to_message, type_name
 from .jobs import JobQueue, Ticket, completion
 from .parameters import RAYS_RANGE
 from .worker import CanceledError, WorkspaceJob
@@ -52,16 +55,29 @@ class WorkspaceServer:
 
     def __init__(self, node: Any, name: Callable[[str], str]) -> None:
         self._node = node
-        self.jobs = JobQueue(node.worker, self._finish_job, self._fail_job)
-        cloud: dict[int, Any] = {
-            kind: node.recorded_publisher(PointCloud2, name(topic))
+        # the clouds: published by the worker process (ros/clouds.py), recorded here
+        topics = {
+            int(kind): node.resolve_topic_name(name(topic))
             for kind, topic in (
                 (WorkspaceKind.ORIENTATION, "orientation_workspace"),
                 (WorkspaceKind.PROJECTED_TORSION_ZERO, "projected_workspace"),
+                (WorkspaceKind.PROJECTED_EXACT, "projected_workspace"),
             )
         }
-        cloud[WorkspaceKind.PROJECTED_EXACT] = cloud[WorkspaceKind.PROJECTED_TORSION_ZERO]
-        self._cloud_publishers = cloud
+        cloud_qos = qos_profile_text(durability="transient_local", depth=1)
+        for topic in set(topics.values()):
+            node.recorder.add_channel(topic, type_name(PointCloud2), cloud_qos)
+        node.worker.cloud_topics = CloudTopics(
+            node.get_name(), node.get_namespace(), topics, node.context.get_domain_id()
+        )
+        self.jobs = JobQueue(
+            node.worker,
+            self._finish_job,
+            self._fail_job,
+            lambda cloud: node.recorder.write_serialized(
+                cloud.topic, cloud.data, cloud.log_time_ns
+            ),
+        )
         self._summary_publisher = node.recorded_publisher(
             WorkspaceSummary, name("workspace_summary")
         )
@@ -94,6 +110,9 @@ class WorkspaceServer:
 
     def job(self, request: WorkspaceRequest) -> WorkspaceJob | _Failed:
         """The job of a request with the node's parameters filled in, or why it is refused."""
+        inactive = self._node.inactive_reason()
+        if inactive is not None:  # not active (lifecycle): refused, never silence
+            return _Failed(inactive)
         settings = self._node.state.settings
         kind, position = int(request.kind), position_from_point(request.position)
         if WorkspaceKind.of(kind) is None:
@@ -122,6 +141,7 @@ class WorkspaceServer:
             stamp_ns=self._node._now_ns(),
             frame_id=self._node.state.manipulator.frame_id,
             request_id=request.request_id,
+            result_points=RESULT_MAX_POINTS,
         )
 
     def _submit(self, request: WorkspaceRequest, **callbacks: Any) -> Ticket | None:
@@ -133,11 +153,11 @@ class WorkspaceServer:
         return self.jobs.submit(Ticket(job, **callbacks))
 
     def _finish_job(self, job: WorkspaceJob, fields: Any) -> tuple[Any, Any]:
-        """Job thread: the worker's fields -> published (and recorded) summary and cloud."""
+        """Job thread: the worker's fields -> published (and recorded) summary, and the
+        action's bounded cloud (the worker published the full one)."""
         summary_fields, cloud_fields = fields
         cloud = to_message(PointCloud2, cloud_fields)
         summary = to_message(WorkspaceSummary, summary_fields)
-        self._node.publish(self._cloud_publishers[job.kind], cloud)
         self._node.publish(self._summary_publisher, summary)
         self._node.get_logger().info(summary.message)
         return summary, cloud
@@ -179,7 +199,8 @@ class WorkspaceServer:
         else:
             position, stamp_ns = position_from_point(origin.position), self._node._now_ns()
             kind = int(origin.kind)  # as requested, even when unknown (7 is not orientation)
-        frame_id = self._node.state.manipulator.frame_id
+        state = self._node.state
+        frame_id = state.manipulator.frame_id if state is not None else ""
         fields = messages.summary_fields(
             None,
             message=reason,

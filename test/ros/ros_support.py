@@ -145,11 +145,13 @@ def running_node(
     overrides: dict[str, Any] | None = None,
     extra_args: list[str] | None = None,
     params_text: str | None = None,
+    node_options: list[str] | None = None,
 ) -> Iterator[NodeProcess]:
     """Start workspace_node with a parameters file in ``directory``; stop it on exit.
 
     The file is the example with ``overrides``, or ``params_text`` as given. The node records
-    into ``directory / "logs"``. Needs ROS_DOMAIN_ID set (``ros_domain``).
+    into ``directory / "logs"``. ``extra_args`` follow ``--ros-args``;
+    ``node_options`` (``--autostart=false``) precede it. Needs ROS_DOMAIN_ID set (``ros_domain``).
     """
     assert "ROS_DOMAIN_ID" in os.environ, "use the ros_domain fixture first"
     record_dir = directory / "logs"
@@ -162,7 +164,13 @@ def running_node(
         params = directory / "params.yaml"
         params.write_text(params_text, encoding="utf-8")
     log_path = directory / "node.log"
-    command = [str(NODE_EXECUTABLE), "--ros-args", "--params-file", str(params)]
+    command = [
+        str(NODE_EXECUTABLE),
+        *(node_options or []),
+        "--ros-args",
+        "--params-file",
+        str(params),
+    ]
     with log_path.open("wb") as log:
         process = subprocess.Popen(
             [*command, *(extra_args or [])],

@@ -132,6 +132,12 @@ def test_sigint_log_holds_exactly_what_the_node_did(ros_domain, ros_client, tmp_
         verdicts = ros_client.collect(
             ReachabilityResult, f"{node_name}/reachability", transient_local=True
         )
+        # the clouds come from the worker's own node: seen before the first one is published
+        ros_client.spin_until(
+            lambda: ros_client.node.count_publishers(f"{node_name}/projected_workspace") > 0,
+            what="the cloud publisher",
+            timeout=DISCOVERY_TIMEOUT,
+        )
         check = check_request([[0, 0, 0], [30, 20, 5], [45, 80, 10]])
         check_response = ros_client.call(CheckPoses, f"{node_name}/check_poses", check)
         compute = ComputeWorkspace.Request()

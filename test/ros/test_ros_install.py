@@ -38,6 +38,7 @@ def test_package_is_registered_in_the_ament_index():
     for name in (
         "msg/TiltTorsion.msg",
         "srv/CheckPoses.srv",
+        "srv/CheckPosesFlat.srv",
         "srv/ComputeWorkspace.srv",
         "action/ComputeWorkspace.action",
     ):
@@ -156,6 +157,7 @@ def test_node_offers_every_interface_of_the_issue(node_topics):
         "workspace_request": "hexapod_workspace_msgs/msg/WorkspaceRequest",
         "commanded_pose": "hexapod_workspace_msgs/msg/CommandedPose",
         "check_poses": "hexapod_workspace_msgs/srv/CheckPoses",
+        "check_poses_flat": "hexapod_workspace_msgs/srv/CheckPosesFlat",
         "compute_orientation_workspace": "std_srvs/srv/Trigger",
         "compute_projected_workspace": "std_srvs/srv/Trigger",
     }

@@ -204,7 +204,9 @@ def test_unreachable_reference_is_an_empty_workspace_not_a_crash(client):
 def test_trigger_publishes_cloud_and_summary(client, model, service, kind):
     expected = core_workspace(model, kind, tuple(model.position))
     summaries = client.collect(WorkspaceSummary, f"{NODE}/workspace_summary")
-    clouds = client.collect(PointCloud2, CLOUD_TOPIC[kind])
+    # transient local, as the README asks of a cloud subscriber: the cloud comes from the
+    # worker's node, which may discover a new reader after it has published
+    clouds = client.collect(PointCloud2, CLOUD_TOPIC[kind], transient_local=True)
     client.spin_until(
         lambda: client.node.count_publishers(f"{NODE}/workspace_summary") > 0
         and client.node.count_publishers(CLOUD_TOPIC[kind]) > 0,
@@ -212,11 +214,16 @@ def test_trigger_publishes_cloud_and_summary(client, model, service, kind):
     )
     response = client.call(Trigger, f"{NODE}/{service}", Trigger.Request())
     assert response.success, response.message
-    client.spin_until(
-        lambda: any(s.kind == kind and s.message == response.message for s in summaries)
-        and len(clouds) > 0,
-        what=f"summary and cloud of {service}",
-    )
+
+    def summary_and_cloud() -> bool:
+        stamps = {
+            s.header.stamp.sec * 10**9 + s.header.stamp.nanosec
+            for s in summaries
+            if s.kind == kind and s.message == response.message
+        }
+        return any(c.header.stamp.sec * 10**9 + c.header.stamp.nanosec in stamps for c in clouds)
+
+    client.spin_until(summary_and_cloud, what=f"summary and cloud of {service}")
     summary = next(s for s in summaries if s.message == response.message)
     assert_summary_matches(summary, expected, kind)
     cloud = next(c for c in clouds if c.header.stamp == summary.header.stamp)
@@ -267,7 +274,7 @@ def test_failed_requests_leave_the_last_boundary_for_late_subscribers(client):
 def test_workspace_request_topic_publishes_results(client, model):
     expected = core_workspace(model, WorkspaceKind.PROJECTED_TORSION_ZERO)
     summaries = client.collect(WorkspaceSummary, f"{NODE}/workspace_summary")
-    clouds = client.collect(PointCloud2, f"{NODE}/projected_workspace")
+    clouds = client.collect(PointCloud2, f"{NODE}/projected_workspace", transient_local=True)
     publisher = client.publisher(WorkspaceRequest, f"{NODE}/workspace_request")
     publisher.publish(workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO, request_id="topic-1"))
     bad = workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO, (math.nan, 0, 0), "topic-bad")
