@@ -34,7 +34,7 @@ from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.core.orientation import OrientationWorkspace, orientation_workspace
 from hexapod_workspace.core.projected import ProjectedWorkspace, projected_workspace
 from hexapod_workspace.core.resolution import WorkspaceKind
-from hexapod_workspace.errors import HexapodWorkspaceError, UnreachableReferenceError
+from hexapod_workspace.errors import HexapodWorkspaceError
 from hexapod_workspace.logs import messages
 
 from .clouds import CloudTopics, PublishedCloud, decimated_cloud_fields
@@ -212,17 +212,10 @@ def _serve(connection: Connection, cancel: Any, topics: CloudTopics | None = Non
                 fields, published = _published(publisher, job, fields)
                 connection.send(("published", published))
             reply: tuple[str, Any] = ("ok", fields)
-        except UnreachableReferenceError as error:  # the empty workspace: an empty cloud
-            if publisher is not None:
-                empty = messages.pointcloud_fields(
-                    np.zeros((0, 6)), frame_id=job.frame_id, stamp_ns=job.stamp_ns
-                )
-                connection.send(("published", publisher.publish(job.kind, empty)))
-            reply = ("error", error)
         except CanceledError:
             reply = ("canceled", None)
-        except HexapodWorkspaceError as error:
-            reply = ("error", error)
+        except HexapodWorkspaceError as error:  # an empty workspace too: results only are
+            reply = ("error", error)  # published, the latched clouds keep the last boundary
         except Exception as error:  # a bug: report it, keep serving
             reply = ("error", WorkerError(f"{type(error).__name__}: {error}"))
         connection.send(reply)
