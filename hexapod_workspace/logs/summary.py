@@ -92,6 +92,14 @@ class PoseCheckCall:
     response: dict[str, Any] | None = None
     n_poses: int | None = None
 
+    @property
+    def n_reachable(self) -> int:
+        """Poses answered reachable (nested ``results`` or flat ``reachable``)."""
+        response = self.response or {}
+        if "results" in response:
+            return sum(bool(r["reachable"]) for r in response["results"])
+        return int(np.count_nonzero(np.asarray(response.get("reachable", []), dtype=bool)))
+
 
 @dataclass
 class AtlasRecord:
@@ -108,14 +116,6 @@ class AtlasRecord:
     log_time_ns: int
     topic: str
     columns: dict[str, np.ndarray]
-
-    @property
-    def n_reachable(self) -> int:
-        """Poses answered reachable (nested ``results`` or flat ``reachable``)."""
-        response = self.response or {}
-        if "results" in response:
-            return sum(bool(r["reachable"]) for r in response["results"])
-        return int(np.count_nonzero(np.asarray(response.get("reachable", []), dtype=bool)))
 
 
 @dataclass

@@ -240,7 +240,6 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         self._extensions = list(extensions)
         for attach in self._extensions:
             attach(self)
-        self._warn_unknown_overrides()
         if autostart:
             try:
                 self.autostart()  # configure + activate (ros/lifecycle.py)
