@@ -45,8 +45,9 @@ points), and inflations add: ``sd(A ⊕ r_A, B ⊕ r_B) = sd(A, B) − r_A − r
 * Overlapping cores (GJK finds the origin in ``M``): the value is the largest of (1) over the
   candidate axes (box face normals, cylinder axes, cross products of edges and axes, the
   direction between the centres): exact for a segment or point against a box (these are all
-  the face normals of ``M``: the separating-axis theorem), a lower bound otherwise; the upper
-  bound returned is then 0 (the bodies overlap).
+  the face normals of ``M``: the separating-axis theorem), a lower bound otherwise, raised to
+  the signed distance of two capsules that hold the bodies when that is larger; the upper
+  bound of the cores' distance is then 0 (they overlap).
 """
 
 from __future__ import annotations
@@ -71,7 +72,6 @@ __all__ = [
     "POINT",
     "RECORD_SIZE",
     "SEGMENT",
-    "bounding_radius",
     "pair_distance",
     "pair_distances",
     "record",
@@ -146,27 +146,7 @@ def record(
     return out
 
 
-def bounding_radius(body: NDArray[np.float64]) -> float:
-    """Radius of the smallest sphere about the record's centre that holds the body, m."""
-    return float(_bounding_radius(body))
-
-
 # ------------------------------------------------------------------------------ helpers
-@_helper
-def _bounding_radius(body: NDArray[np.float64]) -> float:
-    kind = int(body[_KIND])
-    p0, p1, p2 = body[_P], body[_P + 1], body[_P + 2]
-    if kind == POINT:
-        core = 0.0
-    elif kind == SEGMENT:
-        core = abs(p0)
-    elif kind == BOX:
-        core = math.sqrt(p0 * p0 + p1 * p1 + p2 * p2)
-    else:
-        core = math.sqrt(p0 * p0 + p1 * p1)
-    return float(core + body[_INFLATION])
-
-
 @_helper
 def _support(
     body: NDArray[np.float64], dx: float, dy: float, dz: float, out: NDArray[np.float64]
@@ -291,6 +271,50 @@ def _ends(body: NDArray[np.float64]) -> tuple[float, float, float, float, float,
         2.0 * ay,
         2.0 * az,
     )
+
+
+@_helper
+def _enclosing(body: NDArray[np.float64]) -> tuple[float, float, float, float, float, float, float]:
+    """A capsule that holds the body: first end, direction (end − start) and radius, m.
+    Its axis is the segment or cylinder axis, or the longest axis of a box."""
+    kind = int(body[_KIND])
+    if kind <= SEGMENT:
+        p0x, p0y, p0z, dx, dy, dz = _ends(body)
+        return p0x, p0y, p0z, dx, dy, dz, body[_INFLATION]
+    if kind == CYLINDER:
+        axis, half, radius = 2, body[_P + 1], body[_P]
+    else:
+        axis = 0
+        if body[_P + 1] > body[_P + axis]:
+            axis = 1
+        if body[_P + 2] > body[_P + axis]:
+            axis = 2
+        half = body[_P + axis]
+        radius = math.sqrt(
+            body[_P] ** 2 + body[_P + 1] ** 2 + body[_P + 2] ** 2 - body[_P + axis] ** 2
+        )
+    ax = body[_R + axis] * half
+    ay = body[_R + 3 + axis] * half
+    az = body[_R + 6 + axis] * half
+    return (
+        body[_C] - ax,
+        body[_C + 1] - ay,
+        body[_C + 2] - az,
+        2.0 * ax,
+        2.0 * ay,
+        2.0 * az,
+        radius,
+    )
+
+
+@_helper
+def _capsule_bound(a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
+    """A lower bound of sd(a, b), m: the signed distance of capsules that hold them (signed
+    distance only decreases when the bodies grow). Exact for spheres and capsules."""
+    p0x, p0y, p0z, d1x, d1y, d1z, ra = _enclosing(a)
+    q0x, q0y, q0z, d2x, d2y, d2z, rb = _enclosing(b)
+    distance = _segment_segment(p0x, p0y, p0z, d1x, d1y, d1z, q0x, q0y, q0z, d2x, d2y, d2z)
+    return float(distance - ra - rb)
 
 
 @_helper
@@ -546,7 +570,10 @@ def _pair(
     if kb == POINT:
         return _point_solid(b, a) - inflation, 0.0
     lower, upper = _gjk(a, b, work)
-    return lower - inflation, upper - lower
+    # Both are lower bounds of sd; in contact the enclosing capsules' can be the better one
+    # (and the scene's pair skipping relies on the value never being below it).
+    value = max(lower - inflation, _capsule_bound(a, b))
+    return value, upper - inflation - value
 
 
 @_jit

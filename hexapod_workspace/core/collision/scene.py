@@ -63,7 +63,7 @@ from .distance import (
     CYLINDER,
     RECORD_SIZE,
     SEGMENT,
-    _bounding_radius,
+    _capsule_bound,
     _helper,
     _jit,
     _pair,
@@ -220,18 +220,15 @@ def _scene_kernel(
 ) -> None:
     """Per pose: fill the moving bodies (rows 0–7 of ``bodies``), then the closest pair.
 
-    Unless ``all_pairs``, pairs are visited by increasing bounding-sphere lower bound
-    (|c_a − c_b| − R_a − R_b ≤ sd, by inclusion) and the visit stops once that bound cannot
-    beat the best distance found: the minimum is the same as over all pairs.
+    Unless ``all_pairs``, pairs are visited by increasing lower bound (the signed distance of
+    capsules that hold the two bodies: ≤ sd, by inclusion; exact for capsule pairs) and the
+    visit stops once that bound cannot beat the best distance found: the minimum is the same
+    as over all pairs.
     """
     n_pairs = pairs.shape[0]
-    n_bodies = bodies.shape[0]
     work = np.empty((13, 3))
-    radius = np.empty(n_bodies)
     bound = np.empty(n_pairs)
     order = np.empty(n_pairs, dtype=np.int64)
-    for body in range(_FIRST_OBSTACLE, n_bodies):
-        radius[body] = _bounding_radius(bodies[body])
     for pose in range(rotations.shape[0]):
         r = rotations[pose]
         p = positions[pose]
@@ -252,7 +249,6 @@ def _scene_kernel(
             row[_R + 8] = axis[2]
             row[_P] = 0.5 * length
             row[_INFLATION] = leg_radius
-            radius[leg] = 0.5 * length + leg_radius
         if tool_ends.shape[0] == 2:
             row = bodies[_TOOL]
             q0 = _transform(r, tool_ends[0], p)
@@ -270,7 +266,6 @@ def _scene_kernel(
             row[_R + 8] = axis[2]
             row[_P] = 0.5 * length
             row[_INFLATION] = tool_radius
-            radius[_TOOL] = 0.5 * length + tool_radius
         if platform_record[0] == CYLINDER:
             row = bodies[_PLATFORM]
             row[0] = CYLINDER
@@ -284,7 +279,6 @@ def _scene_kernel(
                     )
             row[_P : _P + 3] = platform_record[_P : _P + 3]
             row[_INFLATION] = 0.0
-            radius[_PLATFORM] = _bounding_radius(row)
         best = np.inf
         chosen = -1
         if all_pairs:
@@ -296,16 +290,7 @@ def _scene_kernel(
                     chosen = k
         else:
             for k in range(n_pairs):
-                first = bodies[pairs[k, 0]]
-                second = bodies[pairs[k, 1]]
-                dx = first[_C] - second[_C]
-                dy = first[_C + 1] - second[_C + 1]
-                dz = first[_C + 2] - second[_C + 2]
-                bound[k] = (
-                    math.sqrt(dx * dx + dy * dy + dz * dz)
-                    - radius[pairs[k, 0]]
-                    - radius[pairs[k, 1]]
-                )
+                bound[k] = _capsule_bound(bodies[pairs[k, 0]], bodies[pairs[k, 1]])
             order[:] = np.argsort(bound, kind="mergesort")
             for rank in range(n_pairs):
                 k = order[rank]
@@ -344,7 +329,7 @@ def scene_distances(
         Tool-tip positions OC, base frame, m (one is broadcast to every rotation).
     all_pairs : bool
         Also return the distance of every pair (otherwise pairs that cannot be the closest, by
-        their bounding spheres, are skipped).
+        the capsules that hold them, are skipped).
 
     Returns
     -------
