@@ -471,6 +471,15 @@ def test_obstacle_refusals(group: dict, message: str) -> None:
             {"collision.platform": {"radius": 0.3, "z_min": 0.2, "z_max": 0.1}},
             "collision.platform.z_max: expected more than z_min",
         ),
+        (
+            {"collision.tool.radius": 0.05},
+            "collision.tool.length: expected a positive length (m) with collision.tool.radius",
+        ),
+        (
+            {"collision.platform.z_min": 0.05},
+            "collision.platform.radius: expected a positive radius (m) with "
+            "collision.platform.z_min given",
+        ),
         ({"collision.obstacles.names": "vise"}, "collision.obstacles.names: expected a list"),
         ({"collision.obstacles.names": ["vise"]}, "collision.obstacles.vise: listed in"),
         (

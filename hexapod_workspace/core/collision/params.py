@@ -22,7 +22,8 @@ name (the pattern ros2_control uses)::
           length: 1.5                  # cylinder, capsule: along the local z axis, centred, m
 
 The platform body exists when ``collision.platform.radius`` > 0, the tool body when
-``collision.tool.length`` > 0 (a zero radius makes it a line); ``frame`` defaults to ``base`` and
+``collision.tool.length`` > 0 (a zero radius makes it a line); half a body (a z range without
+a radius, a tool radius without a length) is refused; ``frame`` defaults to ``base`` and
 ``orientation`` to the identity. Every error is one line naming the parameter, what was
 expected and what was given, raised before anything is built.
 """
@@ -385,6 +386,14 @@ def collision_scene(
             )
             raise ConfigError(msg)
         platform = PlatformBody(radius, z_range[0], z_range[1])
+    else:
+        given = [k for k in ("z_min", "z_max") if f"collision.platform.{k}" in flat]
+        if given:
+            msg = (
+                f"collision.platform.radius: expected a positive radius (m) with "
+                f"collision.platform.{given[0]} given, got {radius!r}"
+            )
+            raise ConfigError(msg)
 
     tool = None
     length = _number("collision.tool.length", flat.get("collision.tool.length", 0.0), minimum=0.0)
@@ -393,6 +402,12 @@ def collision_scene(
     )
     if length > 0.0:
         tool = ToolBody(tool_radius, length)
+    elif tool_radius > 0.0:
+        msg = (
+            "collision.tool.length: expected a positive length (m) with collision.tool.radius "
+            f"{tool_radius!r}, got {length!r}"
+        )
+        raise ConfigError(msg)
 
     obstacles = []
     for name in names:
