@@ -10,7 +10,7 @@ tolerance measured as platform rotation or joint travel, as in
   tool axes on a 15° cone, ψ = 0; moves of about 0.6 mm and 0.2°);
 * large moves: random moves of ±0.3 m and tilts up to 30° (most cross the workspace boundary).
 
-Then :func:`hexapod_workspace.plan_torsion` on a 1,000-waypoint off-axis toolpath (the README's
+Then :func:`hexapod_workspace.plan_torsion` on a 1,000-waypoint off-axis toolpath (docs/paths.md's
 example shape), without a torsion limit and with ``max_dpsi`` = 5°, timed in the same run with
 the compiled dynamic programmes and with the numpy ones they replaced (the plans must be equal).
 

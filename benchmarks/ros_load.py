@@ -7,7 +7,7 @@ Starts workspace_node from the colcon install space (``make ros``) in a DDS doma
    of the same service type, single-threaded, constant answer, its own process), and with 1000
    poses against the core's ``check`` in this process (goals: <= 1.3x and <= 3x);
 2. under load: one commander process publishes ``CommandedPose`` at ``--rate`` Hz for
-   ``--duration`` s (reliable, KEEP_ALL, what the README asks of a publisher) and receives
+   ``--duration`` s (reliable, KEEP_ALL, what docs/ros.md asks of a publisher) and receives
    the ``ReachabilityResult`` of each; ``--clients`` processes call ``check_poses`` (1 pose)
    back to back; this process keeps a 3-D orientation workspace computing (the
    ``~/compute_workspace`` action, or the old service when the node has no action).

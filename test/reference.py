@@ -1,6 +1,6 @@
 """Literal, per-pose reference implementations (slow on purpose).
 
-They follow the definitions of the README, *Conventions*, line by line, one pose at a time, with a
+They follow the definitions of docs/theory.md, line by line, one pose at a time, with a
 segment distance computed by a different method than :mod:`hexapod_workspace.core.constraints`
 (interior critical point plus the four edge cases). Tests use them as independent evidence
 for the batched code; the benchmarks use them as the "straightforward per-pose loop" and the

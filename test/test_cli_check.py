@@ -56,7 +56,7 @@ def test_unreachable_exit_1_reason_on_stderr_and_global_options_after_command():
     assert pose["reachable"] is False
     assert pose["violated"] == ["leg_length", "platform_joint"]
     assert pose["margins"]["leg_length"] < 0
-    # The README: the reason for exit 1 goes to stderr.
+    # docs/cli.md: the reason for exit 1 goes to stderr.
     assert err == "hexapod-workspace: 1 of 1 poses unreachable\n"
 
 

@@ -41,8 +41,8 @@ SEGMENT_KEYS = {
 
 
 def cone(count: int = 40) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Off-axis circle of tool-tip positions with tool axes on a 17° cone (the README example's
-    shape, fewer waypoints): ψ = 0 fails near φ = 130°, other torsions reach."""
+    """Off-axis circle of tool-tip positions with tool axes on a 17° cone (the shape of the
+    Motions page's example, fewer waypoints): ψ = 0 fails near φ = 130°, other torsions reach."""
     t = np.linspace(0.0, 2.0 * np.pi, count)
     positions = np.column_stack(
         [0.2 + 0.02 * np.cos(t), 0.2 + 0.02 * np.sin(t), np.full(count, -0.95)]
@@ -185,7 +185,7 @@ def test_huge_angles_are_their_principal_values(tmp_path):
 
 
 def test_the_tool_direction_plot_labels_every_ring_clear_of_the_curves(example):
-    """Issue 16 item 18: the polar panel of the README's toolpath figure (tool axes on a 17°
+    """Issue 16 item 18: the polar panel of the Motions page's toolpath figure (tool axes on a 17°
     cone off the axis) labels every ring, and no label covers a curve or a tool direction."""
     from cli_support import polar_labels_clear
 

@@ -24,7 +24,7 @@ def test_example_loads_with_defaults_from_the_home_pose(example):
     assert example.base_joints.shape == (6, 3)
     assert example.platform_joints.shape == (6, 3)
     np.testing.assert_allclose(np.linalg.norm(example.base_joint_axes, axis=1), 1.0)
-    # Default axes: the leg directions at the home pose (README, Conventions).
+    # Default axes: the leg directions at the home pose (docs/theory.md, Conventions).
     legs = example.home_position + example.platform_joints - example.base_joints
     directions = legs / np.linalg.norm(legs, axis=1, keepdims=True)
     np.testing.assert_allclose(example.base_joint_axes, directions)
@@ -301,7 +301,7 @@ def test_lengths_beyond_a_million_metres_are_refused(example_parameters, name):
 
 
 def test_example_from_any_working_directory(tmp_path, monkeypatch, example):
-    """The README's API snippet uses the packaged example, not a relative path."""
+    """The API snippets (README, Getting started) use the packaged example, not a relative path."""
     monkeypatch.chdir(tmp_path)
     assert Manipulator.example() == example
 

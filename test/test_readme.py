@@ -1,14 +1,19 @@
-"""The README's examples are what the code prints and answers (issue 16, item 14).
+"""The examples of the README and of the documentation pages are what the code prints and
+answers (issue 16, item 14; issue 20: the README's sections moved into ``docs/``).
 
-* every ``$ hexapod-workspace ...`` example of the *Command line* section is run, and its printed
-  lines must be the README's, except for the measured times (masked: they are stated with their
-  conditions, never asserted) and a ``...`` line, which stands for the rest;
-* the node's Trigger, action and topic examples carry the numbers the node computes: the same
-  job the node's worker runs (:func:`hexapod_workspace.ros.worker.compute_fields`, no rclpy),
-  with the node's default parameters.
+* every ``$ hexapod-workspace ...`` example of the README's *Command line* section and of the
+  command-line page (``docs/cli.md``) is run, and its printed lines must be the page's, except
+  for the measured times (masked: they are stated with their conditions, never asserted) and a
+  ``...`` line, which stands for the rest;
+* the demo table of the README and of ``docs/getting_started.md`` is what the demo prints;
+* the node's Trigger, action and topic examples (``docs/ros.md``) carry the numbers the node
+  computes: the same job the node's worker runs
+  (:func:`hexapod_workspace.ros.worker.compute_fields`, no rclpy), with the node's default
+  parameters.
 
-The ROS interface and parameter tables are checked against a live node in
-``test/ros/test_ros_readme.py``; the atlas snippet in ``test_readme_atlas.py``.
+The README's interface table and the node's parameters are checked against a live node in
+``test/ros/test_ros_readme.py``; the atlas snippet (``docs/atlas.md``) in
+``test_readme_atlas.py``; the README's links in ``test_readme_links.py``.
 """
 
 from __future__ import annotations
@@ -28,24 +33,29 @@ from hexapod_workspace.core import resolution
 from hexapod_workspace.core.resolution import WorkspaceKind
 from hexapod_workspace.ros.worker import WorkspaceJob, compute_fields
 
-README = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+ROOT = Path(__file__).resolve().parents[1]
+README = (ROOT / "README.md").read_text(encoding="utf-8")
+#: The documentation pages whose examples are checked here.
+CLI_PAGE = (ROOT / "docs" / "cli.md").read_text(encoding="utf-8")
+GETTING_STARTED = (ROOT / "docs" / "getting_started.md").read_text(encoding="utf-8")
+ROS_PAGE = (ROOT / "docs" / "ros.md").read_text(encoding="utf-8")
 #: A measured time in the CLI's output ("23.4 ms", "2.34 s"): stated in the README, not tested.
 TIME = re.compile(r"\b\d+(?:\.\d+)? (?:ms|s)\b")
 
 
-def section(title: str) -> str:
-    """The README's text from the heading ``title`` to the next heading of the same level."""
+def section(title: str, text: str = README) -> str:
+    """The text from the heading ``title`` to the next heading of the same level."""
     level = title.split(" ", 1)[0]
-    start = README.index(f"\n{title}\n")
-    end = README.find(f"\n{level} ", start + len(title) + 2)
-    return README[start : end if end > 0 else None]
+    start = text.index(f"\n{title}\n")
+    end = text.find(f"\n{level} ", start + len(title) + 2)
+    return text[start : end if end > 0 else None]
 
 
-def _examples() -> list[tuple[str, list[str], int]]:
+def _examples(text: str) -> list[tuple[str, list[str], int]]:
     """(command line, the lines shown after it, its exit status) of every CLI example of
-    *Command line*; the status is 0 unless an ``$ echo $?`` line follows with another."""
+    ``text``; the status is 0 unless an ``$ echo $?`` line follows with another."""
     examples: list[tuple[str, list[str], int]] = []
-    for block in re.findall(r"```\n(.*?)```", section("## Command line"), re.DOTALL):
+    for block in re.findall(r"```\n(.*?)```", text, re.DOTALL):
         lines = block.splitlines()
         for k, line in enumerate(lines):
             if line.startswith("$ echo $?"):
@@ -61,13 +71,16 @@ def _examples() -> list[tuple[str, list[str], int]]:
     return [example for example in examples if example[0].startswith("hexapod-workspace ")]
 
 
-EXAMPLES = _examples()
+README_EXAMPLES = _examples(section("## Command line"))
+PAGE_EXAMPLES = _examples(CLI_PAGE)
+EXAMPLES = README_EXAMPLES + PAGE_EXAMPLES
 
 
 def test_the_cli_examples_are_found():
-    commands = [command.split()[1:3] for command, _, _ in EXAMPLES]
-    assert len(EXAMPLES) >= 7, commands
-    assert [status for _, _, status in EXAMPLES].count(1) == 1  # check with an unreachable pose
+    commands = [command.split()[1:3] for command, _, _ in PAGE_EXAMPLES]
+    assert len(PAGE_EXAMPLES) >= 7, commands
+    assert [status for _, _, status in PAGE_EXAMPLES].count(1) == 1  # an unreachable pose
+    assert [status for _, _, status in README_EXAMPLES] == [1]  # the README's one example
 
 
 @pytest.mark.parametrize(("command", "shown", "status"), EXAMPLES, ids=[e[0] for e in EXAMPLES])
@@ -107,7 +120,8 @@ def _assert_close(got, shown, path: str = "") -> None:
 
 
 def test_the_demo_table_is_what_the_demo_prints(tmp_path):
-    """The README's demo table, times aside (measured, stated with their conditions)."""
+    """The demo table of the README and of Getting started, times aside (measured, stated
+    with their conditions)."""
     code, out, err = run_main("demo", "--out", str(tmp_path / "demo"))
     assert code == 0, err
 
@@ -118,8 +132,9 @@ def test_the_demo_table_is_what_the_demo_prints(tmp_path):
             if line.startswith(("| on_axis |", "| off_axis |"))
         ]
 
-    assert len(rows(README)) == 2
-    assert rows(README) == rows(out)
+    for text in (README, GETTING_STARTED):
+        assert len(rows(text)) == 2
+        assert rows(text) == rows(out)
 
 
 # ------------------------------------------------------------------------- the node's examples
@@ -145,7 +160,7 @@ def _shown_number(text: str, name: str) -> float:
 
 
 def test_the_trigger_examples_are_what_the_node_answers():
-    ros = section("## ROS 2 node")
+    ros = ROS_PAGE
     example = Manipulator.example()
     jobs = {
         "compute_projected_workspace": (
@@ -165,7 +180,7 @@ def test_the_trigger_examples_are_what_the_node_answers():
 
 
 def test_the_action_and_topic_examples_carry_the_node_s_numbers():
-    ros = section("## ROS 2 node")
+    ros = ROS_PAGE
     action = ros.split("$ ros2 action send_goal", 1)[1].split("```", 1)[0]
     assert "kind: 1, position: {x: 0.2, y: 0.2, z: -0.95}, n_rays: 360, tolerance: 1.0e-6" in action
     summary = _node_job(WorkspaceKind.PROJECTED_TORSION_ZERO, [0.2, 0.2, -0.95], 360, 1e-6)

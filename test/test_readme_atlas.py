@@ -1,7 +1,8 @@
-"""The README's atlas Python snippet, saved as a script and run as a user would (issue 16, item
-12): on a real local Dask cluster (worker processes on 127.0.0.1, which re-import the script),
-twice (the second run finds the finished store and returns it), and without its main guard
-(one clear error, no store left behind). Only the grid step is coarsened, to keep it short."""
+"""The atlas page's Python snippet (``docs/atlas.md``, once the README's), saved as a script
+and run as a user would (issue 16, item 12): on a real local Dask cluster (worker processes on
+127.0.0.1, which re-import the script), twice (the second run finds the finished store and
+returns it), and without its main guard (one clear error, no store left behind). Only the grid
+step is coarsened, to keep it short."""
 
 from __future__ import annotations
 
@@ -22,10 +23,9 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def _readme_snippet() -> str:
-    """The python block of the README's atlas section that calls workspace_atlas."""
-    readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    section = readme.split("## Workspace atlas", 1)[1]
-    blocks = re.findall(r"```python\n(.*?)```", section, re.DOTALL)
+    """The python block of the atlas page (``docs/atlas.md``) that calls workspace_atlas."""
+    page = (ROOT / "docs" / "atlas.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"```python\n(.*?)```", page, re.DOTALL)
     (snippet,) = [block for block in blocks if "workspace_atlas(m, grid" in block]
     assert "step=0.1)" in snippet
     return snippet.replace("step=0.1)", "step=0.25)")  # 5 x 5 x 3 positions instead of 847

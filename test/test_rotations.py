@@ -42,7 +42,7 @@ def random_tt(rng: np.random.Generator, count: int) -> np.ndarray:
 
 
 def test_matrix_is_the_product_of_elementary_rotations(rng):
-    # Definition (README, Conventions): R = Rz(phi) Ry(theta) Rz(-phi) Rz(psi).
+    # Definition (docs/theory.md, Conventions): R = Rz(phi) Ry(theta) Rz(-phi) Rz(psi).
     for phi, theta, psi in random_tt(rng, 50):
         expected = rz(phi) @ ry(theta) @ rz(-phi) @ rz(psi)
         np.testing.assert_allclose(tt_to_matrix([phi, theta, psi]), expected, atol=1e-14)

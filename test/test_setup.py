@@ -58,9 +58,10 @@ def test_the_python_requirement_is_the_same_everywhere():
     tools = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]
     assert tools["ruff"]["target-version"] == "py" + minimum.replace(".", "")
     assert tools["mypy"]["python_version"] == minimum
-    readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    stated = set(re.findall(r"Python (?:≥|>=) ?(\d+\.\d+)", readme))
-    assert stated == {minimum}, stated
+    for page in ("README.md", "docs/getting_started.md"):
+        text = (ROOT / page).read_text(encoding="utf-8")
+        stated = set(re.findall(r"Python (?:≥|>=) ?(\d+\.\d+)", text))
+        assert stated == {minimum}, (page, stated)
     assert sys.version_info >= tuple(int(v) for v in minimum.split("."))
 
 
@@ -134,8 +135,9 @@ def test_node_check_passes_here_and_make_test_runs_it_first():
     assert (done.returncode, done.stderr) == (0, "")
     makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
     assert re.search(r"^test: node-check ", makefile, re.MULTILINE)
-    readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    assert "Node.js ≥ 18 with npm" in readme.split("## The demo")[0]
+    for page in ("README.md", "docs/getting_started.md"):
+        text = (ROOT / page).read_text(encoding="utf-8")
+        assert "Node.js ≥ 18 with npm" in text.split("## Command line")[0].split("## The demo")[0]
 
 
 # ---------------------------------------------------------------------- item 11: ROS_DOMAIN_ID
@@ -162,8 +164,9 @@ def test_node_and_client_shells_share_one_documented_domain():
     seen = {_domain(with_env, env), _domain(with_env, env), _domain(sourced, env)}
     seen.add(_domain(sourced, env))
     assert seen == {"0"}
-    readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    assert "otherwise use **0**, ROS 2's own default" in readme
+    for page in ("README.md", "docs/ros.md"):
+        text = (ROOT / page).read_text(encoding="utf-8")
+        assert "otherwise use **0**, ROS 2's own default" in text, page
     # A domain the user chose is kept by both.
     env["ROS_DOMAIN_ID"] = "42"
     assert {_domain(with_env, env), _domain(sourced, env)} == {"42"}

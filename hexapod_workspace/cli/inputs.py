@@ -137,7 +137,7 @@ def load_manipulator(
 def output_file(path: str | Path, flag: str, *, force: bool, suffixes: tuple[str, ...]) -> Path:
     """Check a file the user asked us to write, before any work is done.
 
-    Rules (the README's "Files the CLI writes"): the name must end with one of ``suffixes``;
+    Rules (docs/cli.md, "Files the CLI writes"): the name must end with one of ``suffixes``;
     its folder must exist (files are never written into folders we would have to invent); an
     existing file is replaced only when it already is a file of that kind (a log for
     ``--record``, an image for ``--plot``) or with ``--force``.

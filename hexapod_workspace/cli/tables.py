@@ -1,7 +1,7 @@
 """The CSV files the CLI reads (``check --poses-file``, ``check-path``): one reader, one set of
 header rules, errors that name the file's line.
 
-Rules (the README's "CSV files"):
+Rules (docs/cli.md, "CSV files"):
 
 * cells are separated by semicolons, commas, tabs or spaces (the first of ``;``, ``,``, tab
   found on a line; else spaces); blank lines and lines starting with ``#`` are skipped;

@@ -1,6 +1,6 @@
 """Inverse kinematics, exact segment distance and the constraint margins, batched.
 
-Inverse kinematics of leg i (README, *Conventions*): ``L_i = p + R·b_i − a_i``, length
+Inverse kinematics of leg i (docs/theory.md, *Conventions*): ``L_i = p + R·b_i − a_i``, length
 ``ℓ_i = |L_i|``, unit direction ``n_i = L_i / ℓ_i`` (from base joint A_i to platform joint B_i).
 
 Each constraint has a signed margin, ≥ 0 when it holds and < 0 when it is violated; the

@@ -355,7 +355,7 @@ class Manipulator:
         Parameters
         ----------
         path : str or pathlib.Path
-            YAML parameters file, as in the README's section *ROS 2 node*, *Parameters*.
+            YAML parameters file, as in docs/configuration.md.
         warn : bool
             No effect (a file's unusable model is refused, not warned about); accepted so that
             callers written when it warned keep working.

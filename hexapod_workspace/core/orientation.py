@@ -1,6 +1,6 @@
 """3-D orientation workspace (ψ slices in the cylindrical picture) and torsion ranges.
 
-Cylindrical picture (README, *Conventions*): x = θ cos φ, y = θ sin φ, z = ψ. The orientation
+Cylindrical picture (docs/theory.md): x = θ cos φ, y = θ sin φ, z = ψ. The orientation
 workspace at a position is the set of reachable (x, y, ψ) connected to the reference
 orientation (0, 0, 0). It is computed as in Bonev & Ryu, with every boundary located to a
 tolerance by the certified search of :mod:`hexapod_workspace.core.search`:

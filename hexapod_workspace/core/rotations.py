@@ -1,6 +1,6 @@
 """Tilt-and-Torsion angles and the other orientation representations, batch-first.
 
-Conventions (README, "Conventions"): the Tilt-and-Torsion (T&T) angles (φ, θ, ψ) of Bonev & Ryu
+Conventions (docs/theory.md): the Tilt-and-Torsion (T&T) angles (φ, θ, ψ) of Bonev & Ryu
 define ``R(φ, θ, ψ) = Rz(φ) · Ry(θ) · Rz(−φ) · Rz(ψ)``, the orientation of the mobile frame
 relative to the base frame, with φ ∈ (−π, π] (azimuth of the tilt axis), θ ∈ [0, π] (tilt) and
 ψ ∈ [−π, π] (torsion). The same rotation in ZYZ Euler angles is (φ, θ, ψ − φ). The *approach

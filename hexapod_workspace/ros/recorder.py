@@ -10,7 +10,7 @@ Flush bound (end to end, for the node): the thread writes a message as soon as i
 interpreter and flushes whatever has been pending for :data:`FLUSH_INTERVAL` s, waking at least
 every :data:`WAKE_INTERVAL` s; so a message is in the file (the operating system's hands; a
 SIGKILL of the node does not lose it) at most about ``FLUSH_INTERVAL + WAKE_INTERVAL`` s after
-the callback queued it. :data:`FLUSH_BOUND` is the bound the README states and
+the callback queued it. :data:`FLUSH_BOUND` is the bound docs/log_format.md states and
 ``test_node_recording`` proves under a 200 Hz stream with some margin for a loaded machine.
 
 Rotation (:class:`Rotation`, the ``recording.max_*`` parameters), as rosbag2 splits a bag: the

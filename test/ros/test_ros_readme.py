@@ -1,12 +1,15 @@
-"""The README's ROS tables are the node's (issue 16, item 14), checked against a real node built
-in this process with its extensions (as ``workspace_node`` runs it), over real rclpy:
+"""The README's interface table and the documentation's ROS facts are the node's (issue 16,
+item 14; issue 20), checked against a real node built in this process with its extensions (as
+``workspace_node`` runs it), over real rclpy:
 
-* the *Parameters* table lists exactly the parameters the node declares besides the model's
-  (those are the parameters file's), each with the node's default;
-* the *Topics* table lists exactly the topics the node publishes and subscribes to (rclpy's
-  own graph, ``/rosout``, ``/parameter_events`` and action internals aside), with their types;
-  every service and action the node offers is named with its type;
-* the node-session ``replay`` example lists exactly the channels of a real node log.
+* the parameters the documentation lists as the node's own (``docs/ros.md`` generates them from
+  :func:`~hexapod_workspace.ros.parameters.parameter_specs`) are exactly the parameters the node
+  declares besides the model's (those are the parameters file's), each with the node's default;
+* the README's interface table lists exactly the topics the node publishes and subscribes to
+  (rclpy's own graph, ``/rosout``, ``/parameter_events`` and action internals aside), with
+  their types, and exactly the services and actions it offers, with their types;
+* the node-session ``replay`` example (``docs/log_format.md``) lists exactly the channels of a
+  real node log.
 """
 
 from __future__ import annotations
@@ -24,10 +27,13 @@ from rclpy.parameter import Parameter  # noqa: E402
 
 from hexapod_workspace import Manipulator, logs  # noqa: E402
 from hexapod_workspace.ros.node import EXTENSIONS, NODE_NAME, WorkspaceNode  # noqa: E402
-from hexapod_workspace.ros.parameters import parameter_specs  # noqa: E402
+from hexapod_workspace.ros.parameters import MODEL_DESCRIPTIONS, parameter_specs  # noqa: E402
 
-README = (Path(__file__).resolve().parents[2] / "README.md").read_text(encoding="utf-8")
-ROS = README[README.index("\n## ROS 2 node\n") : README.index("<!-- ros:end -->")]
+ROOT = Path(__file__).resolve().parents[2]
+README = (ROOT / "README.md").read_text(encoding="utf-8")
+ROS = README[README.index("\n## ROS 2 node\n") :]
+LOG_PAGE = (ROOT / "docs" / "log_format.md").read_text(encoding="utf-8")
+ROS_PAGE = (ROOT / "docs" / "ros.md").read_text(encoding="utf-8")
 PREFIX = f"/{NODE_NAME}/"
 #: The topic the test gives ``motion.current_pose_topic`` (the table names the parameter).
 CURRENT_POSE = "/cell/current_pose"
@@ -43,35 +49,15 @@ _RCLPY_SERVICES = (
 )
 
 
-def table(title: str) -> list[list[str]]:
-    """The cells of the first Markdown table after the heading ``title`` of the ROS section."""
-    text = ROS[ROS.index(f"\n{title}\n") :]
+def table() -> list[list[str]]:
+    """The cells of the interface table of the README's ROS section."""
     rows = []
-    for line in text.splitlines()[1:]:
+    for line in ROS.splitlines()[1:]:
         if line.startswith("|"):
             rows.append([cell.strip() for cell in line.strip("|").split("|")])
         elif rows:
             break
     return rows[2:]  # the header and the rule
-
-
-def shown_default(cell: str) -> object:
-    """The default in a 'type, default (range), read-only' cell: the first literal in it."""
-    for token in re.sub(r"\([^)]*\)", "", cell).split(","):
-        token = token.strip()
-        if token in ("true", "false"):
-            return token == "true"
-        if token == '""':
-            return ""
-        if token.startswith("`") and token.endswith("`"):
-            return token.strip("`")
-        for kind in (int, float):
-            try:
-                return kind(token)
-            except ValueError:
-                pass
-    msg = f"no default in {cell!r}"
-    raise AssertionError(msg)
 
 
 @pytest.fixture(scope="module")
@@ -94,23 +80,26 @@ def node(ros_context, tmp_path_factory):
         node.destroy_node()
 
 
-def test_the_parameters_table_is_what_the_node_declares(node):
-    rows = {row[0].strip("`"): row[1] for row in table("### Parameters")}
+def test_the_documented_node_parameters_are_what_the_node_declares(node):
+    """``docs/ros.md`` lists the specs outside MODEL_DESCRIPTIONS (``:group: node``), each with
+    its default, and names the parameters extensions declare; the configuration reference lists
+    the model's."""
+    specs = {
+        name: spec for name, spec in parameter_specs().items() if name not in MODEL_DESCRIPTIONS
+    }
     declared = node.get_parameters_by_prefix("")
     model = set(Manipulator.example().to_parameters())
     rclpy_own = {"use_sim_time", "start_type_description_service"}
-    assert set(rows) == set(declared) - model - rclpy_own
-    overridden = {
-        "recording.directory": parameter_specs()["recording.directory"].default,
-        "motion.current_pose_topic": "",
-    }
-    for name, cell in rows.items():
-        default = overridden.get(name, declared[name].value)
-        shown = shown_default(cell)
-        if isinstance(default, float):
-            assert shown == pytest.approx(default, rel=1e-3), (name, cell, default)
-        else:
-            assert shown == default, (name, cell, default)
+    own = set(declared) - model - rclpy_own
+    assert set(specs) <= own
+    # Parameters an extension declares (motion.current_pose_topic) are not in the generated
+    # list: the page names each of them in its text.
+    for name in own - set(specs):
+        assert f"`{name}`" in ROS_PAGE, name
+    overridden = {"recording.directory", "motion.current_pose_topic"}  # set by this test
+    for name, spec in specs.items():
+        if name not in overridden:
+            assert declared[name].value == spec.default, name
 
 
 def _graph(node) -> tuple[dict, dict]:
@@ -130,41 +119,53 @@ def _graph(node) -> tuple[dict, dict]:
     return topics, services
 
 
-def test_the_topics_table_is_every_topic_of_the_node(node):
+def _rows(kind: str) -> dict[str, str]:
+    """Absolute name -> type of the README table's rows of ``kind`` (topic, service, action)."""
+    rows = {}
+    for name, where, type_name in table():
+        name = name.strip("`")
+        if name.startswith("~/"):
+            name = PREFIX + name[2:]
+        elif "motion.current_pose_topic" in name:
+            name = CURRENT_POSE
+        if where.split(",")[0] == kind:
+            rows[name] = type_name.strip("`")
+    return rows
+
+
+def test_the_interface_table_lists_every_topic_of_the_node(node):
     topics, _ = _graph(node)
     offered = {
         name: tuple(types)
         for name, types in topics.items()
         if "/_action/" not in name and name not in ("/rosout", "/parameter_events")
     }
-    shown = {}
-    for row in table("### Topics"):
-        name = row[0].strip("`")
-        if name.startswith("~/"):
-            name = PREFIX + name[2:]
-        elif "motion.current_pose_topic" in name:
-            name = CURRENT_POSE
-        shown[name] = (row[1].strip("`"),)
+    shown = {name: (type_name,) for name, type_name in _rows("topic").items()}
     assert shown == offered
 
 
-def test_every_service_and_action_is_named_with_its_type(node):
+def test_the_interface_table_lists_every_service_and_action_with_its_type(node):
     _, services = _graph(node)
     named = {}
     for name, (kind,) in services.items():
         short = name.removeprefix(PREFIX)
         if short.endswith("/_action/send_goal"):  # an action: pkg/action/X_SendGoal
-            named[short.split("/_action/")[0]] = kind.removesuffix("_SendGoal")
+            named[("action", PREFIX + short.split("/_action/")[0])] = kind.removesuffix("_SendGoal")
         elif "/_action/" not in short and short not in _RCLPY_SERVICES:
-            named[short] = kind
-    assert {"check_poses", "compute_workspace", "check_path", "compute_atlas"} <= set(named)
-    for short, kind in named.items():
-        assert f"`~/{short}`" in README, short
-        assert f"`{kind}" in README, (short, kind)
+            named[("service", name)] = kind
+    assert {"check_poses", "compute_workspace", "check_path", "compute_atlas"} <= {
+        name.removeprefix(PREFIX) for _, name in named
+    }
+    shown = {
+        (kind, name): type_name
+        for kind in ("service", "action")
+        for name, type_name in _rows(kind).items()
+    }
+    assert shown == named
 
 
 def test_the_replay_example_lists_the_channels_of_a_real_node_log(node):
-    example = ROS_REPLAY = README[README.index("A node session (") :]
+    example = ROS_REPLAY = LOG_PAGE[LOG_PAGE.index("A node session (") :]
     block = ROS_REPLAY[ROS_REPLAY.index("```\n") + 4 :]
     block = block[: block.index("```")]
     assert "$ hexapod-workspace replay" in example
