@@ -31,12 +31,14 @@ class WaypointChecks:
         (φ, θ, ψ) in rad, canonical ranges.
     reachable : ndarray, shape (N,), bool
     margins : dict of str to ndarray, shape (N,)
-        Signed margin of each constraint (keys :data:`CONSTRAINT_NAMES`; m, rad, rad, m; +inf
+        Signed margin of each constraint (keys
+        :data:`~hexapod_workspace.core.constraint_table.CONSTRAINT_NAMES`; m, rad, rad, m; +inf
         when the interference check is disabled), as in :class:`CheckResult`.
     relative : ndarray, shape (N,)
         Smallest relative margin (dimensionless, see :func:`relative_margins`).
     limiting_constraint : ndarray, shape (N,), int
-        Index into :data:`CONSTRAINT_NAMES` of the smallest relative margin.
+        Index into :data:`~hexapod_workspace.core.constraint_table.CONSTRAINT_NAMES` of the
+        smallest relative margin.
     limiting_leg : ndarray, shape (N,), int
         1-based leg of the limiting constraint (interference: lower leg of the pair).
     limiting_pair : ndarray, shape (N, 2), int
@@ -57,7 +59,8 @@ class WaypointChecks:
 
     @property
     def margin_array(self) -> NDArray[np.float64]:
-        """The margins as one array, shape (C, N), rows in :data:`CONSTRAINT_NAMES` order."""
+        """The margins as one array, shape (C, N), rows in the order of
+        :data:`~hexapod_workspace.core.constraint_table.CONSTRAINT_NAMES`."""
         return np.stack([self.margins[name] for name in CONSTRAINT_NAMES])
 
     @property
