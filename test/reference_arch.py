@@ -197,9 +197,13 @@ def model_from_parameters(flat: Mapping[str, Any]) -> ReferenceModel:
         raise ValueError(msg)
     home = np.asarray(flat["geometry.home_position"], dtype=float)
     position = np.asarray(flat.get("pose.position", home), dtype=float)
-    stroke = ("leg_length_min", "leg_length_max") if architecture == "ups" else (
-        "actuator_min",
-        "actuator_max",
+    stroke = (
+        ("leg_length_min", "leg_length_max")
+        if architecture == "ups"
+        else (
+            "actuator_min",
+            "actuator_max",
+        )
     )
     fields: dict[str, Any] = {
         "architecture": architecture,
@@ -247,11 +251,10 @@ def model_from_parameters(flat: Mapping[str, Any]) -> ReferenceModel:
         base_axes = _rotate_about(model.crank_axes, -q[0], directions)  # type: ignore[arg-type]
     else:
         base_axes = directions
-    platform_axes = (
-        _unit_rows(given_platform.reshape(6, 3)) if given_platform.size else -directions
+    platform_axes = _unit_rows(given_platform.reshape(6, 3)) if given_platform.size else -directions
+    return ReferenceModel(
+        **{**fields, "base_joint_axes": base_axes, "platform_joint_axes": platform_axes}
     )
-    return ReferenceModel(**{**fields, "base_joint_axes": base_axes,
-                             "platform_joint_axes": platform_axes})
 
 
 def load(path: str | Path) -> ReferenceModel:
@@ -289,8 +292,9 @@ def platform_points(
 ) -> NDArray[np.float64]:
     """B_i = p + R·b_i, shape (N, 6, 3), m, base frame."""
     rotations = rotation_matrices(angles)
-    return np.asarray(position, dtype=float) + np.einsum("nkl,il->nik", rotations,
-                                                         model.platform_joints)
+    return np.asarray(position, dtype=float) + np.einsum(
+        "nkl,il->nik", rotations, model.platform_joints
+    )
 
 
 def _rotate_about(
@@ -478,8 +482,9 @@ def evaluate(model: ReferenceModel, angles: ArrayLike, position: ArrayLike) -> R
             tau = np.sum(n * arm, axis=-1) / model.crank_lengths
         per_leg["transmission"] = np.abs(tau) - model.transmission_min
     if model.architecture == "rus":
-        base_axes = _rotate_about(model.crank_axes, q, np.broadcast_to(model.base_joint_axes,
-                                                                       legs.shape))
+        base_axes = _rotate_about(
+            model.crank_axes, q, np.broadcast_to(model.base_joint_axes, legs.shape)
+        )
     else:
         base_axes = np.broadcast_to(model.base_joint_axes, legs.shape)
     per_leg["base_joint"] = model.base_joint_max_angle - _angle(base_axes, n)
@@ -489,8 +494,10 @@ def evaluate(model: ReferenceModel, angles: ArrayLike, position: ArrayLike) -> R
     margins = {name: per_leg[name].min(axis=1) for name in per_leg}  # NaN propagates
     if model.leg_diameter > 0.0:
         pairs = np.stack(
-            [segment_distance(ends[:, i], platform[:, i], ends[:, j], platform[:, j])
-             for i, j in PAIRS],
+            [
+                segment_distance(ends[:, i], platform[:, i], ends[:, j], platform[:, j])
+                for i, j in PAIRS
+            ],
             axis=1,
         )
         per_leg["leg_pairs"] = pairs - model.leg_diameter  # (N, 15), pairs in PAIRS order
@@ -508,8 +515,6 @@ def evaluate(model: ReferenceModel, angles: ArrayLike, position: ArrayLike) -> R
 
     names = MARGIN_NAMES[model.architecture]
     margins = {name: margins[name] for name in names}
-    enforced = tuple(
-        name for name in names if name != "singularity" or model.singularity_min > 0.0
-    )
+    enforced = tuple(name for name in names if name != "singularity" or model.singularity_min > 0.0)
     reachable = np.logical_and.reduce([margins[name] >= 0.0 for name in enforced])
     return ReferenceResult(margins, per_leg, q, enforced, reachable)
