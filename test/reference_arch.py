@@ -290,11 +290,10 @@ def rotation_matrices(angles: ArrayLike) -> NDArray[np.float64]:
 def platform_points(
     model: ReferenceModel, angles: ArrayLike, position: ArrayLike
 ) -> NDArray[np.float64]:
-    """B_i = p + R·b_i, shape (N, 6, 3), m, base frame."""
+    """B_i = p + R·b_i, shape (N, 6, 3), m, base frame; ``position`` (3,) or one per pose (N, 3)."""
     rotations = rotation_matrices(angles)
-    return np.asarray(position, dtype=float) + np.einsum(
-        "nkl,il->nik", rotations, model.platform_joints
-    )
+    p = np.asarray(position, dtype=float)[..., None, :]
+    return p + np.einsum("nkl,il->nik", rotations, model.platform_joints)
 
 
 def _rotate_about(
@@ -456,7 +455,8 @@ def _angle(u: NDArray[np.float64], v: NDArray[np.float64]) -> NDArray[np.float64
 
 
 def evaluate(model: ReferenceModel, angles: ArrayLike, position: ArrayLike) -> ReferenceResult:
-    """Every margin of the poses ``angles`` (N, 3) (φ, θ, ψ in rad) at ``position`` (3,), m."""
+    """Every margin of the poses ``angles`` (N, 3) (φ, θ, ψ in rad) at ``position``, m: one (3,)
+    for all poses or one per pose (N, 3)."""
     angles = np.atleast_2d(np.asarray(angles, dtype=float))
     count = angles.shape[0]
     rotations = rotation_matrices(angles)
