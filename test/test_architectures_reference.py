@@ -1,7 +1,8 @@
 """The package's ``check`` against the plain-numpy reference (test/reference_arch.py), per leg
 architecture, over at least 10⁵ random poses each: the packaged example of each architecture
-(10⁵ poses over six positions) and one variant with per-leg limits, explicit joint axes, an
-architecture-specific changes (4·10⁴ more poses).
+(10⁵ poses over six positions) and one variant with per-leg limits, explicit joint axes and
+architecture-specific changes (4·10⁴ more poses). Runs for 6-UPS on this branch; pus and rus
+join when the architectures of issue 17 are merged (branch ``model``).
 
 Written against the public contract of issue 17 only: ``Manipulator.from_params_file`` reads
 the architecture keys; ``check(manipulator, angles, position)`` returns ``margins`` by name
