@@ -38,8 +38,8 @@ class WaypointChecks:
     relative : ndarray, shape (N,)
         Smallest relative margin (dimensionless, see :func:`relative_margins`).
     limiting_constraint : ndarray, shape (N,), int
-        Index into :data:`~hexapod_workspace.core.constraint_table.CONSTRAINT_NAMES` of the smallest
-        relative margin.
+        Index into :data:`~hexapod_workspace.core.constraint_table.CONSTRAINT_NAMES` of the
+        smallest relative margin.
     limiting_leg : ndarray, shape (N,), int
         1-based leg of the limiting constraint (interference: lower leg of the pair).
     limiting_pair : ndarray, shape (N, 2), int

@@ -12,11 +12,11 @@ unconfigured
     Every command is answered ``success`` false, "inactive: ...". Parameters may be set freely
     (they are validated as a whole by *configure*). No log is open, no worker runs.
 configure
-    Validates the parameters as a whole and builds the manipulator model (:func:`~hexapod_
-    workspace.ros.parameters.state_from`). A bad set leaves the node unconfigured, with the
-    reason in the transition's log line and on ``/diagnostics`` (level ERROR); otherwise opens
-    the MCAP log (``recording.enabled``), starts the worker process and loads the core's
-    kernels. State *inactive*.
+    Validates the parameters as a whole and builds the manipulator model
+    (:func:`~hexapod_workspace.ros.parameters.state_from`). A bad set leaves the node
+    unconfigured, with the reason in the transition's log line and on ``/diagnostics`` (level
+    ERROR); otherwise opens the MCAP log (``recording.enabled``), starts the worker process and
+    loads the core's kernels. State *inactive*.
 activate
     Starts serving: pose checks, commands, workspace and path requests. State *active*.
 deactivate

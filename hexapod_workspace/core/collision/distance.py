@@ -122,7 +122,7 @@ def record(
     Parameters
     ----------
     kind : int
-        :data:`POINT`, :data:`SEGMENT`, :data:`BOX` or :data:`CYLINDER`.
+        ``POINT``, ``SEGMENT``, ``BOX`` or ``CYLINDER`` (module constants).
     centre : ndarray, shape (3,)
         Centre of the core in the working frame, m.
     rotation : ndarray, shape (3, 3)

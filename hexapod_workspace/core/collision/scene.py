@@ -12,7 +12,8 @@ Bodies (SI, frames named; see :mod:`.distance` for the shapes and the signed dis
   centre point C along +z of the tool frame for ``collision.tool.length`` (towards the
   platform in the packaged example). The tool frame is the mobile frame unless a tool transform
   (platform <- tool, the machining cell's tool frame) is given.
-* **Obstacles**: fixed boxes, cylinders, spheres and capsules (:mod:`.params`).
+* **Obstacles**: fixed boxes, cylinders, spheres and capsules
+  (:mod:`hexapod_workspace.core.collision.params`).
 
 Pairs checked: the tool against each leg, and every moving body (tool, platform, legs) against
 every obstacle. Bodies attached to each other are not checked (legs–platform, tool–platform);
