@@ -181,3 +181,18 @@ def test_cli_reports_singularity_on_request(tmp_path, example):
     code, out, err = run_main("--config", str(config), "--json", "check", "--pose", "0", "10", "0")
     assert code == 1
     assert json.loads(out)["poses"][0]["violated"] == ["singularity"]
+
+
+def test_a_reported_singularity_margin_never_limits_a_pose(example):
+    """Asked for as a report (limits.singularity_min 0), the singularity margin is shown but
+    neither the verdicts nor the limiting constraint and leg change."""
+    rng = np.random.default_rng(20261124)
+    angles = np.column_stack(
+        [rng.uniform(-np.pi, np.pi, 5000), rng.uniform(0.0, 1.2, 5000), rng.uniform(-1, 1, 5000)]
+    )
+    plain = check(example, angles)
+    reported = check(example, angles, singularity=True)
+    assert np.all(np.isfinite(reported.margins["singularity"]))
+    np.testing.assert_array_equal(plain.reachable, reported.reachable)
+    np.testing.assert_array_equal(plain.limiting_constraint, reported.limiting_constraint)
+    np.testing.assert_array_equal(plain.limiting_leg, reported.limiting_leg)

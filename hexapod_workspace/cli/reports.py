@@ -16,7 +16,7 @@ from typing import IO, TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.constraint_table import CONSTRAINTS
+from ..core.constraint_table import CONSTRAINTS, SINGULARITY
 from ..core.constraints import CONSTRAINT_NAMES, CheckResult
 from ..core.orientation import OrientationWorkspace, TorsionRange
 from ..core.projected import ProjectedWorkspace
@@ -123,8 +123,15 @@ def check_table(result: CheckResult, out: IO[str], degrees: NDArray[np.float64])
     """
     x, y, z = result.position
     out.write(f"position: ({x:.4f}, {y:.4f}, {z:.4f}) m\n")
-    names = " ".join(f"{row.column:>11}" for row in CONSTRAINTS)
-    units = " ".join(f"{'[' + row.report_unit + ']':>11}" for row in CONSTRAINTS)
+    # The singularity margin is a column only where it was evaluated (enforced by
+    # limits.singularity_min > 0 or asked for with --singularity); otherwise it is +inf.
+    shown = [
+        row
+        for row in CONSTRAINTS
+        if row is not CONSTRAINTS[SINGULARITY] or not np.all(np.isposinf(result.margins[row.name]))
+    ]
+    names = " ".join(f"{row.column:>11}" for row in shown)
+    units = " ".join(f"{'[' + row.report_unit + ']':>11}" for row in shown)
     header = (
         f"{'':>9} {'':>9} {'':>9}  {'':<9}  {'margin to each limit (>= 0 holds, < 0 violated)'}",
         f"{'phi':>9} {'theta':>9} {'psi':>9}  {'reachable':<9}  {names}  {'limiting':>8}  violated",
@@ -142,11 +149,11 @@ def check_table(result: CheckResult, out: IO[str], degrees: NDArray[np.float64])
     columns = [
         *angle_columns,
         np.where(result.reachable, "yes", "NO").tolist(),
-        *((result.margins[row.name] * row.report_factor).tolist() for row in CONSTRAINTS),
+        *((result.margins[row.name] * row.report_factor).tolist() for row in shown),
         result.limiting_leg.tolist(),
         [",".join(v) or "-" for v in result.violated],
     ]
-    template = angle_format + "  %-9s  " + " ".join(["%11.3f"] * len(CONSTRAINTS)) + "  %8d  %s"
+    template = angle_format + "  %-9s  " + " ".join(["%11.3f"] * len(shown)) + "  %8d  %s"
     _write_rows(out, template, columns, "\n")
     reachable = int(np.count_nonzero(result.reachable))
     out.write(f"\n{reachable}/{len(result)} poses reachable\n")

@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from . import kernels
-from .constraint_table import CONSTRAINT_NAMES, N_CONSTRAINTS
+from .constraint_table import CONSTRAINT_NAMES, N_CONSTRAINTS, SINGULARITY
 from .resolution import MAX_POSITION_NORM, validate_position
 
 if TYPE_CHECKING:
@@ -443,6 +443,15 @@ def check(
         msg = f"position: expected 3 finite values (x, y, z) in m, got {position.tolist()}"
         raise InputError(msg)
     legs = ints[:N_CONSTRAINTS]
+    limiting_constraint, limiting_leg = ints[N_CONSTRAINTS], ints[N_CONSTRAINTS + 1]
+    if singularity and manipulator.singularity_min == 0.0:
+        # Reported, not enforced: the singularity margin never limits a pose. The limiting
+        # constraint is the one with the smallest relative margin among the others.
+        relative = relative_margins(manipulator, margins)
+        relative[SINGULARITY] = np.inf
+        relative = np.where(np.isnan(relative), -np.inf, relative)  # NaN is violated
+        limiting_constraint = np.argmin(relative, axis=0).astype(np.int64)
+        limiting_leg = legs[limiting_constraint, np.arange(count)]
     return CheckResult(
         position=position,
         angles=angles,
@@ -450,8 +459,8 @@ def check(
         margins={name: margins[k] for k, name in enumerate(CONSTRAINT_NAMES)},
         limiting_legs={name: legs[k] for k, name in enumerate(CONSTRAINT_NAMES)},
         limiting_pair=pairs,
-        limiting_constraint=ints[N_CONSTRAINTS],
-        limiting_leg=ints[N_CONSTRAINTS + 1],
+        limiting_constraint=limiting_constraint,
+        limiting_leg=limiting_leg,
     )
 
 

@@ -20,6 +20,7 @@ from test_ros_node import check_request, sample_angles  # noqa: E402
 from hexapod_workspace import CONSTRAINT_NAMES, check, logs  # noqa: E402
 from hexapod_workspace.errors import InputError  # noqa: E402
 from hexapod_workspace.logs.summary import summarize_log  # noqa: E402
+from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402
 from hexapod_workspace.ros.flat import angles_from_flat, flat_margins  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # test/recording_support.py
@@ -115,7 +116,7 @@ def test_flat_check_matches_core_and_the_nested_form(client, model):
     nested = client.call(CheckPoses, f"{NODE}/check_poses", check_request(angles))
     assert nested.success, nested.message
     for k, name in enumerate(flat.constraint_names):
-        got = np.array([getattr(r, f"{name}_margin") for r in nested.results])
+        got = np.array([margins_by_name(r)[name] for r in nested.results])
         np.testing.assert_array_equal(margins_of(flat)[:, k], got)
     assert flat.message == nested.message
 
