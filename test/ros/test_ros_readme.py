@@ -159,10 +159,6 @@ def test_the_interface_table_lists_every_topic_of_the_node(node):
         if "/_action/" not in name
         and name not in ("/rosout", "/parameter_events", *_LIFECYCLE_TOPICS)
     }
-    # The two boundary-cloud topics are published by the worker process's own node
-    # (``<node>_clouds``, ros/clouds.py), not by this node: the names the node hands its worker.
-    for topic in node.worker.cloud_topics.topics.values():
-        offered[topic] = ("sensor_msgs/msg/PointCloud2",)
     shown = {name: (type_name,) for name, type_name in _rows("topic").items()}
     assert shown == offered
 
