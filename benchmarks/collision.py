@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Cost of the ``collision`` margin (issue 21) against today's pose check, in the same run.
+"""Cost of the ``collision`` margin (the core collision bodies) against today's pose check,
+in the same run.
 
 The scene is the example machine with the tool, the platform and three obstacles (a box vise,
 a cylinder column, a sphere) around it: 6 + 3 × 8 = 30 pairs. Measured per pose:
@@ -9,7 +10,7 @@ a cylinder column, a sphere) around it: 6 + 3 × 8 = 30 pairs. Measured per pose
 * ``scene_distances`` on the same batch (the closest pair, pairs skipped by bounding spheres),
   and with every pair's distance (``all_pairs``).
 
-The issue's goal: a pose check with collisions within 2× of today's, i.e. (check + scene) /
+The goal: a pose check with collisions within 2× of today's, i.e. (check + scene) /
 check ≤ 2. Times are the best of several runs (the machine is shared); the load average is
 printed with the results. Usage: python benchmarks/collision.py [--poses N]
 """

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""The open model (issue 17) against the code before it, ratios measured in the same run.
+"""The open model (constraint table, singularity margin) against the code before it, ratios
+measured in the same run.
 
 The baseline is the package as of commit 3c6da1e (four constraints wired by hand, one leg
 architecture), extracted with ``git archive`` and imported as ``hexapod_workspace_baseline``

@@ -8,10 +8,10 @@ executor answering commands) from running. Steps: the pipe from the worker (pick
 message (``to_message``), CDR serialisation (what the recorder does), ``publish`` to a
 transient-local topic with a subscriber in another process, the action result's message, and
 the recorder's MCAP write of the serialised bytes, and the bounded result the node now sends.
-Before issue 19 the node's own process took: publish, two serialisations (cloud and recorded
-result) and the full action result; now the worker process builds, serialises and publishes the
-cloud, and the node only unpickles its bytes, writes them to the log and sends the bounded
-result. Run it in the ROS environment::
+Before the clouds moved to the worker, the node's own process took: publish, two
+serialisations (cloud and recorded result) and the full action result; now the worker process
+builds, serialises and publishes the cloud, and the node only unpickles its bytes, writes them
+to the log and sends the bounded result. Run it in the ROS environment::
 
     tools/with_ros_env.sh python benchmarks/ros_cloud_cost.py [--points 274000] [--repeat 5]
 """

@@ -42,7 +42,7 @@ NODE_EXECUTABLE = (
     REPO / "install" / "hexapod_workspace" / "lib" / "hexapod_workspace" / "workspace_node"
 )
 GOAL_MS = 2.0
-#: Goal of issue 19 for 1000 poses in the flat form, as a ratio to the in-process core.
+#: Goal for 1000 poses in the flat form, as a ratio to the in-process core.
 GOAL_FLAT_CORE_RATIO = 3.0
 NODE = "/hexapod_workspace"
 FLOOR = "/latency_floor/check_poses"

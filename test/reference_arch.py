@@ -1,11 +1,13 @@
 """Plain-numpy reference of the three leg architectures (6-UPS, 6-PUS, 6-RUS), slow on purpose.
 
-Written from the formulas of issue 17 and the README's *Conventions*, not from the package's
-kernels, and importing nothing from the package: it reads the ROS 2 parameters file itself,
-computes the default joint axes itself and has its own exact segment distance. The tests use it
-as independent evidence for the compiled code (``test_architectures_reference.py``) and check it
-on its own (``test_reference_arch.py``). Vectorised over poses only where that changes nothing
-but the speed (one numpy row per pose, explicit loops over the six legs and the 15 leg pairs).
+Written from the architectures' formulas (leg inverse kinematics, actuator, transmission and
+singularity margins as specified for the package) and the conventions of docs/theory.md, not
+from the package's kernels, and importing nothing from the package: it reads the ROS 2
+parameters file itself, computes the default joint axes itself and has its own exact segment
+distance. The tests use it as independent evidence for the compiled code
+(``test_architectures_reference.py``) and check it on its own (``test_reference_arch.py``).
+Vectorised over poses only where that changes nothing but the speed (one numpy row per pose,
+explicit loops over the six legs and the 15 leg pairs).
 
 Model (SI units, base frame unless said otherwise)
 --------------------------------------------------
@@ -190,7 +192,8 @@ class ReferenceModel:
 
 
 def model_from_parameters(flat: Mapping[str, Any]) -> ReferenceModel:
-    """A :class:`ReferenceModel` from dotted parameter names (defaults as in issue 17)."""
+    """A :class:`ReferenceModel` from dotted parameter names (the specified defaults of the
+    architecture keys)."""
     architecture = str(flat.get("geometry.architecture", "ups"))
     if architecture not in ARCHITECTURES:
         msg = f"geometry.architecture: expected one of {ARCHITECTURES}, got {architecture!r}"

@@ -2,9 +2,9 @@
 architecture, over at least 10⁵ random poses each: the packaged example of each architecture
 (10⁵ poses over six positions) and one variant with per-leg limits, explicit joint axes and
 architecture-specific changes (4·10⁴ more poses). Runs for 6-UPS on this branch; pus and rus
-join when the architectures of issue 17 are merged (branch ``model``).
+join when the package has the pus and rus leg architectures.
 
-Written against the public contract of issue 17 only: ``Manipulator.from_params_file`` reads
+Written against the planned public contract only: ``Manipulator.from_params_file`` reads
 the architecture keys; ``check(manipulator, angles, position)`` returns ``margins`` by name
 (``leg_length`` for ups, ``actuator`` for pus/rus, ``ik``, ``transmission``, ``base_joint``,
 ``platform_joint``, ``leg_interference``, ``singularity``), shape (N,), NaN where undefined,

@@ -1,4 +1,4 @@
-"""The atlas figures (issue 16, item 18): the slice maps outline exactly the grid cells the
+"""The atlas figures: the slice maps outline exactly the grid cells the
 dexterous volume counts (a single cell as a square, with the counts in each panel's title), and
 the 3-D view is an opaque section fitted to the reachable cells (no blank quarter)."""
 

@@ -1,5 +1,5 @@
-"""The atlas command's cost estimate is measured on the run's own grid (issue 16, item 7: it
-assumed 0.3 s per position and announced 205 core-hours for about 3)."""
+"""The atlas command's cost estimate is measured on the run's own grid (it used
+to assume 0.3 s per position and announced 205 core-hours for about 3)."""
 
 from __future__ import annotations
 

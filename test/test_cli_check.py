@@ -225,7 +225,7 @@ def test_poses_file_with_header_in_input_order(tmp_path, example):
         ("phi_deg,theta_deg,psi_deg\n", "no poses"),
         ("1,2,x\n", "line 1: 'x' is not a number"),
         ("1,5;2;3\n", "'1,5' is not a number (use a decimal point)"),
-        # issue 16, item 2: header names are read, never guessed
+        # header names are read, never guessed
         ("tilt,phi_deg,psi_deg\n1,2,3\n", "line 1: unknown column 'tilt' (expected phi_deg or"),
         ("phi,theta,psi\n1,2,3\n", "line 1: column 'phi' names no unit (expected phi_deg or"),
         ("phi_grad,theta_deg,psi_deg\n1,2,3\n", "column 'phi_grad' has unit 'grad', not taken"),
@@ -243,14 +243,14 @@ def test_bad_poses_file_exit_2(tmp_path, content, reason):
 @pytest.mark.parametrize(
     ("header", "row"),
     [
-        ("theta_deg,phi_deg,psi_deg", "60,0,0"),  # the issue's file: read as phi = 60 before
+        ("theta_deg,phi_deg,psi_deg", "60,0,0"),  # a user's file: read as phi = 60 before
         ("psi_deg;theta_deg;phi_deg", "0;60;0"),
         ("phi_rad,theta_rad,psi_rad", f"0,{math.radians(60.0)!r},0"),  # read as degrees before
         ("THETA_RAD psi_deg phi_deg", f"{math.radians(60.0)!r} 0 0"),
     ],
 )
 def test_poses_file_columns_are_read_by_name_and_unit(tmp_path, example, header, row):
-    """Issue 16, item 2: theta = 60 deg is unreachable whatever the column order or unit."""
+    """Theta = 60 deg is unreachable whatever the column order or unit."""
     code, out, err = poses_run(tmp_path, f"{header}\n{row}\n")
     (pose,) = json.loads(out)["poses"]
     assert [pose["phi_deg"], pose["theta_deg"], pose["psi_deg"]] == pytest.approx([0, 60, 0])
@@ -324,7 +324,7 @@ def test_check_record_then_replay(tmp_path):
 @pytest.mark.parametrize(
     ("changes", "hint"),
     [
-        # issue 16, item 16: leg limits in millimetres (it was a warning and "unreachable")
+        # leg limits in millimetres (it was a warning and "unreachable")
         ({"limits.leg_length_min": [800.0], "limits.leg_length_max": [1450.0]}, "limits"),
         ("geometry-mm", "geometry"),
     ],

@@ -185,7 +185,7 @@ def test_huge_angles_are_their_principal_values(tmp_path):
 
 
 def test_the_tool_direction_plot_labels_every_ring_clear_of_the_curves(example):
-    """Issue 16 item 18: the polar panel of the Motions page's toolpath figure (tool axes on a 17°
+    """The polar panel of the Motions page's toolpath figure (tool axes on a 17°
     cone off the axis) labels every ring, and no label covers a curve or a tool direction."""
     from cli_support import polar_labels_clear
 
@@ -208,7 +208,7 @@ def check_path_json(source: Path) -> tuple[int, dict]:
 
 
 def test_columns_in_radians_and_millimetres_give_the_same_verdicts(tmp_path):
-    """Issue 16, item 2: every file reader takes the units its header names."""
+    """Every file reader takes the units its header names."""
     positions, t, _ = cone()
     angles = np.column_stack([np.degrees(t), np.full(40, 17.0), np.zeros(40)])
     degrees = write_csv(
@@ -238,7 +238,7 @@ def test_columns_in_radians_and_millimetres_give_the_same_verdicts(tmp_path):
 @pytest.mark.parametrize(
     ("content", "match"),
     [
-        # issue 16, item 15: the file line (comments and the header count), not numpy's text
+        # errors name the file line (comments and the header count), not numpy's text
         (
             "# path\nx,y,z,i,j,k\n0,0,-1.3,0,0,1\n\n0,0,-1.3\n",
             "line 5: expected 6 values x,y,z,i,j,k, got 3: '0,0,-1.3'",

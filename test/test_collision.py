@@ -1,4 +1,4 @@
-"""Collision bodies (issue 21 core): distances against coal and dense sampling, rate bounds,
+"""Collision bodies (the core library): distances against coal and dense sampling, rate bounds,
 parameters.
 
 Independent references: coal 3 (the maintained successor of hpp-fcl: GJK/EPA, signed distance,

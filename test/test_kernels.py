@@ -38,7 +38,7 @@ CONFIG = Path(__file__).resolve().parents[1] / "config" / "example_gpm.yaml"
 
 
 def _design(example: Manipulator, name: str) -> Manipulator:
-    """The four designs of the issue: axisymmetric (the example), per-leg limits,
+    """The four test designs: axisymmetric (the example), per-leg limits,
     non-axisymmetric, crossed legs."""
     parameters = example.to_parameters()
     if name == "per_leg_limits":

@@ -232,7 +232,8 @@ def test_yaml_example_is_commented():
     text = example_config_path().read_text()
     keys = [line for line in text.splitlines() if line.strip().endswith(":") or ": " in line]
     assert len(keys) > 10
-    # Every key line of the example is preceded by a comment line (the issue asks for comments).
+    # Every key line of the example is preceded by a comment line (a user reads the file to
+    # learn its keys).
     lines = text.splitlines()
     for index, line in enumerate(lines):
         stripped = line.strip()

@@ -252,7 +252,7 @@ def test_check_path_refuses_bad_input(example, kwargs, match):
 
 def test_check_path_refuses_what_check_refuses(example):
     """Positions are bounded by their distance to the base origin, as in a pose check: a point
-    within ±1e6 m per coordinate but 1.27e6 m away is refused by both (issue 20, finding 1)."""
+    within ±1e6 m per coordinate but 1.27e6 m away is refused by both."""
     far = [9e5, 9e5, 0.0]
     with pytest.raises(InputError, match="position"):
         check(example, [0.0, 0.0, 0.0], far)

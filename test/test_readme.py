@@ -1,5 +1,5 @@
 """The examples of the README and of the documentation pages are what the code prints and
-answers (issue 16, item 14; issue 20: the README's sections moved into ``docs/``).
+answers (the README's long sections now live in ``docs/``, and are checked there).
 
 * every ``$ hexapod-workspace ...`` example of the README's *Command line* section and of the
   command-line page (``docs/cli.md``) is run, and its printed lines must be the page's, except

@@ -1,5 +1,5 @@
 """The atlas page's Python snippet (``docs/atlas.md``, once the README's), saved as a script
-and run as a user would (issue 16, item 12): on a real local Dask cluster (worker processes on
+and run as a user would: on a real local Dask cluster (worker processes on
 127.0.0.1, which re-import the script), twice (the second run finds the finished store and
 returns it), and without its main guard (one clear error, no store left behind). Only the grid
 step is coarsened, to keep it short."""

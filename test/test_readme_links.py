@@ -1,4 +1,4 @@
-"""Every relative link of the README resolves (issue 20): to a file or folder of the repository
+"""Every relative link of the README resolves: to a file or folder of the repository
 and, with ``#anchor``, to a heading of that Markdown file, under the anchor GitHub gives it.
 
 The documentation pages' own links are checked by the docs build (``make docs``: Sphinx with

@@ -417,7 +417,7 @@ def test_publish_counts_only_what_went_out(tmp_path: Path, monkeypatch) -> None:
 
 
 def test_plotting_leaves_matplotlib_global_state_alone(tmp_path: Path) -> None:
-    """Finding 8: no backend switch and no pyplot on import or use; axis beyond the curves."""
+    """No backend switch and no pyplot on import or use; axis beyond the curves."""
     import subprocess
     import sys
 
@@ -468,7 +468,7 @@ def test_projected_plot_radial_axis_clears_the_largest_tilt(tmp_path: Path) -> N
 
 
 def test_orientation_plot_labels_of_the_two_panels_stay_apart() -> None:
-    """Issue 16 item 18: the 3-D panel's ψ label and the top view's θ sin φ label do not touch
+    """The 3-D panel's ψ label and the top view's θ sin φ label do not touch
     (measured on the drawn figure, on and off the axis)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 

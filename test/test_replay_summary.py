@@ -1,5 +1,5 @@
-"""``replay`` of a node session: Pose-form checks, long sessions, atlas clouds, NaN requests
-(issue 16, item 6). Logs are written with the package's writer in the node's channel layout."""
+"""``replay`` of a node session: Pose-form checks, long sessions, atlas clouds, NaN requests.
+Logs are written with the package's writer in the node's channel layout."""
 
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """What a fresh clone meets before any computation: the Python and Node.js requirements, the DDS
-domain of the tools' ROS environment and the install hint of the atlas extra (issue 16, items
-9, 10, 11 and 13). The tools/ scripts run for real, with stand-in interpreters where a version
-this machine does not have is needed."""
+domain of the tools' ROS environment and the install hint of the atlas extra. The tools/
+scripts run for real, with stand-in interpreters where a version this machine does not have is
+needed."""
 
 from __future__ import annotations
 
@@ -51,7 +51,7 @@ def _stand_in(folder: Path, name: str, output: str) -> Path:
     return path
 
 
-# ------------------------------------------------------------------------------- item 9: Python
+# -------------------------------------------------------------------------------------- Python
 def test_the_python_requirement_is_the_same_everywhere():
     minimum = _min_python()
     assert _setup_keywords()["python_requires"] == f">={minimum}"
@@ -98,7 +98,7 @@ def test_venv_refuses_an_old_interpreter_with_one_line_before_pip(tmp_path):
     assert "no Python interpreter" in done.stderr
 
 
-# ---------------------------------------------------------------------------- item 10: Node.js
+# ------------------------------------------------------------------------------------- Node.js
 def _check_node(path: Path) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
         [BASH, str(ROOT / "tools" / "check_node.sh")],
@@ -140,7 +140,7 @@ def test_node_check_passes_here_and_make_test_runs_it_first():
         assert "Node.js ≥ 18 with npm" in text.split("## Command line")[0].split("## The demo")[0]
 
 
-# ---------------------------------------------------------------------- item 11: ROS_DOMAIN_ID
+# ------------------------------------------------------------------------------- ROS_DOMAIN_ID
 def _domain(script: str, env: dict[str, str]) -> str:
     done = subprocess.run(
         [BASH, "-c", script],
@@ -172,7 +172,7 @@ def test_node_and_client_shells_share_one_documented_domain():
     assert {_domain(with_env, env), _domain(sourced, env)} == {"42"}
 
 
-# --------------------------------------------------------------------- item 13: the extra hint
+# ------------------------------------------------------------------------------ the extra hint
 def test_the_atlas_extra_is_named_once():
     from hexapod_workspace.atlas import EXTRA_REQUIREMENTS
 

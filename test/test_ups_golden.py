@@ -1,4 +1,4 @@
-"""6-UPS answers stay those of the code before the constraint table (issue 17).
+"""6-UPS answers stay those of the code before the constraint table.
 
 ``test/golden/ups_example.npz`` was computed by ``test/golden/make_ups_golden.py`` run on a
 checkout of commit 3c6da1e (see its docstring): the packaged example and the same machine with

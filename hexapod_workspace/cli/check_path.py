@@ -153,7 +153,7 @@ def path_to_json(
     baseline: PathCheck,
     degrees: NDArray[np.float64] | None = None,
 ) -> dict[str, Any]:
-    """The JSON document of a path check or a torsion plan (keys of the issue, degrees).
+    """The JSON document of a path check or a torsion plan (documented keys, degrees).
 
     Parameters
     ----------

@@ -31,9 +31,10 @@ class WaypointChecks:
         (φ, θ, ψ) in rad, canonical ranges.
     reachable : ndarray, shape (N,), bool
     margins : dict of str to ndarray, shape (N,)
-        Signed margin of each constraint (keys
-        :data:`~hexapod_workspace.core.constraint_table.CONSTRAINT_NAMES`; m, rad, rad, m; +inf
-        when the interference check is disabled), as in :class:`CheckResult`.
+        Signed margin of each constraint, keyed by the constraint table's names
+        (:data:`~hexapod_workspace.core.constraint_table.CONSTRAINT_NAMES`),
+        each in its row's unit (m, rad or 1); +inf when not evaluated (interference with
+        D = 0, singularity with ``limits.singularity_min`` 0), as in :class:`CheckResult`.
     relative : ndarray, shape (N,)
         Smallest relative margin (dimensionless, see :func:`relative_margins`).
     limiting_constraint : ndarray, shape (N,), int

@@ -1,4 +1,4 @@
-"""Golden 6-UPS answers of the packaged example, computed by the code *before* issue 17.
+"""Golden 6-UPS answers of the packaged example, computed by the code *before* the constraint table.
 
 Run from a checkout of commit 3c6da1e (the last main commit before the constraint table, the
 architectures and the singularity margin), e.g.::

@@ -124,7 +124,7 @@ def test_invalid_overrides_refuse_to_start(ros_context, overrides, named):
 @pytest.mark.parametrize(
     ("overrides", "named"),
     [
-        # issue 16, item 1: the misspelt key used to be dropped with a warning, the example's
+        # the misspelt key used to be dropped with a warning, the example's
         # 1.45 m stood in and z = -1.45 m was answered reachable
         (
             {**example_model(), "limits.leg_lenght_max": [1.30]},
@@ -164,7 +164,7 @@ def test_optional_model_parameters_take_the_model_defaults_not_the_example(ros_c
         assert model.leg_diameter == 0.0  # the example's is 0.05 m
         np.testing.assert_array_equal(model.position, model.home_position)
         assert node.get_parameter("limits.leg_diameter").value == 0.0
-        # the verdict of the issue: z = -1.45 m is out of reach of 1.30 m legs
+        # the verdict a user reported wrong: z = -1.45 m is out of reach of 1.30 m legs
         response = node._on_check_poses(
             check_request([(0.0, 0.0, 0.0)], (0.0, 0.0, -1.45)), CheckPoses.Response()
         )

@@ -1,4 +1,4 @@
-"""The node's log folder stays bounded (issue 16, item 8): the recorder splits its log by size
+"""The node's log folder stays bounded: the recorder splits its log by size
 and by age, as rosbag2 splits a bag, and removes the oldest logs beyond a total size.
 
 The recorder is the node's own (rclpy serialisation, its thread, real files); every log it

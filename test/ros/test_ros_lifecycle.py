@@ -33,7 +33,7 @@ def test_node_stops_cleanly_on_signal(ros_client, tmp_path, sig):
     assert status == 0, output
     assert "Traceback" not in output, output
     (log,) = (tmp_path / "logs").glob("*.mcap")
-    # issue 16, item 17: what the node serves, and where its log went when it stopped
+    # what the node serves, and where its log went when it stopped
     (ready,) = [line for line in output.splitlines() if "ready: /hexapod_workspace" in line]
     for name in ("check_poses", "check_path", "compute_workspace", "compute_atlas"):
         assert name in ready, ready
@@ -77,11 +77,11 @@ def test_node_stops_cleanly_while_goals_compute_and_queue(ros_client, tmp_path):
         ({"limits.leg_diameter": 0}, "limits.leg_diameter"),  # an integer where m is a float
         ({"resolution.projected_method": "fastest"}, "resolution.projected_method"),
         ({"resolution.n_rays": 1}, "resolution.n_rays"),
-        # issue 16, item 1: a misspelt key or section stops the node (it used to warn and
+        # a misspelt key or section stops the node (it used to warn and
         # answer for the example's 1.45 m legs)
         ({"limits.leg_lenght_max": [1.30]}, "limits.leg_lenght_max: unknown parameter"),
         ({"limit.leg_length_max": [1.30]}, "limit: unknown section"),
-        # issue 16, item 3: six legs from one point
+        # a degenerate machine: six legs from one point
         ({"geometry.base_joints": [0.0] * 18}, "joints 1 and 2 coincide"),
     ],
     ids=[
@@ -108,7 +108,7 @@ def test_invalid_parameters_file_exits_with_the_reason(ros_domain, tmp_path, ove
 
 
 def test_a_partial_model_in_the_file_stops_the_node(ros_domain, tmp_path):
-    """Issue 16, item 1: only limits.leg_length_max given; the example must not fill in the
+    """Only limits.leg_length_max given; the example must not fill in the
     rest of the machine."""
     text = (
         "hexapod_workspace:\n  ros__parameters:\n"

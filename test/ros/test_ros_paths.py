@@ -237,7 +237,7 @@ def test_path_calls_are_recorded_and_replayed(client, workspace_node):
         assert len(requests) == len(responses) >= 1
         assert requests[-1] == plain(request)
         assert responses[-1] == plain(response)
-        # issue 16, item 5: the current pose of every motion verdict is in the log, before it
+        # the current pose of every motion verdict is in the log, before it
         current = None
         verdicts = 0
         for topic, _, message in reader(logs[0]):

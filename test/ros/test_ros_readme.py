@@ -1,5 +1,5 @@
-"""The README's interface table and the documentation's ROS facts are the node's (issue 16,
-item 14; issue 20), checked against a real node built in this process with its extensions (as
+"""The README's interface table and the documentation's ROS facts are the node's,
+checked against a real node built in this process with its extensions (as
 ``workspace_node`` runs it), over real rclpy:
 
 * the parameters the documentation lists as the node's own (``docs/ros.md`` generates them from

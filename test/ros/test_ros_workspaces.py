@@ -243,7 +243,7 @@ def test_late_subscriber_gets_the_last_result(client, model):
 
 
 def test_failed_requests_leave_the_last_boundary_for_late_subscribers(client):
-    """Issue 16, item 4: failures publish their summary only; the transient-local cloud stays
+    """Failures publish their summary only; the transient-local cloud stays
     the last computed boundary, and an unknown kind's summary keeps its kind."""
     good = compute(client, workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO, request_id="ok"))
     assert good.success and good.boundary.width > 0, good.message

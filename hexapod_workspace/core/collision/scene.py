@@ -11,7 +11,7 @@ Bodies (SI, frames named; see :mod:`.distance` for the shapes and the signed dis
 * **Tool/spindle**: a capsule of ``collision.tool.radius`` around the segment from the tool
   centre point C along +z of the tool frame for ``collision.tool.length`` (towards the
   platform in the packaged example). The tool frame is the mobile frame unless a tool transform
-  (platform <- tool, the tool frame of the cell issue) is given.
+  (platform <- tool, the machining cell's tool frame) is given.
 * **Obstacles**: fixed boxes, cylinders, spheres and capsules
   (:mod:`hexapod_workspace.core.collision.params`).
 
