@@ -202,6 +202,27 @@ def _transform(
     return out
 
 
+@_helper
+def _segment_record(
+    row: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64], radius: float
+) -> None:
+    """Fill ``row`` with the capsule of ``radius`` around segment ab (a leg, the tool): centre,
+    unit axis as the record's local z, half length; a zero-length segment gets a zero axis."""
+    axis = b - a
+    length = math.sqrt(axis[0] ** 2 + axis[1] ** 2 + axis[2] ** 2)
+    row[0] = SEGMENT
+    row[_C : _C + 3] = 0.5 * (a + b)
+    if length > 0.0:
+        axis = axis / length
+    else:
+        axis[:] = 0.0
+    row[_R + 2] = axis[0]
+    row[_R + 5] = axis[1]
+    row[_R + 8] = axis[2]
+    row[_P] = 0.5 * length
+    row[_INFLATION] = radius
+
+
 @_jit
 def _scene_kernel(
     rotations: NDArray[np.float64],
@@ -234,39 +255,12 @@ def _scene_kernel(
         r = rotations[pose]
         p = positions[pose]
         for leg in range(6):
-            row = bodies[leg]
             b = _transform(r, platform_joints[leg], p)
-            a = base_joints[leg]
-            axis = b - a
-            length = math.sqrt(axis[0] ** 2 + axis[1] ** 2 + axis[2] ** 2)
-            row[0] = SEGMENT
-            row[_C : _C + 3] = 0.5 * (a + b)
-            if length > 0.0:
-                axis = axis / length
-            else:
-                axis[:] = 0.0
-            row[_R + 2] = axis[0]
-            row[_R + 5] = axis[1]
-            row[_R + 8] = axis[2]
-            row[_P] = 0.5 * length
-            row[_INFLATION] = leg_radius
+            _segment_record(bodies[leg], base_joints[leg], b, leg_radius)
         if tool_ends.shape[0] == 2:
-            row = bodies[_TOOL]
             q0 = _transform(r, tool_ends[0], p)
             q1 = _transform(r, tool_ends[1], p)
-            axis = q1 - q0
-            length = math.sqrt(axis[0] ** 2 + axis[1] ** 2 + axis[2] ** 2)
-            row[0] = SEGMENT
-            row[_C : _C + 3] = 0.5 * (q0 + q1)
-            if length > 0.0:
-                axis = axis / length
-            else:
-                axis[:] = 0.0
-            row[_R + 2] = axis[0]
-            row[_R + 5] = axis[1]
-            row[_R + 8] = axis[2]
-            row[_P] = 0.5 * length
-            row[_INFLATION] = tool_radius
+            _segment_record(bodies[_TOOL], q0, q1, tool_radius)
         if platform_record[0] == CYLINDER:
             row = bodies[_PLATFORM]
             row[0] = CYLINDER
