@@ -74,6 +74,7 @@ __all__ = [
     "PLATFORM_JOINT",
     "SINGULARITY",
     "Constraint",
+    "applicable",
     "rate_bounds",
     "scales",
 ]
@@ -106,6 +107,11 @@ class Constraint:
         What the scale is, in words.
     speed, turn, spin : float
         Rate coefficients: ``|dm/ds| ≤ speed·V + turn·V/ℓ_f + spin·Ω`` (module documentation).
+    applies : callable
+        ``applies(manipulator)``: whether the constraint exists for this model (a leg-length
+        stroke exists only where legs change length, a collision margin only where bodies are
+        declared). Where it does not, the kernels hold +inf in its row (never limiting) and the
+        interfaces that list margins by name leave it out (:func:`applicable`).
     """
 
     name: str
@@ -120,6 +126,7 @@ class Constraint:
     speed: float
     turn: float
     spin: float
+    applies: Callable[[Manipulator], bool] = lambda manipulator: True
 
 
 def _half_stroke(manipulator: Manipulator) -> float:
@@ -250,6 +257,11 @@ def rate_bounds(
             if coefficient != 0.0:
                 bounds[k] = bounds[k] + coefficient * value
     return bounds
+
+
+def applicable(manipulator: Manipulator) -> tuple[int, ...]:
+    """Rows of the table that exist for this model, in table order (see ``Constraint.applies``)."""
+    return tuple(k for k, row in enumerate(CONSTRAINTS) if row.applies(manipulator))
 
 
 def scales(manipulator: Manipulator) -> NDArray[np.float64]:
