@@ -325,3 +325,29 @@ def test_a_clone_named_like_the_package_does_not_shadow_it(tmp_path):
         check=False,
     )
     assert done.returncode == 0, done.stderr
+
+
+def _rz(a: float) -> np.ndarray:
+    return np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
+
+
+def _ry(a: float) -> np.ndarray:
+    return np.array([[np.cos(a), 0.0, np.sin(a)], [0.0, 1.0, 0.0], [-np.sin(a), 0.0, np.cos(a)]])
+
+
+def test_leg_endpoints_follow_the_pose_written_out_per_leg() -> None:
+    """leg_endpoints against B_i = p + R·b_i written out leg by leg with a plain rotation."""
+    from hexapod_workspace.core.legs import leg_endpoints
+    from hexapod_workspace.core.rotations import tt_to_matrix
+
+    m = Manipulator.example(warn=False)
+    angles = np.radians([[30.0, 20.0, 10.0], [0.0, 0.0, 0.0]])
+    position = np.array([0.05, -0.02, -1.2])
+    base, platform = leg_endpoints(m, tt_to_matrix(angles), position)
+    assert base.shape == platform.shape == (2, 6, 3)
+    for n, (phi, theta, psi) in enumerate(angles):
+        r = _rz(phi) @ _ry(theta) @ _rz(-phi) @ _rz(psi)
+        for k in range(6):
+            expected = position + r @ m.platform_joints[k]
+            np.testing.assert_allclose(platform[n, k], expected, atol=1e-15)
+            np.testing.assert_array_equal(base[n, k], m.base_joints[k])
