@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 import pytest
+from frames_reference import homogeneous, tt
 
 from hexapod_workspace import check
 from hexapod_workspace.core.constraints import check_pose
@@ -26,29 +27,6 @@ from hexapod_workspace.core.frames import (
 from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.core.rotations import matrix_to_tt
 from hexapod_workspace.errors import ConfigError, InputError
-
-
-def rz(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def ry(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def tt(phi: float, theta: float, psi: float) -> np.ndarray:
-    """R(φ, θ, ψ) = Rz(φ)·Ry(θ)·Rz(−φ)·Rz(ψ), from the convention's definition."""
-    return rz(phi) @ ry(theta) @ rz(-phi) @ rz(psi)
-
-
-def homogeneous(rotation: np.ndarray, translation) -> np.ndarray:
-    matrix = np.eye(4)
-    matrix[:3, :3] = rotation
-    matrix[:3, 3] = translation
-    return matrix
-
 
 TOOL_OFFSET = [0.012, -0.02, -0.16]
 TOOL_ANGLES = [0.4, 0.12, -0.3]
