@@ -162,7 +162,7 @@ def _feed_values(values: Any, count: int, name: str) -> NDArray[np.float64]:
     bad = ~np.isnan(array) & ~(np.isfinite(array) & (array > 0.0))
     if np.any(bad):
         k = int(np.flatnonzero(bad)[0])
-        msg = f"{name}[{k}]: expected a finite value > 0 (NaN = none), got {array[k]!r}"
+        msg = f"{name}[{k}]: expected a finite value > 0 (NaN = none), got {float(array[k])!r}"
         raise InputError(msg)
     return np.broadcast_to(array, (count,)).copy()
 
@@ -204,7 +204,7 @@ def validate_speed_request(request: Any, interpolation: str) -> None:
         raise InputError(msg)
     if durations.size and not np.all(np.isfinite(durations) & (durations > 0.0)):
         k = int(np.flatnonzero(~(np.isfinite(durations) & (durations > 0.0)))[0])
-        msg = f"durations_s[{k}]: expected a finite value > 0 s, got {durations[k]!r}"
+        msg = f"durations_s[{k}]: expected a finite value > 0 s, got {float(durations[k])!r}"
         raise InputError(msg)
     _optional_rate(request.rapid_feed_mm_min, "rapid_feed_mm_min", "mm/min")
     _optional_rate(request.rotary_feed_deg_min, "rotary_feed_deg_min", "deg/min")
@@ -251,10 +251,18 @@ def path_speeds(state: State, request: Any, result: PathCheck | TorsionPlan) -> 
     feed = np.where(feed > 0.0, feed, np.nan)
     rotary_feed = np.where(rotary_feed > 0.0, rotary_feed, np.nan)
     speeds = feed_limits(rates, feed, rotary_feed, limits)
-    return {
+    fields: dict[str, Any] = {
         "speeds": segment_speed_fields(speeds, rapid, feed, rotary_feed),
         "actuator_speed_max": [float(v) for v in limits],
     }
+    slow = [k for k in range(count) if speeds.speed_ok[k] is False]
+    if slow:  # as check-path: a move that must slow down does not run as programmed
+        shown = ", ".join(str(k) for k in slow[:8]) + (
+            f", ... ({len(slow)})" if len(slow) > 8 else ""
+        )
+        fields["ok"] = False
+        fields["message_suffix"] = f"; moves {shown} must slow down (actuator speed)"
+    return fields
 
 
 # --------------------------------------------------------------------------- parameter changes

@@ -200,7 +200,9 @@ def check_path_response_fields(
         )
         if speeds:
             assert state is not None
-            fields.update(cell.path_speeds(state, request, result))
+            speed_fields = cell.path_speeds(state, request, result)
+            fields["message"] += speed_fields.pop("message_suffix", "")
+            fields.update(speed_fields)
     except HexapodWorkspaceError as error:
         fields = path_fields.failed_check_path_response_fields(str(error))
     if state is not None:

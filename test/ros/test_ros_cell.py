@@ -411,6 +411,10 @@ def test_check_path_reports_actuator_speeds_and_feed_max(client, platform):
         truth.feed_max[0] / (1e-3 / 60.0), rel=1e-12
     )
     assert any(not s.speed_ok for s in response.speeds if s.speed_checked)  # the limit bites
+    slow = [k for k, s in enumerate(response.speeds) if s.speed_checked and not s.speed_ok]
+    assert (
+        not response.ok and f"moves {', '.join(map(str, slow))} must slow down" in response.message
+    )
 
     # the same moves given their durations: the same speeds
     durations = [float(d) for d in truth.duration]
@@ -428,7 +432,7 @@ def test_check_path_reports_actuator_speeds_and_feed_max(client, platform):
     # bad feeds: refused with the field and the value
     good = [ros_pose(t) for t in path]
     for bad, words in (
-        (CheckPath.Request(poses=good, feeds_mm_min=[-5.0]), ["feeds_mm_min[0]", "-5"]),
+        (CheckPath.Request(poses=good, feeds_mm_min=[-5.0]), ["feeds_mm_min[0]", "got -5.0"]),
         (CheckPath.Request(poses=good, feeds_mm_min=[1.0, 2.0]), ["feeds_mm_min", "2"]),
         (
             CheckPath.Request(poses=good, feeds_mm_min=[100.0], durations_s=[1.0] * 5),
