@@ -398,7 +398,7 @@ def _part_call(
     base frame, the part's feeds (mm/min) and rapid flags, the speeds and frames in the
     response."""
     from ..logs import paths as path_fields
-    from ..logs.cell import cell_frames_fields, segment_speed_fields
+    from ..logs.cell import cell_frames_fields, segment_speed_fields, slow_moves_clause
 
     rapid_feed, rotary_feed = rates
     if isinstance(result, TorsionPlan):  # tool axes: psi = 0 poses, the torsion planned
@@ -432,6 +432,9 @@ def _part_call(
         result, pairs=model.leg_diameter > 0.0, baseline=baseline
     )
     moves = len(speeds.duration)
+    clause = slow_moves_clause(speeds)
+    if clause:  # the node's answer to the same request says so too
+        response.update(ok=False, message=response["message"] + clause)
     response.update(
         speeds=segment_speed_fields(
             speeds, part.rapid[1:], feed, np.where(speeds.rotary, rotary_feed, math.nan)

@@ -25,6 +25,7 @@ __all__ = [
     "axis_limits_fields",
     "cell_frames_fields",
     "segment_speed_fields",
+    "slow_moves_clause",
 ]
 
 #: m/s per mm/min and rad/s per deg/min (the units of feeds in requests and results).
@@ -89,6 +90,16 @@ def segment_speed_fields(
             }
         )
     return fields
+
+
+def slow_moves_clause(speeds: FeedLimits, first: int = 0) -> str:
+    """``"; moves 3, 7 must slow down (actuator speed)"`` for the moves whose certified peak
+    exceeds a limit (numbered from ``first``), ``""`` when there are none."""
+    slow = [first + k for k in range(speeds.duration.size) if speeds.speed_ok[k] is False]
+    if not slow:
+        return ""
+    shown = ", ".join(str(k) for k in slow[:8]) + (f", ... ({len(slow)})" if len(slow) > 8 else "")
+    return f"; moves {shown} must slow down (actuator speed)"
 
 
 def axis_limits_fields(

@@ -288,6 +288,9 @@ def path_call_report(index: int, call: dict[str, Any], start_ns: int) -> dict[st
         "segments_failed": sum(not m["ok"] for m in segments),
         "psi_zero_waypoints_failed": len(response.get("psi_zero_waypoints_failed", [])),
         "psi_zero_segments_failed": len(response.get("psi_zero_segments_failed", [])),
+        "moves_to_slow_down": sum(
+            bool(m["speed_checked"]) and not m["speed_ok"] for m in response.get("speeds", [])
+        ),
     }
 
 
@@ -305,4 +308,9 @@ def path_call_line(report: dict[str, Any]) -> str:
         f"({report['waypoints_failed']} waypoints, {report['segments_failed']} moves fail; "
         f"psi = 0: {report['psi_zero_waypoints_failed']} and "
         f"{report['psi_zero_segments_failed']})"
+        + (
+            f"; {report['moves_to_slow_down']} move(s) must slow down (actuator speed)"
+            if report.get("moves_to_slow_down")
+            else ""
+        )
     )

@@ -59,6 +59,7 @@ from hexapod_workspace.logs.cell import (
     axis_limits_fields,
     cell_frames_fields,
     segment_speed_fields,
+    slow_moves_clause,
 )
 
 from .conversions import to_message, type_name
@@ -255,13 +256,10 @@ def path_speeds(state: State, request: Any, result: PathCheck | TorsionPlan) -> 
         "speeds": segment_speed_fields(speeds, rapid, feed, rotary_feed),
         "actuator_speed_max": [float(v) for v in limits],
     }
-    slow = [k for k in range(count) if speeds.speed_ok[k] is False]
-    if slow:  # as check-path: a move that must slow down does not run as programmed
-        shown = ", ".join(str(k) for k in slow[:8]) + (
-            f", ... ({len(slow)})" if len(slow) > 8 else ""
-        )
+    clause = slow_moves_clause(speeds)
+    if clause:  # as check-path: a move that must slow down does not run as programmed
         fields["ok"] = False
-        fields["message_suffix"] = f"; moves {shown} must slow down (actuator speed)"
+        fields["message_suffix"] = clause
     return fields
 
 
