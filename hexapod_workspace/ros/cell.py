@@ -26,15 +26,20 @@ Feeds
 Axis limits
     :class:`AxisLimitsPublisher`: with ``motion.current_pose_topic`` set, the ± reach along the
     six axes of ``axis_limits.frame`` at the last current pose, on ``~/axis_limits``
-    (``AxisLimits``), at most ``axis_limits.rate`` per second, computed in a thread of its own
-    so the command path never waits for it (only for the interpreter, as for the recorder).
+    (``AxisLimits``), at most ``axis_limits.rate`` per second. The 12 certified reaches take
+    0.3-0.5 s, so they run in a spawned process of their own (a thread of this interpreter would
+    hold the interpreter lock from the command callbacks: 2.5x the commanded-pose latency in
+    ``benchmarks/ros_cell_latency.py``); a thread of the node hands it the pose and publishes.
 """
 
 from __future__ import annotations
 
 import math
+import multiprocessing
 import threading
 import time
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
 import numpy as np
@@ -351,6 +356,7 @@ class AxisLimitsPublisher:
         self._node = node
         self._current_pose = current_pose
         self.publisher = node.recorded_publisher(AxisLimits, topic)
+        self._pool: ProcessPoolExecutor | None = None  # started with the first current pose
         self._wake = threading.Event()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="axis_limits", daemon=True)
@@ -364,6 +370,27 @@ class AxisLimitsPublisher:
         self._stop.set()
         self._wake.set()
         self._thread.join(timeout=10.0)
+        if self._pool is not None:
+            self._pool.shutdown(wait=False, cancel_futures=True)
+
+    def _compute(
+        self,
+        manipulator: Any,
+        rotation: NDArray[np.float64],
+        position: NDArray[np.float64],
+        frame: str,
+        work: Any,
+    ) -> dict[str, Any]:
+        """:func:`~hexapod_workspace.core.reach.axis_limits` in the spawned process."""
+        if self._pool is None:
+            self._pool = ProcessPoolExecutor(
+                max_workers=1, mp_context=multiprocessing.get_context("spawn")
+            )
+        future = self._pool.submit(
+            axis_limits, manipulator, rotation, position, frame=frame, work=work
+        )
+        result: dict[str, Any] = future.result()
+        return result
 
     def _run(self) -> None:
         while not self._stop.is_set():
@@ -379,6 +406,8 @@ class AxisLimitsPublisher:
                 self._publish(state)
             except Exception as error:  # keep publishing; the reason goes to the log
                 self._node.internal_error(error)
+                if self._pool is not None and isinstance(error, BrokenProcessPool):
+                    self._pool = None  # the process died: the next pose starts a new one
             # rate limit: at most axis_limits.rate messages per second
             self._stop.wait(
                 max(0.0, 1.0 / state.settings.axis_limits_rate - (time.monotonic() - started))
@@ -399,7 +428,7 @@ class AxisLimitsPublisher:
                 state, frame_id, position[None, :], quaternion[None, :]
             )
             rotation = quaternion_to_matrix(quaternions)[0]
-            limits = axis_limits(state.manipulator, rotation, positions[0], frame=frame, work=work)
+            limits = self._compute(state.manipulator, rotation, positions[0], frame, work)
             fields = axis_limits_fields(
                 limits,
                 **where,
