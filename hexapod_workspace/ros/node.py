@@ -391,8 +391,8 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
     def set_parameters_atomically(self, parameter_list: list[Parameter]) -> SetParametersResult:
         """As rclpy's, with refusals that name the parameter and the value (unknown names and
         wrong types included); a tool-table entry not declared yet is declared (after the whole
-        set is validated). Every outcome is recorded (:class:`~hexapod_workspace.ros.cell.
-        CellStatus`)."""
+        set is validated). Every outcome is recorded
+        (:class:`~hexapod_workspace.ros.cell.CellStatus`)."""
         result = self._set_parameters_checked(parameter_list)
         status = getattr(self, "cell_status", None)
         if status is not None:

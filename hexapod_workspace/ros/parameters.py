@@ -350,8 +350,9 @@ class State:
     Attributes
     ----------
     manipulator : Manipulator
-        The model that answers for tool-frame poses (:func:`~hexapod_workspace.core.frames.
-        tool_model` of ``platform`` and the active tool): what every check uses.
+        The model that answers for tool-frame poses
+        (:func:`~hexapod_workspace.core.frames.tool_model` of ``platform`` and the active
+        tool): what every check uses.
     settings : Settings
     platform : Manipulator
         The model as the parameters give it (platform frame).
