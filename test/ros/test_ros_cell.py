@@ -15,6 +15,7 @@ import time
 
 import numpy as np
 import pytest
+from cli_support import run_main
 from frames_reference import homogeneous, tt
 from recording_support import read_with_rosbags
 from ros_support import require_ros
@@ -507,3 +508,9 @@ def test_the_log_records_parameter_changes_and_the_frames(client, workspace_node
     assert responses and responses[-1].frames.work_frame_id == "part"
     limits = [m for topic, _, m in messages if topic == f"{NODE}/axis_limits"]
     assert limits and limits[-1].success
+    # replay reports them
+    code, out, _ = run_main("replay", str(log))
+    assert code == 0
+    assert "tool.number = 99: refused: tool.number: tool 99 is not in the tool table" in out
+    assert "tools.T5.offset = [0.0, 0.01, -0.05]: applied" in out
+    assert "axis limits: " in out and "(base frame; m, rad): x -" in out
