@@ -431,6 +431,7 @@ def summary_fields(
             tolerance=float(tolerance),
             n_points=int(n_points or 0),
             elapsed=0.0 if workspace is None else float(workspace.elapsed),
+            frames=no_cell_frames_fields(),
         )
         return fields
     kind = workspace_kind(workspace) if kind is None else int(kind)
@@ -458,6 +459,7 @@ def summary_fields(
         elapsed=float(workspace.elapsed),
     )
     fields["message"] = message if message is not None else summary_line(fields)
+    fields["frames"] = no_cell_frames_fields()
     return fields
 
 

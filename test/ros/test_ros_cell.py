@@ -486,6 +486,43 @@ def test_axis_limits_follow_the_current_pose(ros_client, client, platform):
     assert message.frames.work_frame_id == "part"
 
 
+def test_a_workspace_is_the_tool_centre_points_and_says_its_frames(client, platform):
+    """The projected workspace at pose.position is the tool model's (the orientation workspace
+    about the tool centre point), and its summary carries the frames."""
+    from hexapod_workspace_msgs.msg import WorkspaceSummary
+    from std_srvs.srv import Trigger
+
+    from hexapod_workspace import projected_workspace
+    from hexapod_workspace.core import resolution
+
+    summaries = client.collect(WorkspaceSummary, f"{NODE}/workspace_summary")
+    response = client.call(Trigger, f"{NODE}/compute_projected_workspace", Trigger.Request())
+    assert response.success, response.message
+    client.spin_until(
+        lambda: any(s.message == response.message for s in summaries), what="the summary"
+    )
+    summary = next(s for s in summaries if s.message == response.message)
+    assert summary.frames.work_frame_id == "part" and summary.frames.tool_number == 0
+    offset = summary.frames.tool_offset
+    assert [offset.x, offset.y, offset.z] == TOOL_OFFSET
+    model = tool_model(platform, cell_tool())
+    expected = projected_workspace(
+        model,
+        tuple(platform.position),
+        n_phi=resolution.DEFAULT_N_PHI,
+        tolerance=resolution.DEFAULT_TOLERANCE,
+    )
+    assert summary.tilt_max == pytest.approx(expected.tilt_max, abs=1e-12)
+    assert summary.tilt_min == pytest.approx(expected.tilt_min, abs=1e-12)
+    platform_only = projected_workspace(
+        platform,
+        tuple(platform.position),
+        n_phi=resolution.DEFAULT_N_PHI,
+        tolerance=resolution.DEFAULT_TOLERANCE,
+    )
+    assert abs(platform_only.tilt_max - expected.tilt_max) > 1e-3  # the tool changes it
+
+
 def test_the_log_records_parameter_changes_and_the_frames(client, workspace_node):
     (result,) = set_parameters(client, integer("tool.number", 99))
     assert not result.successful
