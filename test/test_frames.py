@@ -125,6 +125,11 @@ def test_cell_parameters_are_read_and_validated():
         cell.select(3)
     defaults = cell_from_mapping({})
     assert defaults.tool.is_identity and defaults.work.frame_id == "work" and not defaults.tools
+    # tool.number selects the active tool from the table (0: tool.offset / tool.orientation)
+    selected = cell_from_mapping(
+        {"tool": {"offset": [0, 0, -0.1], "number": 12}, "tools.T12.offset": [0, 0, -0.2]}
+    )
+    assert selected.tool.number == 12 and selected.tool.offset.tolist() == [0, 0, -0.2]
 
 
 @pytest.mark.parametrize(
@@ -140,6 +145,10 @@ def test_cell_parameters_are_read_and_validated():
         ({"work.frame_id": ""}, r"^work\.frame_id: expected a non-empty string"),
         ({"limits.actuator_speed_max": [-1.0]}, r"^limits\.actuator_speed_max: expected values"),
         ({"limits.actuator_speed_max": [1.0, 2.0]}, r"^limits\.actuator_speed_max: expected 1"),
+        ({"tool.number": 3, "tools.T1.offset": [0, 0, 0]}, r"^tool\.number: tool 3 is not .*T1\)"),
+        ({"tool.number": -1}, r"^tool\.number: expected an integer >= 0"),
+        ({"tool.number": True}, r"^tool\.number: expected an integer >= 0"),
+        ({"tool.number": 1.0}, r"^tool\.number: expected an integer >= 0"),
     ],
 )
 def test_bad_cell_parameters_are_refused_in_one_line(parameters, message):
