@@ -252,3 +252,45 @@ def test_bad_flags_exit_2(tmp_path):
     assert code == 2 and "--feed-mm-min: expected a value > 0" in one_error_line(err)
     code, _, err = run_main("reach", "--direction", "0", "0", "0", "0", "0", "0")
     assert code == 2 and "expected a non-zero direction" in one_error_line(err)
+
+
+def test_record_of_a_cl_file_holds_one_check_path_call_per_tool(tmp_path):
+    """--record with a CL file: one ~/check_path call per part, in the base frame, with its feeds
+    and the speeds and frames of the JSON document; read back with rosbags and mcap_ros2."""
+    from recording_support import read_with_mcap_ros2, read_with_rosbags
+
+    log = tmp_path / "pocket.mcap"
+    args = ["--rapid-feed-mm-min", "2400", "--rotary-feed-deg-min", "360", "--json"]
+    code, out, err = run_main(
+        "--config", str(CELL), "check-path", str(POCKET), *args, "--record", str(log)
+    )
+    assert code == 1 and "recorded the path check (2 call(s))" in err
+    document = json.loads(out)
+    for reader in (read_with_rosbags, read_with_mcap_ros2):
+        messages = reader(log)
+        requests = [m for topic, _, m in messages if topic.endswith("/check_path/request")]
+        responses = [m for topic, _, m in messages if topic.endswith("/check_path/response")]
+        assert len(requests) == len(responses) == 2
+        for part, request, response in zip(document["parts"], requests, responses, strict=True):
+            assert request.header.frame_id == "base" and request.free_torsion
+            assert len(request.poses) == len(part["waypoints"])
+            assert response.frames.tool_number == part["tool"]["number"]
+            assert response.frames.request_frame_id == "base"
+            assert len(response.speeds) == len(part["segments"])
+            for speed, segment in zip(response.speeds, part["segments"], strict=True):
+                assert speed.rapid == segment["rapid"]
+                if segment["duration_s"] is None:
+                    assert not speed.speed_checked and math.isnan(speed.duration_s)
+                    continue
+                assert speed.speed_ok == segment["speed_ok"]
+                assert speed.duration_s == pytest.approx(segment["duration_s"], rel=1e-12)
+                assert speed.actuator_speed_peak == pytest.approx(
+                    segment["actuator_speed_peak"], rel=1e-12
+                )
+                if segment["feed_max_mm_min"] is not None:
+                    assert speed.feed_max_mm_min == pytest.approx(
+                        segment["feed_max_mm_min"], rel=1e-12
+                    )
+            assert [w.reachable for w in response.waypoints] == [
+                w["reachable"] for w in part["waypoints"]
+            ]

@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 import pytest
+from frames_reference import homogeneous, tt
 
 from hexapod_workspace import check
 from hexapod_workspace.core.constraints import check_pose
@@ -26,29 +27,6 @@ from hexapod_workspace.core.frames import (
 from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.core.rotations import matrix_to_tt
 from hexapod_workspace.errors import ConfigError, InputError
-
-
-def rz(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def ry(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def tt(phi: float, theta: float, psi: float) -> np.ndarray:
-    """R(φ, θ, ψ) = Rz(φ)·Ry(θ)·Rz(−φ)·Rz(ψ), from the convention's definition."""
-    return rz(phi) @ ry(theta) @ rz(-phi) @ rz(psi)
-
-
-def homogeneous(rotation: np.ndarray, translation) -> np.ndarray:
-    matrix = np.eye(4)
-    matrix[:3, :3] = rotation
-    matrix[:3, 3] = translation
-    return matrix
-
 
 TOOL_OFFSET = [0.012, -0.02, -0.16]
 TOOL_ANGLES = [0.4, 0.12, -0.3]
@@ -147,6 +125,11 @@ def test_cell_parameters_are_read_and_validated():
         cell.select(3)
     defaults = cell_from_mapping({})
     assert defaults.tool.is_identity and defaults.work.frame_id == "work" and not defaults.tools
+    # tool.number selects the active tool from the table (0: tool.offset / tool.orientation)
+    selected = cell_from_mapping(
+        {"tool": {"offset": [0, 0, -0.1], "number": 12}, "tools.T12.offset": [0, 0, -0.2]}
+    )
+    assert selected.tool.number == 12 and selected.tool.offset.tolist() == [0, 0, -0.2]
 
 
 @pytest.mark.parametrize(
@@ -162,6 +145,10 @@ def test_cell_parameters_are_read_and_validated():
         ({"work.frame_id": ""}, r"^work\.frame_id: expected a non-empty string"),
         ({"limits.actuator_speed_max": [-1.0]}, r"^limits\.actuator_speed_max: expected values"),
         ({"limits.actuator_speed_max": [1.0, 2.0]}, r"^limits\.actuator_speed_max: expected 1"),
+        ({"tool.number": 3, "tools.T1.offset": [0, 0, 0]}, r"^tool\.number: tool 3 is not .*T1\)"),
+        ({"tool.number": -1}, r"^tool\.number: expected an integer >= 0"),
+        ({"tool.number": True}, r"^tool\.number: expected an integer >= 0"),
+        ({"tool.number": 1.0}, r"^tool\.number: expected an integer >= 0"),
     ],
 )
 def test_bad_cell_parameters_are_refused_in_one_line(parameters, message):

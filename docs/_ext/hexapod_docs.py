@@ -96,6 +96,8 @@ class InterfacesDirective(_Generated):
             if row.kind == "action" and "/srv/" in row.type:
                 type_name = row.type.replace("/srv/", "/action/")
             where = f" Added by :mod:`{row.extension}`." if row.extension else ""
+            if row.condition:
+                where += f" Only with {row.condition}."
             out += [
                 f"``{name}``",
                 f"   {row.kind} · ``{type_name}`` · QoS: {row.qos_text}",

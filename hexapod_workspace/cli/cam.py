@@ -34,6 +34,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import IO, Any
 
@@ -60,8 +61,8 @@ from ..core.paths import (
     plan_torsion,
     reported_parts,
 )
-from ..core.rotations import degrees_to_radians, matrix_to_tt, tt_to_matrix
-from ..core.speeds import UPS, actuator_rates, feed_limits
+from ..core.rotations import degrees_to_radians, matrix_to_quaternion, matrix_to_tt, tt_to_matrix
+from ..core.speeds import UPS, FeedLimits, actuator_rates, feed_limits
 from .check_path import (
     _degrees_flag,
     _text,
@@ -71,6 +72,7 @@ from .check_path import (
     path_to_json,
     psi_zero_baseline,
     read_path_file,
+    record_path_calls,
 )
 from .commands import PROG
 from .inputs import PLOT_FORMATS, CliError, finite, load_manipulator, output_file
@@ -304,8 +306,9 @@ def _check_part(
     cell: CellFrames,
     options: argparse.Namespace,
     feeds: tuple[float, float],
-) -> tuple[PathCheck | TorsionPlan, dict[str, Any]]:
-    """Check (or plan) one part and add the speed keys to its document."""
+) -> tuple[PathCheck | TorsionPlan, dict[str, Any], tuple[dict[str, Any], dict[str, Any]]]:
+    """Check (or plan) one part and add the speed keys to its document; also return the part
+    as a ``~/check_path`` call (request and response fields, base frame) for ``--record``."""
     model = tool_model(platform, part.tool)
     tolerance = (
         DEFAULT_PATH_TOLERANCE
@@ -375,7 +378,72 @@ def _check_part(
             waypoint["line"] = int(part.lines[k])
     document["tool"] = tool_json(part.tool)
     document["first_waypoint"] = part.first
-    return result, document
+    call = _part_call(model, part, cell, result, baseline, tolerance, options, feeds, speeds, feed)
+    return result, document, call
+
+
+def _part_call(
+    model: Manipulator,
+    part: _Part,
+    cell: CellFrames,
+    result: PathCheck | TorsionPlan,
+    baseline: PathCheck | None,
+    tolerance: float,
+    options: argparse.Namespace,
+    rates: tuple[float, float],
+    speeds: FeedLimits,
+    feed: NDArray[np.float64],
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """One part as the ``~/check_path`` call the node would answer the same way: poses in the
+    base frame, the part's feeds (mm/min) and rapid flags, the speeds and frames in the
+    response."""
+    from ..logs import paths as path_fields
+    from ..logs.cell import cell_frames_fields, segment_speed_fields, slow_moves_clause
+
+    rapid_feed, rotary_feed = rates
+    if isinstance(result, TorsionPlan):  # tool axes: psi = 0 poses, the torsion planned
+        angles = np.column_stack([result.directions, np.zeros(len(part.positions))])
+        max_dpsi = (
+            None
+            if options.max_dpsi_deg is None
+            else _degrees_flag(options.max_dpsi_deg, "--max-dpsi-deg")
+        )
+        psi_step = _degrees_flag(options.psi_step_deg, "--psi-step-deg")
+    else:
+        assert part.degrees is not None
+        angles, max_dpsi, psi_step = degrees_to_radians(part.degrees), None, 0.0
+    request = path_fields.check_path_request_fields(
+        part.positions,
+        matrix_to_quaternion(tt_to_matrix(angles)),
+        free_torsion=isinstance(result, TorsionPlan),
+        interpolation=options.interpolation,
+        tolerance=tolerance,
+        max_dpsi=max_dpsi,
+        psi_step=psi_step,
+    )
+    request.update(
+        header={"stamp": {"sec": 0, "nanosec": 0}, "frame_id": model.frame_id},
+        feeds_mm_min=(part.feeds[1:] / _MM_MIN).tolist(),
+        rapid=[bool(r) for r in part.rapid[1:]],
+        rapid_feed_mm_min=0.0 if math.isnan(rapid_feed) else rapid_feed / _MM_MIN,
+        rotary_feed_deg_min=0.0 if math.isnan(rotary_feed) else rotary_feed / _DEG_MIN,
+    )
+    response = path_fields.check_path_response_fields(
+        result, pairs=model.leg_diameter > 0.0, baseline=baseline
+    )
+    moves = len(speeds.duration)
+    clause = slow_moves_clause(speeds)
+    if clause:  # the node's answer to the same request says so too
+        response.update(ok=False, message=response["message"] + clause)
+    response.update(
+        speeds=segment_speed_fields(
+            speeds, part.rapid[1:], feed, np.where(speeds.rotary, rotary_feed, math.nan)
+        ),
+        actuator_speed_max=cell.actuator_speed_max.tolist(),
+        frames=cell_frames_fields(replace(cell, tool=part.tool), model.frame_id),
+    )
+    assert len(response["speeds"]) == moves
+    return request, response
 
 
 def _finite(value: float) -> float | None:
@@ -410,12 +478,11 @@ def _speed_summary(documents: list[dict[str, Any]], limits: NDArray[np.float64])
 
 def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
     """``check-path`` for CL files, frames and feeds (see the module documentation)."""
-    if options.record is not None:
-        msg = (
-            "check-path: --record is not available with CL files, --frame or feeds yet; "
-            "check the path without them for a log"
-        )
-        raise CliError(msg)
+    record = (
+        None
+        if options.record is None
+        else output_file(options.record, "--record", force=options.force, suffixes=(".mcap",))
+    )
     plot = (
         None
         if options.plot is None
@@ -429,9 +496,10 @@ def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str])
     rapid = _positive(options.rapid_feed_mm_min, "--rapid-feed-mm-min", "mm/min") * _MM_MIN
     rotary = _positive(options.rotary_feed_deg_min, "--rotary-feed-deg-min", "deg/min") * _DEG_MIN
     parts, ignored = _read_parts(options, cell, frame, feed)
-    results, documents = [], []
+    results, documents, calls = [], [], []
     for part in parts:
-        result, document = _check_part(platform, part, cell, options, (rapid, rotary))
+        result, document, call = _check_part(platform, part, cell, options, (rapid, rotary))
+        calls.append(call)
         if frame == "work":
             _to_frame(document, cell.work)
         results.append(result)
@@ -450,6 +518,9 @@ def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str])
         report = {"ok": ok, **common, "parts": documents}
     if plot is not None:
         plot_speeds(documents, speed, plot)
+    if record is not None:  # one ~/check_path call per part (tool), in the base frame
+        written = record_path_calls(record, calls)
+        err.write(f"{PROG}: recorded the path check ({len(calls)} call(s)) to {written}\n")
     if options.json:
         out.write(json.dumps(report, allow_nan=False) + "\n")
     else:

@@ -57,6 +57,7 @@ __all__ = [
     "psi_zero_baseline",
     "read_path_file",
     "record_path",
+    "record_path_calls",
 ]
 
 _POSITION = ("x", "y", "z")
@@ -465,26 +466,42 @@ def record_path(
         The ψ = 0 baseline of a path of fixed orientations
         (:func:`~hexapod_workspace.core.baseline.psi_zero_baseline`).
     """
+    from ..logs import paths as path_fields
+
+    response = path_fields.check_path_response_fields(result, pairs=pairs, baseline=baseline)
+    return record_path_calls(path, [(request, response)], stamp_ns=stamp_ns)
+
+
+def record_path_calls(
+    path: str | Path,
+    calls: list[tuple[dict[str, Any], dict[str, Any]]],
+    *,
+    stamp_ns: int | None = None,
+) -> Path:
+    """Record ``~/check_path`` calls (CheckPath_Request and _Response fields, in order) in MCAP,
+    1 µs apart, starting at ``stamp_ns`` (default now)."""
     from ..logs import SERVICE_QOS, LogWriter, recorded_type, service_topics
     from ..logs import paths as path_fields
 
     stamp = time.time_ns() if stamp_ns is None else int(stamp_ns)
     request_topic, response_topic = service_topics(path_fields.CHECK_PATH_TOPIC)
     with LogWriter(path, flush_interval=0, flush_messages=1) as writer:
-        writer.write_fields(
-            request_topic,
-            recorded_type(f"{path_fields.CHECK_PATH_TYPE}_Request"),
-            request,
-            stamp,
-            qos=SERVICE_QOS,
-        )
-        writer.write_fields(
-            response_topic,
-            recorded_type(f"{path_fields.CHECK_PATH_TYPE}_Response"),
-            path_fields.check_path_response_fields(result, pairs=pairs, baseline=baseline),
-            stamp + 1_000,
-            qos=SERVICE_QOS,
-        )
+        for request, response in calls:
+            writer.write_fields(
+                request_topic,
+                recorded_type(f"{path_fields.CHECK_PATH_TYPE}_Request"),
+                request,
+                stamp,
+                qos=SERVICE_QOS,
+            )
+            writer.write_fields(
+                response_topic,
+                recorded_type(f"{path_fields.CHECK_PATH_TYPE}_Response"),
+                response,
+                stamp + 1_000,
+                qos=SERVICE_QOS,
+            )
+            stamp += 2_000
     return Path(path)
 
 

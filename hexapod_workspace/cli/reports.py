@@ -436,7 +436,36 @@ def log_report(summary: LogSummary) -> dict[str, Any]:
             }
             for t in summary.triggers
         ],
+        "parameter_changes": [
+            {
+                "time_s": (c["log_time_ns"] - start) / 1e9,
+                "accepted": bool(c["accepted"]),
+                "parameters": dict(zip(c["names"], c["values"], strict=False)),
+                "reason": c["reason"],
+            }
+            for c in summary.parameter_changes
+        ],
+        "axis_limits": [_axis_limits_json(a, start) for a in summary.axis_limits],
         "problems": list(contents.problems),
+    }
+
+
+def _axis_limits_json(fields: dict[str, Any], start: int) -> dict[str, Any]:
+    """One recorded AxisLimits: the frame, the pose's position (m, base frame) and per axis
+    ``[minus, plus]`` (m or rad), or the reason it failed."""
+    position = fields["pose"]["position"]
+    return {
+        "time_s": (fields["log_time_ns"] - start) / 1e9,
+        "success": bool(fields["success"]),
+        "message": fields["message"],
+        "frame": fields["frame"],
+        "position": [position["x"], position["y"], position["z"]],
+        "axes": {
+            name: [float(minus), float(plus)]
+            for name, minus, plus in zip(
+                fields["axes"], fields["minus"], fields["plus"], strict=True
+            )
+        },
     }
 
 
@@ -522,6 +551,28 @@ def log_report_text(report: dict[str, Any], out: IO[str]) -> None:
             for call in report["trigger_calls"]
         ]
         _capped(lines, "trigger calls", out)
+    changes = report.get("parameter_changes", [])
+    if changes:
+        refused = sum(not c["accepted"] for c in changes)
+        out.write(f"parameter changes: {len(changes)} ({refused} refused)\n")
+        lines = [
+            f"+{c['time_s']:.3f} s "
+            + ", ".join(f"{name} = {value}" for name, value in c["parameters"].items())
+            + (": applied" if c["accepted"] else f": refused: {c['reason']}")
+            for c in changes
+        ]
+        _capped(lines, "parameter changes", out)
+    limits = report.get("axis_limits", [])
+    if limits:
+        last = limits[-1]
+        out.write(f"axis limits: {len(limits)} published; the last at +{last['time_s']:.3f} s")
+        if last["success"]:
+            axes = ", ".join(
+                f"{name} -{minus:.4g}..+{plus:.4g}" for name, (minus, plus) in last["axes"].items()
+            )
+            out.write(f" ({last['frame']} frame; m, rad): {axes}\n")
+        else:
+            out.write(f": failed: {last['message']}\n")
 
 
 #: Text replay lists at most this many entries per kind (the first and the last ones).

@@ -30,7 +30,9 @@ Tool table
 ----------
 ``tools.T<n>.offset`` (3 numbers, m) and ``tools.T<n>.orientation`` (3 numbers, rad, default
 zero), n = 1, 2, ... (ROS parameter names cannot start with a digit). A tool change (CL
-``LOADTL/n``) selects entry n.
+``LOADTL/n``) selects entry n. ``tool.number`` (default 0) selects the active tool: 0 is the
+``tool.offset``/``tool.orientation`` pair, n > 0 is table entry n (which must exist); the node
+changes tools by setting it at run time.
 """
 
 from __future__ import annotations
@@ -67,6 +69,7 @@ __all__ = [
 CELL_DEFAULTS: dict[str, Any] = {
     "tool.offset": [0.0, 0.0, 0.0],
     "tool.orientation": [0.0, 0.0, 0.0],
+    "tool.number": 0,
     "work.origin": [0.0, 0.0, 0.0],
     "work.orientation": [0.0, 0.0, 0.0],
     "work.frame_id": "work",
@@ -173,7 +176,8 @@ class CellFrames:
     Attributes
     ----------
     tool : Tool
-        The active tool (``tool.*``).
+        The active tool: ``tool.offset``/``tool.orientation`` (number 0), or the table entry
+        ``tool.number`` selects.
     work : WorkFrame
     tools : dict of int to Tool
         The tool table (``tools.T<n>.*``), by number.
@@ -260,6 +264,7 @@ def cell_from_mapping(parameters: Mapping[str, Any]) -> CellFrames:
             _frozen(_angles3(f"tools.T{number}.orientation", entry.get("orientation", [0.0] * 3))),
             number,
         )
+    tool = _selected(tool, tools, values["tool.number"])
     name = "limits.actuator_speed_max"
     speeds = _numbers(name, values[name])
     if speeds.size not in (1, 6):
@@ -269,6 +274,24 @@ def cell_from_mapping(parameters: Mapping[str, Any]) -> CellFrames:
         msg = f"{name}: expected values >= 0 (0 = unlimited), got {_describe(speeds.tolist())}"
         raise ConfigError(msg)
     return CellFrames(tool, work, tools, _frozen(np.broadcast_to(speeds, (6,)).copy()))
+
+
+def _selected(tool: Tool, tools: dict[int, Tool], number: Any) -> Tool:
+    """The active tool: ``tool`` for ``tool.number`` 0, else the table's entry (ConfigError
+    naming ``tool.number`` and the defined tools when there is none)."""
+    if isinstance(number, bool) or not isinstance(number, (int, np.integer)) or number < 0:
+        msg = f"tool.number: expected an integer >= 0 (0 = tool.offset), got {_describe(number)}"
+        raise ConfigError(msg)
+    if number == 0:
+        return tool
+    if int(number) not in tools:
+        have = ", ".join(f"T{n}" for n in sorted(tools)) or "none"
+        msg = (
+            f"tool.number: tool {int(number)} is not in the tool table (tools.T<n>; "
+            f"defined: {have})"
+        )
+        raise ConfigError(msg)
+    return tools[int(number)]
 
 
 def cell_from_params_file(path: str | Path) -> CellFrames:

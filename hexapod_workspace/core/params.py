@@ -46,12 +46,15 @@ NODE_PARAMETERS = (
     "recording.max_file_duration",
     "recording.max_total_mb",
     "motion.current_pose_topic",
+    "axis_limits.frame",
+    "axis_limits.rate",
 )
 #: Parameters of the machining cell (tool and work frames, tool table, actuator speeds), read by
 #: :func:`hexapod_workspace.core.frames.cell_from_mapping`; ``tools.`` holds ``tools.T<n>.*``.
 CELL_PARAMETERS = (
     "tool.offset",
     "tool.orientation",
+    "tool.number",
     "work.origin",
     "work.orientation",
     "work.frame_id",

@@ -50,6 +50,8 @@ class Interface:
         What it carries, one line.
     extension : str
         The module that adds it to the node (``""``: the node itself).
+    condition : str
+        When the node offers it (``""``: always), e.g. only with a parameter set.
     """
 
     key: str
@@ -60,6 +62,7 @@ class Interface:
     durability: str = "volatile"
     depth: int = 10
     extension: str = ""
+    condition: str = ""
 
     @property
     def name(self) -> str:
@@ -162,8 +165,20 @@ INTERFACES: tuple[Interface, ...] = (
         "check_path",
         "service",
         f"{_MSGS}/srv/CheckPath",
-        "a motion through waypoints: certified moves, or a torsion plan",
+        "a motion through waypoints: certified moves, or a torsion plan; with feeds or "
+        "durations, the certified peak actuator speed and the largest feed of each move",
         extension="hexapod_workspace.ros.paths",
+    ),
+    Interface(
+        "axis_limits",
+        "publisher",
+        f"{_MSGS}/msg/AxisLimits",
+        "the +/- reach along the six axes of axis_limits.frame at the current pose (soft "
+        "limits), at most axis_limits.rate Hz",
+        extension="hexapod_workspace.ros.cell",
+        durability="transient_local",
+        depth=1,
+        condition="motion.current_pose_topic set",
     ),
     Interface(
         "compute_atlas",

@@ -40,6 +40,7 @@ __all__ = [
     "compute_workspace_request_fields",
     "compute_workspace_response_fields",
     "header_fields",
+    "no_cell_frames_fields",
     "point_fields",
     "pointcloud_fields",
     "pointcloud_to_array",
@@ -181,13 +182,33 @@ def _failed_pose_check() -> dict[str, Any]:
     }
 
 
-def check_poses_request_fields(position: ArrayLike, angles: ArrayLike) -> dict[str, Any]:
-    """hexapod_workspace_msgs/srv/CheckPoses_Request from a position (3,) m and angles (N, 3)."""
+def check_poses_request_fields(
+    position: ArrayLike, angles: ArrayLike, frame_id: str = ""
+) -> dict[str, Any]:
+    """hexapod_workspace_msgs/srv/CheckPoses_Request from a position (3,) m and angles (N, 3)
+    in the frame ``frame_id`` (``""``: the base frame)."""
     angles = np.asarray(angles, dtype=float).reshape(-1, 3)
     return {
         "position": point_fields(position),
         "orientations": [{"phi": p, "theta": t, "psi": s} for p, t, s in angles.tolist()],
         "poses": [],
+        "header": header_fields(0, frame_id),
+    }
+
+
+def no_cell_frames_fields(request_frame_id: str = "") -> dict[str, Any]:
+    """hexapod_workspace_msgs/msg/CellFrames of a result computed without a machining cell: the
+    tool at the platform frame, no work frame (the cell's own: logs/cell.py)."""
+    zero = {"x": 0.0, "y": 0.0, "z": 0.0}
+    angles = {"phi": 0.0, "theta": 0.0, "psi": 0.0}
+    return {
+        "tool_offset": dict(zero),
+        "tool_orientation": dict(angles),
+        "work_origin": dict(zero),
+        "work_orientation": dict(angles),
+        "tool_number": 0,
+        "work_frame_id": "",
+        "request_frame_id": str(request_frame_id),
     }
 
 
@@ -206,6 +227,7 @@ def check_poses_response_fields(
         "success": True,
         "message": message if message is not None else f"{reachable}/{len(result)} reachable",
         "results": pose_checks_fields(result),
+        "frames": no_cell_frames_fields(),
     }
 
 
@@ -264,6 +286,7 @@ def reachability_result_fields(
         "motion_ok": False,
         "current_pose": identity_pose_fields(),
         "motion": unchecked_motion_fields(),
+        "frames": no_cell_frames_fields(),
     }
 
 
@@ -408,6 +431,7 @@ def summary_fields(
             tolerance=float(tolerance),
             n_points=int(n_points or 0),
             elapsed=0.0 if workspace is None else float(workspace.elapsed),
+            frames=no_cell_frames_fields(),
         )
         return fields
     kind = workspace_kind(workspace) if kind is None else int(kind)
@@ -435,6 +459,7 @@ def summary_fields(
         elapsed=float(workspace.elapsed),
     )
     fields["message"] = message if message is not None else summary_line(fields)
+    fields["frames"] = no_cell_frames_fields()
     return fields
 
 

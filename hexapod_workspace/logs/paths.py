@@ -94,6 +94,12 @@ def check_path_request_fields(
         "limit_dpsi": max_dpsi is not None,
         "max_dpsi": float(max_dpsi) if max_dpsi is not None else 0.0,
         "psi_step": float(psi_step),
+        "header": messages.header_fields(0, ""),
+        "rapid": [],
+        "feeds_mm_min": [],
+        "rapid_feed_mm_min": 0.0,
+        "durations_s": [],
+        "rotary_feed_deg_min": 0.0,
     }
 
 
@@ -189,6 +195,9 @@ def check_path_response_fields(
         "break_index": plan.breakpoint.index if plan is not None and plan.breakpoint else -1,
         "psi_zero_waypoints_failed": baseline.failed_waypoints if baseline is not None else [],
         "psi_zero_segments_failed": baseline.failed_segments if baseline is not None else [],
+        "speeds": [],
+        "actuator_speed_max": [0.0] * 6,
+        "frames": messages.no_cell_frames_fields(),
     }
     return fields
 
@@ -279,6 +288,9 @@ def path_call_report(index: int, call: dict[str, Any], start_ns: int) -> dict[st
         "segments_failed": sum(not m["ok"] for m in segments),
         "psi_zero_waypoints_failed": len(response.get("psi_zero_waypoints_failed", [])),
         "psi_zero_segments_failed": len(response.get("psi_zero_segments_failed", [])),
+        "moves_to_slow_down": sum(
+            bool(m["speed_checked"]) and not m["speed_ok"] for m in response.get("speeds", [])
+        ),
     }
 
 
@@ -296,4 +308,9 @@ def path_call_line(report: dict[str, Any]) -> str:
         f"({report['waypoints_failed']} waypoints, {report['segments_failed']} moves fail; "
         f"psi = 0: {report['psi_zero_waypoints_failed']} and "
         f"{report['psi_zero_segments_failed']})"
+        + (
+            f"; {report['moves_to_slow_down']} move(s) must slow down (actuator speed)"
+            if report.get("moves_to_slow_down")
+            else ""
+        )
     )

@@ -37,6 +37,8 @@ _FLAT_RESPONSE = "hexapod_workspace_msgs/srv/CheckPosesFlat_Response"
 _TRIGGER_RESPONSE = "std_srvs/srv/Trigger_Response"
 _PATH_REQUEST = "hexapod_workspace_msgs/srv/CheckPath_Request"
 _PATH_RESPONSE = "hexapod_workspace_msgs/srv/CheckPath_Response"
+_PARAMETER_CHANGE = "hexapod_workspace_msgs/msg/ParameterChange"
+_AXIS_LIMITS = "hexapod_workspace_msgs/msg/AxisLimits"
 
 
 # --------------------------------------------------------------------------- what a log holds
@@ -129,6 +131,10 @@ class LogSummary:
     triggers: list[dict[str, Any]] = field(default_factory=list)
     paths: list[dict[str, Any]] = field(default_factory=list)
     atlases: list[AtlasRecord] = field(default_factory=list)
+    #: the node's set_parameters calls (ParameterChange fields, with ``log_time_ns``)
+    parameter_changes: list[dict[str, Any]] = field(default_factory=list)
+    #: the published axis limits (AxisLimits fields, with ``log_time_ns``)
+    axis_limits: list[dict[str, Any]] = field(default_factory=list)
     decoded: int = 0
 
 
@@ -234,6 +240,13 @@ def summarize_log(
             fields = message_to_fields(item.message)
             fields.update(topic=item.topic, log_time_ns=item.log_time_ns)
             summary.triggers.append(fields)
+        elif msgtype in (_PARAMETER_CHANGE, _AXIS_LIMITS):
+            fields = message_to_fields(item.message)
+            fields["log_time_ns"] = item.log_time_ns
+            kept_in = (
+                summary.parameter_changes if msgtype == _PARAMETER_CHANGE else summary.axis_limits
+            )
+            kept_in.append(fields)
     return summary, kept
 
 

@@ -11,6 +11,11 @@ A command whose header stamp is older than ``check.max_command_age`` when its tu
 answered ``success`` false, "overloaded: ..." (counted), not checked: a verdict that late is of
 no use to a controller, and skipping the check lets the node catch up. Commands with a zero
 stamp are always checked.
+
+A command's ``header.frame_id`` names the frame of its pose: the base frame (or ``""``) or the
+work frame, converted here (:func:`hexapod_workspace.ros.cell.angles_to_base`); any other is
+refused with the reason. The result echoes the pose in the base frame and says with ``frames``
+which tool and work frame it was computed with.
 """
 
 from __future__ import annotations
@@ -26,6 +31,7 @@ from hexapod_workspace.core.constraints import check
 from hexapod_workspace.errors import InputError
 from hexapod_workspace.logs import messages
 
+from .cell import angles_to_base, frames_message
 from .conversions import to_message
 from .paths import commanded_target
 
@@ -74,6 +80,7 @@ class CommandStream:
         for k, command in enumerate(batch):
             try:  # T&T, or a geometry_msgs/Pose converted (hexapod_workspace.ros.paths)
                 position, target = commanded_target(command)
+                target, position = angles_to_base(state, command.header.frame_id, target, position)
             except InputError as error:
                 stats.commands_refused += 1
                 verdicts[k] = (None, 0, str(error))
@@ -112,6 +119,7 @@ class CommandStream:
                 fields = node.paths.with_motion(
                     fields, state.manipulator, positions[k], angles[k][None, :]
                 )
+            fields["frames"] = frames_message(state, command.header.frame_id)
             node.publish(self._publisher, to_message(ReachabilityResult, fields))
         stats.commands_answered += len(batch)
 

@@ -9,6 +9,8 @@ never counted here), ``reachable`` and ``limiting_leg`` one value per pose. The 
 out of the messages as numpy buffers (``array.array`` for rclpy), with no Python loop per pose.
 Requests and answers are recorded like the other services' (``<service>/request`` and
 ``/response``, as the message twins ``CheckPosesFlatRequest``/``CheckPosesFlatResponse``).
+The position and angles are in the frame ``header.frame_id`` names (base or work,
+:mod:`~hexapod_workspace.ros.cell`); the answer's ``frames`` says which tool and work frame.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from numpy.typing import NDArray
 from hexapod_workspace.core.constraints import CONSTRAINT_NAMES, CheckResult, check
 from hexapod_workspace.errors import InputError
 
+from .cell import angles_to_base, frames_message
 from .conversions import position_from_point
 
 __all__ = ["angles_from_flat", "attach", "flat_margins", "flat_response"]
@@ -107,16 +110,21 @@ def attach(node: Any, name: str) -> Any:
         node.stats.check_calls += 1
         state = node.state
         try:
-            angles = angles_from_flat(request.angles, state.settings.max_poses)
-            answer = flat_response(
-                check(state.manipulator, angles, position_from_point(request.position))
+            angles, position = angles_to_base(
+                state,
+                request.header.frame_id,
+                angles_from_flat(request.angles, state.settings.max_poses),
+                position_from_point(request.position),
             )
+            answer = flat_response(check(state.manipulator, angles, position))
         except InputError as error:
             answer = flat_response(None, message=str(error))
         except Exception as error:  # a bug: answered, never silence
             answer = flat_response(None, message=node.internal_error(error))
         if not answer.success:
             node.stats.check_refused += 1
+        if state is not None:
+            answer.frames = frames_message(state, request.header.frame_id)
         return answer
 
     return node.recorded_service(CheckPosesFlat, name, on_check, node.check_group)

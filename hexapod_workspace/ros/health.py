@@ -52,10 +52,12 @@ def diagnostic_array(
     worker_alive: bool,
     recorder: RecorderStatus,
     lifecycle: Lifecycle | None = None,
+    extra: dict[str, str] | None = None,
 ) -> DiagnosticArray:
     """The node's DiagnosticArray: one status, level from what happened since the last call.
 
-    Not active: WARN ("inactive ..."), or ERROR with the reason when configure failed."""
+    Not active: WARN ("inactive ..."), or ERROR with the reason when configure failed.
+    ``extra``: further key-value lines (the machining cell's frames and parameter changes)."""
     lifecycle = lifecycle or Lifecycle("active", True)
     now = {
         "lifecycle state": lifecycle.state,
@@ -103,7 +105,9 @@ def diagnostic_array(
         name=name,
         message=message,
         hardware_id=hardware_id,
-        values=[KeyValue(key=key, value=str(value)) for key, value in now.items()],
+        values=[
+            KeyValue(key=key, value=str(value)) for key, value in {**now, **(extra or {})}.items()
+        ],
     )
     array = DiagnosticArray(status=[status])
     array.header.stamp = stamp

@@ -28,6 +28,9 @@ Topics
     process's node ``<node>_clouds``, :mod:`~hexapod_workspace.ros.clouds`), ``~/workspace_summary``
     (WorkspaceSummary), ``~/reachability`` (depth 1000); ``/diagnostics``
     (diagnostic_msgs/DiagnosticArray, 1 Hz).
+Machining cell
+    Tool and work frames (``tool.*``, ``tools.T<n>.*``, ``work.*``), poses in the work frame,
+    feeds on ``~/check_path`` and ``~/axis_limits``: :mod:`~hexapod_workspace.ros.cell`.
 
 Lifecycle
     A managed node (``lifecycle_msgs`` services ``~/change_state``, ``~/get_state``, ...):
@@ -41,7 +44,8 @@ Services (flat)
 Threads: the executor (single-threaded: every callback is short), the job queue
 (:mod:`~hexapod_workspace.ros.jobs`; the computation runs in a worker process, so it does not
 hold this interpreter), the recorder (:mod:`~hexapod_workspace.ros.recorder`, the only owner of
-the MCAP log). Units: SI (m, rad), positions in the base frame ``frame_id``.
+the MCAP log). Units: SI (m, rad), positions of the tool centre point in the base frame
+``frame_id`` (requests may give the work frame).
 
 Extensions (other services, actions) attach with one call each: :data:`EXTENSIONS` holds
 functions ``attach(node)`` that :func:`main` passes to the node; they use the node's
@@ -90,7 +94,7 @@ from hexapod_workspace.logs import (
 )
 from hexapod_workspace.logs.interfaces import relative_name
 
-from . import health
+from . import cell, health
 from .commands import CommandStream
 from .conversions import angles_from_orientations, position_from_point, to_message, type_name
 from .flat import attach as attach_flat
@@ -105,6 +109,7 @@ from .parameters import (
     parameter_specs,
     refusal,
     state_from,
+    tool_table_specs,
 )
 from .paths import attach as attach_paths
 from .paths import check_poses_from_poses
@@ -236,7 +241,13 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         self._diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self.create_timer(1.0, self._publish_diagnostics)
         # ~/check_path, Pose inputs and the current-pose parameter (hexapod_workspace.ros.paths)
-        self.paths = attach_paths(self, lambda: self.configured_state.manipulator, self.recorder)
+        self.paths = attach_paths(
+            self,
+            lambda: self.configured_state.manipulator,
+            self.recorder,
+            lambda: self.configured_state,
+        )
+        self.cell_status = cell.CellStatus(self)  # parameter changes: log and /diagnostics
         self._extensions = list(extensions)
         for attach in self._extensions:
             attach(self)
@@ -343,6 +354,7 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         of the node declares (misspelt key or section), a model given in part, a wrong type.
         With no model parameter given the packaged example is the model, and the log says so."""
         names = set(self._override_names) | set(getattr(self, "_parameter_overrides", {}))
+        self._specs.update(tool_table_specs(names))  # the tool table given (tools.T<n>.*)
         unknown = unknown_parameter(names, (*self._specs, *NODE_PARAMETERS, *ROS_PARAMETERS))
         if unknown is not None:
             raise ConfigError(f"unknown parameter given to the node: {unknown}")
@@ -366,7 +378,11 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
             )
 
     def _parameter_values(self) -> dict[str, Any]:
-        return {name: self.get_parameter(name).value for name in self._specs}
+        return {
+            name: self.get_parameter(name).value
+            for name in self._specs
+            if self.has_parameter(name)  # a tool-table entry being declared
+        }
 
     def set_parameters(self, parameter_list: list[Parameter]) -> list[SetParametersResult]:
         """As rclpy's, with refusals that name the parameter and the value."""
@@ -374,7 +390,36 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
 
     def set_parameters_atomically(self, parameter_list: list[Parameter]) -> SetParametersResult:
         """As rclpy's, with refusals that name the parameter and the value (unknown names and
-        wrong types included)."""
+        wrong types included); a tool-table entry not declared yet is declared (after the whole
+        set is validated). Every outcome is recorded
+        (:class:`~hexapod_workspace.ros.cell.CellStatus`)."""
+        result = self._set_parameters_checked(parameter_list)
+        status = getattr(self, "cell_status", None)
+        if status is not None:
+            status.record(parameter_list, refused=None if result.successful else result.reason)
+        return result
+
+    def _set_parameters_checked(self, parameter_list: list[Parameter]) -> SetParametersResult:
+        new_tools = cell.new_tool_table_parameters(self, parameter_list)
+        if new_tools:  # a tool added at run time: checked as a whole set, then declared
+            self._specs.update(new_tools)
+            reason = next((r for p in parameter_list if (r := refusal(self._specs, p))), None)
+            checked = (
+                SetParametersResult(successful=False, reason=reason)
+                if reason is not None
+                else self._validate_parameters(parameter_list)
+            )
+            if not checked.successful:
+                for name in new_tools:
+                    del self._specs[name]
+                return checked
+            for name, spec in new_tools.items():
+                given = next((p for p in parameter_list if p.name == name), None)
+                value = given.value if given is not None else spec.default
+                self.declare_parameter(name, value, spec.descriptor())
+            parameter_list = [p for p in parameter_list if p.name not in new_tools]
+            if not parameter_list:
+                return SetParametersResult(successful=True)
         for parameter in parameter_list:
             if parameter.name not in self._specs and self.has_parameter(parameter.name):
                 # an extension's or rclpy's own (use_sim_time, ...): rclpy checks the rest
@@ -394,7 +439,7 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         if not self.configured:
             return SetParametersResult(successful=True)
         values = self._parameter_values()
-        values.update({p.name: p.value for p in parameters if p.name in values})
+        values.update({p.name: p.value for p in parameters if p.name in self._specs})
         try:
             state_from(values)
         except (ConfigError, InputError) as error:
@@ -439,8 +484,16 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
 
     @staticmethod
     def _check_fields(state: State, request: CheckPoses.Request) -> dict[str, Any]:
+        fields = WorkspaceNode._check_verdicts(state, request)
+        fields["frames"] = cell.frames_message(state, request.header.frame_id)
+        return fields
+
+    @staticmethod
+    def _check_verdicts(state: State, request: CheckPoses.Request) -> dict[str, Any]:
         if len(request.poses):  # the geometry_msgs/Pose form (hexapod_workspace.ros.paths)
-            return check_poses_from_poses(state.manipulator, request, state.settings.max_poses)
+            return check_poses_from_poses(
+                state.manipulator, request, state.settings.max_poses, state
+            )
         count, limit = len(request.orientations), state.settings.max_poses
         reason = None
         if count == 0:
@@ -451,11 +504,13 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
             )
         if reason is None:
             try:
-                result = check(
-                    state.manipulator,
+                angles, position = cell.angles_to_base(  # base or work frame (ros/cell.py)
+                    state,
+                    request.header.frame_id,
                     angles_from_orientations(request.orientations),
                     position_from_point(request.position),
                 )
+                result = check(state.manipulator, angles, position)
                 return messages.check_poses_response_fields(result)
             except InputError as error:
                 reason = str(error)
@@ -473,6 +528,7 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
             worker_alive=self.worker.alive,
             recorder=self.recorder.status(),
             lifecycle=health.Lifecycle(self.lifecycle_state, self.active, self.configure_error),
+            extra=self.cell_status.values(self.state),
         )
         self._diagnostics.publish(array)
 
@@ -487,6 +543,8 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         """Cancel the queued and running computations and end the worker process."""
         self.workspaces.stop()
         self.worker.close()
+        if self.paths.axis_limits is not None:
+            self.paths.axis_limits.close()
 
     def destroy_node(self) -> None:
         """Stop the jobs and the worker, finish the MCAP log (logging where it went), then

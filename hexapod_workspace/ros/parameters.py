@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,6 +33,7 @@ from rclpy.parameter import Parameter
 
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import resolution
+from hexapod_workspace.core.frames import CELL_DEFAULTS, CellFrames, cell_from_mapping, tool_model
 from hexapod_workspace.core.manipulator import PARAMETER_DEFAULTS, Manipulator
 from hexapod_workspace.core.validation import require_usable
 from hexapod_workspace.errors import ConfigError
@@ -51,6 +53,7 @@ __all__ = [
     "parameter_specs",
     "refusal",
     "state_from",
+    "tool_table_specs",
 ]
 
 #: Parameter ranges: the core's resolution bounds (one definition, core/resolution.py).
@@ -230,6 +233,7 @@ def parameter_specs() -> dict[str, Spec]:
             read_only=True,
             float_range=(0.0, 1e9),
         ),
+        *_cell_specs(),
         Spec(
             "recording.directory",
             "",
@@ -239,6 +243,86 @@ def parameter_specs() -> dict[str, Spec]:
         ),
     ]
     return {spec.name: spec for spec in specs}
+
+
+#: The machining cell's parameters (hexapod_workspace.core.frames), settable at run time.
+CELL_DESCRIPTIONS = {
+    "tool.offset": (
+        "Tool centre point C in the platform frame (the frame of geometry.platform_joints), m, "
+        "3 floats: every pose given to and returned by the node is C's (tool.number 0)."
+    ),
+    "tool.orientation": (
+        "Tool frame's axes in the platform frame, rad, T&T angles (phi, theta, psi) "
+        "(tool.number 0)."
+    ),
+    "tool.number": (
+        "Active tool: 0 = tool.offset/tool.orientation, n > 0 = the tool table's tools.T<n> "
+        "(a tool change sets it; a number not in the table is refused)."
+    ),
+    "work.origin": "Work (workpiece) frame's origin in the base frame, m, 3 floats.",
+    "work.orientation": "Work frame's axes in the base frame, rad, T&T angles (phi, theta, psi).",
+    "work.frame_id": (
+        "Name of the work frame: poses with this header.frame_id are converted from it; "
+        "another name than the base frame_id."
+    ),
+    "limits.actuator_speed_max": (
+        "Largest actuator speed, actuator unit/s (m/s for legs), 1 value or 6; 0 = unlimited "
+        "(~/check_path's speed verdicts)."
+    ),
+}
+#: The tool table's parameter names (declared from the parameters given at start, or when a
+#: client sets a new one).
+TOOL_TABLE_NAME = re.compile(r"^tools\.T([1-9][0-9]*)\.(offset|orientation)$")
+#: ~/axis_limits settings.
+AXIS_LIMITS_FRAMES = ("base", "work", "tool")
+
+
+def _cell_specs() -> list[Spec]:
+    specs = [
+        Spec(
+            name,
+            CELL_DEFAULTS[name],
+            description,
+            int_range=(0, 1_000_000) if name == "tool.number" else None,
+        )
+        for name, description in CELL_DESCRIPTIONS.items()
+    ]
+    specs += [
+        Spec(
+            "axis_limits.frame",
+            "base",
+            "Frame of the axes of ~/axis_limits: base, work or tool.",
+            constraints=f"one of: {', '.join(AXIS_LIMITS_FRAMES)}",
+        ),
+        Spec(
+            "axis_limits.rate",
+            2.0,
+            "Most ~/axis_limits messages per second (computed beside the command path, for "
+            "the last current pose); 0 = none published.",
+            float_range=(0.0, 100.0),
+        ),
+    ]
+    return specs
+
+
+def tool_table_specs(names: Iterable[str]) -> dict[str, Spec]:
+    """Specs of the tool-table parameters (``tools.T<n>.offset``, ``.orientation``) among
+    ``names``, plus ``tools.T<n>.orientation`` (default zero) for every ``tools.T<n>.offset``."""
+    specs: dict[str, Spec] = {}
+    for name in sorted(names):
+        match = TOOL_TABLE_NAME.match(name)
+        if match is None:
+            continue
+        number = match.group(1)
+        for key, text in (
+            ("offset", "m, tool centre point in the platform frame (3 floats)"),
+            ("orientation", "rad, T&T angles of the tool frame in the platform frame"),
+        ):
+            if key == "offset" and match.group(2) != "offset":
+                continue
+            full = f"tools.T{number}.{key}"
+            specs[full] = Spec(full, [0.0, 0.0, 0.0], f"Tool table, tool {number}: {text}.")
+    return specs
 
 
 @dataclass(frozen=True)
@@ -255,14 +339,31 @@ class Settings:
     recording_enabled: bool
     recording_directory: Path
     recording_rotation: Rotation
+    axis_limits_frame: str = "base"
+    axis_limits_rate: float = 2.0
 
 
 @dataclass(frozen=True)
 class State:
-    """What the callbacks read: swapped as a whole when parameters change."""
+    """What the callbacks read: swapped as a whole when parameters change.
+
+    Attributes
+    ----------
+    manipulator : Manipulator
+        The model that answers for tool-frame poses
+        (:func:`~hexapod_workspace.core.frames.tool_model` of ``platform`` and the active
+        tool): what every check uses.
+    settings : Settings
+    platform : Manipulator
+        The model as the parameters give it (platform frame).
+    cell : CellFrames
+        The active tool, the work frame, the tool table and the actuator speed limits.
+    """
 
     manipulator: Manipulator
     settings: Settings
+    platform: Manipulator | None = None
+    cell: CellFrames | None = None
 
 
 def _plain(value: Any) -> Any:
@@ -327,11 +428,29 @@ def state_from(values: dict[str, Any]) -> State:
     ConfigError
         Invalid model or settings; the message names the parameter and the value.
     """
-    manipulator = require_usable(
+    platform = require_usable(
         Manipulator.from_mapping(
             {name: _plain(values[name]) for name in MODEL_DESCRIPTIONS}, warn=False
         )
     )
+    cell = cell_from_mapping(
+        {
+            name: _plain(value)
+            for name, value in values.items()
+            if name in CELL_DESCRIPTIONS or TOOL_TABLE_NAME.match(name)
+        }
+    )
+    if cell.work.frame_id == platform.frame_id:
+        msg = (
+            f"work.frame_id: expected a name other than the base frame frame_id, got "
+            f"{cell.work.frame_id!r}"
+        )
+        raise ConfigError(msg)
+    frame = str(values.get("axis_limits.frame", "base"))
+    if frame not in AXIS_LIMITS_FRAMES:
+        msg = f"axis_limits.frame: expected one of {', '.join(AXIS_LIMITS_FRAMES)}, got {frame!r}"
+        raise ConfigError(msg)
+    manipulator = tool_model(platform, cell.tool)
     method = str(values["resolution.projected_method"])
     if method not in PROJECTED_METHODS:
         msg = (
@@ -364,8 +483,10 @@ def state_from(values: dict[str, Any]) -> State:
             max_file_seconds=float(values["recording.max_file_duration"]),
             max_total_bytes=int(float(values["recording.max_total_mb"]) * 1e6),
         ),
+        axis_limits_frame=frame,
+        axis_limits_rate=float(values.get("axis_limits.rate", 2.0)),
     )
-    return State(manipulator, settings)
+    return State(manipulator, settings, platform, cell)
 
 
 #: Name prefixes of the model's parameters (``frame_id`` only names the frame).
@@ -373,8 +494,11 @@ MODEL_GROUPS = ("geometry.", "limits.", "pose.")
 
 
 def model_given(names: Iterable[str]) -> list[str]:
-    """The model parameters (``geometry.*``, ``limits.*``, ``pose.*``) among ``names``."""
-    return sorted({name for name in names if name.startswith(MODEL_GROUPS)})
+    """The model parameters (``geometry.*``, ``limits.*``, ``pose.*``) among ``names`` (the
+    cell's ``limits.actuator_speed_max`` is not part of the model)."""
+    return sorted(
+        {name for name in names if name.startswith(MODEL_GROUPS) and name not in CELL_DEFAULTS}
+    )
 
 
 def missing_model_parameters(given: Iterable[str]) -> str | None:
@@ -406,6 +530,8 @@ def model_default(name: str, declared: dict[str, Any]) -> Any:
     ``pose.position`` = ``geometry.home_position``), not the packaged example's value."""
     if name == "pose.position":
         return list(declared["geometry.home_position"])
+    if name in CELL_DEFAULTS:  # limits.actuator_speed_max: the cell's own default
+        return CELL_DEFAULTS[name]
     return PARAMETER_DEFAULTS[name]
 
 

@@ -4,16 +4,20 @@ Everything here is wired onto a node by :func:`attach` (a few lines in the node)
 module keeps only its own wiring:
 
 * service ``~/check_path`` (``hexapod_workspace_msgs/srv/CheckPath``): a path of
-  ``geometry_msgs/Pose`` in the base frame, checked move by move (certified), or with
-  ``free_torsion`` the rotation about each pose's z-axis (the tool axis) planned;
+  ``geometry_msgs/Pose`` in the base or the work frame (``header.frame_id``,
+  :mod:`~hexapod_workspace.ros.cell`), checked move by move (certified), or with
+  ``free_torsion`` the rotation about each pose's z-axis (the tool axis) planned; with feeds or
+  durations, each move's certified peak actuator speed and largest feed (``speeds``);
 * parameter ``motion.current_pose_topic`` (read-only, default ``""``): a
   ``geometry_msgs/PoseStamped`` topic; when set, the last pose received there is the *current
-  pose* and :meth:`PathServices.with_motion` checks each commanded pose as a move from it;
-  every pose received there is recorded (the log reproduces each motion verdict);
+  pose* (base or work frame, by its ``header.frame_id``) and :meth:`PathServices.with_motion`
+  checks each commanded pose as a move from it, and ``~/axis_limits`` follows it
+  (:class:`~hexapod_workspace.ros.cell.AxisLimitsPublisher`); every pose received there is
+  recorded (the log reproduces each motion verdict);
 * conversions of ``geometry_msgs/Pose`` to arrays and back, and of the Pose forms of
   ``CheckPoses`` requests and ``CommandedPose`` messages.
 
-Units: m and rad; positions and quaternions ``(x, y, z, w)`` in the base frame.
+Units: m and rad; positions and quaternions ``(x, y, z, w)``; results in the base frame.
 """
 
 from __future__ import annotations
@@ -48,7 +52,9 @@ from ..errors import HexapodWorkspaceError, InputError
 from ..logs import REQUEST_QOS, SERVICE_QOS, messages, recorded_type, service_topics
 from ..logs import paths as path_fields
 from ..logs.interfaces import relative_name
+from . import cell
 from .conversions import to_message, type_name
+from .parameters import State
 
 __all__ = [
     "CURRENT_POSE_PARAMETER",
@@ -108,11 +114,12 @@ def commanded_target(command: Any) -> tuple[NDArray[np.float64], NDArray[np.floa
 
 
 def check_poses_from_poses(
-    manipulator: Manipulator, request: Any, max_poses: int
+    manipulator: Manipulator, request: Any, max_poses: int, state: State | None = None
 ) -> dict[str, Any]:
     """``CheckPoses_Response`` fields for a request that gives ``poses`` (geometry_msgs/Pose).
 
-    Each pose is checked at its own position; ``orientations`` must then be empty.
+    Each pose is checked at its own position; ``orientations`` must then be empty. With
+    ``state``, the poses are in the frame ``request.header.frame_id`` names (base or work).
     """
     count = len(request.poses)
     if len(request.orientations):
@@ -123,15 +130,24 @@ def check_poses_from_poses(
         return messages.check_poses_response_fields(None, success=False, message=reason)
     positions, quaternions = pose_arrays(request.poses)
     try:
+        if state is not None:
+            positions, quaternions = cell.poses_to_base(
+                state, request.header.frame_id, positions, quaternions
+            )
         result = check_waypoints(manipulator, positions, quaternions=quaternions)
     except InputError as error:
         return messages.check_poses_response_fields(None, success=False, message=str(error))
     return messages.check_poses_response_fields(result)
 
 
-def check_path_response_fields(manipulator: Manipulator, request: Any) -> dict[str, Any]:
+def check_path_response_fields(
+    manipulator: Manipulator, request: Any, state: State | None = None
+) -> dict[str, Any]:
     """``CheckPath_Response`` fields answering a request (a refusal with the reason when the
-    request is malformed)."""
+    request is malformed). With ``state``: poses in the frame ``request.header.frame_id`` names,
+    the speeds of the moves when the request gives feeds or durations
+    (:func:`hexapod_workspace.ros.cell.path_speeds`), and the frames used."""
+    speeds = state is not None and cell.speeds_requested(request)
     try:
         if request.interpolation >= len(INTERPOLATIONS):
             msg = (
@@ -142,6 +158,12 @@ def check_path_response_fields(manipulator: Manipulator, request: Any) -> dict[s
         interpolation = INTERPOLATIONS[request.interpolation]
         tolerance = _option(request.tolerance, "tolerance", DEFAULT_PATH_TOLERANCE)
         positions, quaternions = pose_arrays(request.poses)
+        if state is not None:
+            positions, quaternions = cell.poses_to_base(
+                state, request.header.frame_id, positions, quaternions
+            )
+            if speeds:
+                cell.validate_speed_request(request, interpolation)
         if request.free_torsion:
             psi_step = _option(request.psi_step, "psi_step", DEFAULT_PLAN_PSI_STEP)
             max_dpsi = None
@@ -171,13 +193,21 @@ def check_path_response_fields(manipulator: Manipulator, request: Any) -> dict[s
                 interpolation=interpolation,
                 tolerance=tolerance,
             )
+        fields = path_fields.check_path_response_fields(
+            result,
+            pairs=manipulator.leg_diameter > 0.0,
+            baseline=reported_baseline(manipulator, result),
+        )
+        if speeds:
+            assert state is not None
+            speed_fields = cell.path_speeds(state, request, result)
+            fields["message"] += speed_fields.pop("message_suffix", "")
+            fields.update(speed_fields)
     except HexapodWorkspaceError as error:
-        return path_fields.failed_check_path_response_fields(str(error))
-    return path_fields.check_path_response_fields(
-        result,
-        pairs=manipulator.leg_diameter > 0.0,
-        baseline=reported_baseline(manipulator, result),
-    )
+        fields = path_fields.failed_check_path_response_fields(str(error))
+    if state is not None:
+        fields["frames"] = cell.cell_frames_fields(state.cell, request.header.frame_id)
+    return fields
 
 
 def _option(value: float, name: str, default: float) -> float:
@@ -202,6 +232,7 @@ class _CurrentPose:
     position: NDArray[np.float64]
     quaternion: NDArray[np.float64]
     frame_id: str
+    stamp_ns: int
 
 
 class PathServices:
@@ -222,9 +253,13 @@ class PathServices:
         node: Any,
         get_manipulator: Callable[[], Manipulator],
         recorder: Any | None = None,
+        get_state: Callable[[], State] | None = None,
     ) -> None:
         self._node = node
         self._get_manipulator = get_manipulator
+        self._get_state = get_state
+        #: ~/axis_limits (hexapod_workspace.ros.cell), with a current-pose topic and a state
+        self.axis_limits: cell.AxisLimitsPublisher | None = None
         self._recorder = recorder
         self._lock = threading.Lock()
         self._current: _CurrentPose | None = None
@@ -252,8 +287,9 @@ class PathServices:
             "",
             ParameterDescriptor(
                 description="geometry_msgs/PoseStamped topic of the platform's current pose "
-                "(base frame). When set, each commanded pose is validated as a move (slerp) "
-                "from the last pose received; empty = targets only.",
+                "(tool centre point; header.frame_id the base frame or work.frame_id). When set, "
+                "each commanded pose is validated as a move (slerp) from the last pose received "
+                "and ~/axis_limits follows it; empty = targets only.",
                 read_only=True,
             ),
         ).value
@@ -266,12 +302,18 @@ class PathServices:
             self._current_pose_topic = self.subscription.topic_name
             if recorder is not None:  # every pose a motion verdict may start from is in the log
                 recorder.add_channel(self._current_pose_topic, type_name(PoseStamped), REQUEST_QOS)
+            if get_state is not None:
+                self.axis_limits = cell.AxisLimitsPublisher(
+                    node, relative_name("axis_limits"), self.latest_current_pose
+                )
 
     # ------------------------------------------------------------------ check_path
     def _on_check_path(self, request: Any, response: Any) -> Any:
         self._record(self._request_topic, request)
         try:
-            fields = check_path_response_fields(self._get_manipulator(), request)
+            state = self._get_state() if self._get_state is not None else None
+            manipulator = state.manipulator if state is not None else self._get_manipulator()
+            fields = check_path_response_fields(manipulator, request, state)
         except Exception as error:  # keep serving; the reason goes back to the caller
             self._node.get_logger().error(f"check_path: internal error: {error!r}")
             fields = path_fields.failed_check_path_response_fields(f"internal error: {error}")
@@ -289,8 +331,27 @@ class PathServices:
         after the pose it started from."""
         self._record(self._current_pose_topic, message)
         positions, quaternions = pose_arrays([message.pose])
+        stamp = message.header.stamp
         with self._lock:
-            self._current = _CurrentPose(positions[0], quaternions[0], str(message.header.frame_id))
+            self._current = _CurrentPose(
+                positions[0],
+                quaternions[0],
+                str(message.header.frame_id),
+                stamp.sec * 1_000_000_000 + stamp.nanosec,
+            )
+        if self.axis_limits is not None:
+            self.axis_limits.pose_received()
+
+    def latest_current_pose(
+        self,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], str, int] | None:
+        """The last current pose as received: position (3,), quaternion (4,), its frame_id and
+        its stamp (ns); None before the first."""
+        with self._lock:
+            current = self._current
+        if current is None:
+            return None
+        return current.position, current.quaternion, current.frame_id, current.stamp_ns
 
     @property
     def current_pose(self) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
@@ -330,18 +391,31 @@ class PathServices:
         if current is None or not fields.get("success", False):
             return fields
         fields = dict(fields)
-        if current.frame_id and current.frame_id != manipulator.frame_id:
-            fields["message"] += (
-                f"; move not checked: the current pose is in frame {current.frame_id!r}, "
-                f"not {manipulator.frame_id!r}"
-            )
+        position_now, quaternion_now = current.position, current.quaternion
+        try:
+            if self._get_state is not None:
+                moved, turned = cell.poses_to_base(
+                    self._get_state(),
+                    current.frame_id,
+                    position_now[None, :],
+                    quaternion_now[None, :],
+                )
+                position_now, quaternion_now = moved[0], turned[0]
+            elif current.frame_id and current.frame_id != manipulator.frame_id:
+                msg = (
+                    f"the current pose is in frame {current.frame_id!r}, not "
+                    f"{manipulator.frame_id!r}"
+                )
+                raise InputError(msg)
+        except InputError as error:
+            fields["message"] += f"; move not checked: current pose: {error}"
             return fields
         try:
-            start = quaternion_to_matrix(current.quaternion[None, :])
+            start = quaternion_to_matrix(quaternion_now[None, :])
             target = tt_to_matrix(wrap_angle(np.asarray(angles, dtype=float).reshape(1, 3)))
             result = check_path(
                 manipulator,
-                np.vstack([current.position, np.asarray(position, dtype=float)]),
+                np.vstack([position_now, np.asarray(position, dtype=float)]),
                 rotations=np.concatenate([start, target]),
             )
         except InputError as error:
@@ -362,7 +436,7 @@ class PathServices:
         fields.update(
             motion_checked=True,
             motion_ok=result.ok,
-            current_pose=path_fields.pose_fields(current.position, current.quaternion),
+            current_pose=path_fields.pose_fields(position_now, quaternion_now),
             motion=path_fields.segment_check_fields(segments, 0),
             message=f"{fields['message']}; {clause}",
         )
@@ -370,8 +444,12 @@ class PathServices:
 
 
 def attach(
-    node: Any, get_manipulator: Callable[[], Manipulator], recorder: Any | None = None
+    node: Any,
+    get_manipulator: Callable[[], Manipulator],
+    recorder: Any | None = None,
+    get_state: Callable[[], State] | None = None,
 ) -> PathServices:
     """Create ``~/check_path``, the ``motion.current_pose_topic`` parameter and its
-    subscription on ``node``; see :class:`PathServices`."""
-    return PathServices(node, get_manipulator, recorder)
+    subscription (and, with ``get_state``, ``~/axis_limits``) on ``node``; see
+    :class:`PathServices`."""
+    return PathServices(node, get_manipulator, recorder, get_state)

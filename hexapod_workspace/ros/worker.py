@@ -89,6 +89,9 @@ class WorkspaceJob:
         Header frame and the request's id, copied into the results.
     result_points : int
         Most points of the returned cloud when the worker publishes the full one (0 = all).
+    frames : dict, optional
+        CellFrames fields of the node's tool and work frames when the job was made (copied
+        into the summary).
     """
 
     manipulator: Manipulator
@@ -101,6 +104,7 @@ class WorkspaceJob:
     frame_id: str
     request_id: str = ""
     result_points: int = 0
+    frames: dict[str, Any] | None = None
 
 
 def compute_fields(

@@ -32,6 +32,7 @@ from std_srvs.srv import Trigger
 from hexapod_workspace.core.resolution import WorkspaceKind
 from hexapod_workspace.errors import InputError, UnreachableReferenceError
 from hexapod_workspace.logs import messages, qos_profile_text
+from hexapod_workspace.logs.cell import cell_frames_fields
 
 from .clouds import RESULT_MAX_POINTS, CloudTopics
 from .conversions import position_from_point, to_message, type_name
@@ -142,6 +143,7 @@ class WorkspaceServer:
             frame_id=self._node.state.manipulator.frame_id,
             request_id=request.request_id,
             result_points=RESULT_MAX_POINTS,
+            frames=cell_frames_fields(self._node.state.cell),
         )
 
     def _submit(self, request: WorkspaceRequest, **callbacks: Any) -> Ticket | None:
@@ -156,6 +158,8 @@ class WorkspaceServer:
         """Job thread: the worker's fields -> published (and recorded) summary, and the
         action's bounded cloud (the worker published the full one)."""
         summary_fields, cloud_fields = fields
+        if job.frames is not None:
+            summary_fields = {**summary_fields, "frames": job.frames}
         cloud = to_message(PointCloud2, cloud_fields)
         summary = to_message(WorkspaceSummary, summary_fields)
         self._node.publish(self._summary_publisher, summary)
@@ -213,6 +217,10 @@ class WorkspaceServer:
             kind=kind,
             position=position,  # as requested: NaN stays NaN (replay shows it)
         )
+        if isinstance(origin, WorkspaceJob) and origin.frames is not None:
+            fields["frames"] = origin.frames
+        elif state is not None:
+            fields["frames"] = cell_frames_fields(state.cell)
         summary = to_message(WorkspaceSummary, fields)
         empty = messages.pointcloud_fields(np.zeros((0, 6)), frame_id=frame_id, stamp_ns=stamp_ns)
         cloud = to_message(PointCloud2, empty)

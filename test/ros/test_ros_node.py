@@ -297,13 +297,19 @@ def test_parameters_have_descriptors(client):
 
 def test_a_parameters_file_check_knows_every_parameter_of_the_node(client):
     """The CLI refuses unknown names in a parameters file, so it must know every name
-    the node declares (core.params.NODE_PARAMETERS + the model's + ROS's own), and no more."""
+    the node declares (core.params.NODE_PARAMETERS + the model's + the machining cell's + ROS's
+    own), and no more."""
     from hexapod_workspace.core.manipulator import PARAMETER_DEFAULTS
-    from hexapod_workspace.core.params import NODE_PARAMETERS, ROS_PARAMETERS, unknown_parameter
+    from hexapod_workspace.core.params import (
+        CELL_PARAMETERS,
+        NODE_PARAMETERS,
+        ROS_PARAMETERS,
+        unknown_parameter,
+    )
 
     listed = client.call(ListParameters, f"{NODE}/list_parameters", ListParameters.Request())
     names = set(listed.result.names)
-    known = (*PARAMETER_DEFAULTS, *NODE_PARAMETERS, *ROS_PARAMETERS)
+    known = (*PARAMETER_DEFAULTS, *NODE_PARAMETERS, *CELL_PARAMETERS, *ROS_PARAMETERS)
     assert unknown_parameter(names, known) is None
     assert set(NODE_PARAMETERS) <= names
 
