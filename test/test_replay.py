@@ -402,9 +402,7 @@ def test_publish_counts_only_what_went_out(tmp_path: Path, monkeypatch) -> None:
         for i in range(3):
             writer.write_fields("/mixed/cloud", "sensor_msgs/msg/PointCloud2", cloud, 10 + i)
         for i in range(2):
-            writer.write_fields(
-                "/mixed/status", "shape_msgs/msg/Plane", status, 20 + i
-            )
+            writer.write_fields("/mixed/status", "shape_msgs/msg/Plane", status, 20 + i)
     code, _, err = replay(path, publish=True, rate=0.0)
     assert code == 0, err
     assert (
