@@ -277,12 +277,28 @@ def _run_tutorial(app: Sphinx) -> None:
         sys.argv = argv
 
 
+def _run_scene(app: Sphinx) -> None:
+    """Run docs/scene_figure.py: the collision page's scene figure into _generated/scene/."""
+    out_dir = GENERATED / "scene"
+    out_dir.mkdir(parents=True, exist_ok=True)
+    script = DOCS / "scene_figure.py"
+    argv = sys.argv
+    try:
+        sys.argv = [str(script), str(out_dir)]
+        with (out_dir / "output.txt").open("w", encoding="utf-8") as handle:
+            with redirect_stdout(handle):
+                runpy.run_path(str(script), run_name="__main__")
+    finally:
+        sys.argv = argv
+
+
 def setup(app: Sphinx) -> dict[str, Any]:
     app.add_directive("hexapod-cli", CliDirective)
     app.add_directive("hexapod-interfaces", InterfacesDirective)
     app.add_directive("hexapod-parameters", ParametersDirective)
     app.add_directive("hexapod-interface-files", InterfaceFilesDirective)
     app.connect("builder-inited", _run_tutorial)
+    app.connect("builder-inited", _run_scene)
     app.connect("autodoc-process-docstring", _plain_docstring)
     app.connect("missing-reference", _resolve_own)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
