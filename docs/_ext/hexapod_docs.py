@@ -262,34 +262,32 @@ def _assigned_in_init(cls: type, attr: str) -> bool:
     return re.search(rf"self\.{re.escape(attr)}\s*[:=]", source) is not None
 
 
-def _run_tutorial(app: Sphinx) -> None:
-    """Run the tutorial script: figures and printed output into _generated/tutorial/."""
-    out_dir = GENERATED / "tutorial"
+def _run_script(script_name: str, folder: str) -> None:
+    """Run a docs script with its output folder as argument: its figures and its printed
+    output (``output.txt``) go to ``_generated/<folder>/``."""
+    out_dir = GENERATED / folder
     out_dir.mkdir(parents=True, exist_ok=True)
-    script = DOCS / "tutorial_two_positions.py"
-    printed = out_dir / "output.txt"
+    script = DOCS / script_name
     argv = sys.argv
     try:
         sys.argv = [str(script), str(out_dir)]
-        with printed.open("w", encoding="utf-8") as handle, redirect_stdout(handle):
+        with (
+            (out_dir / "output.txt").open("w", encoding="utf-8") as handle,
+            redirect_stdout(handle),
+        ):
             runpy.run_path(str(script), run_name="__main__")
     finally:
         sys.argv = argv
 
 
+def _run_tutorial(app: Sphinx) -> None:
+    """Run the tutorial script: figures and printed output into _generated/tutorial/."""
+    _run_script("tutorial_two_positions.py", "tutorial")
+
+
 def _run_scene(app: Sphinx) -> None:
     """Run docs/scene_figure.py: the collision page's scene figure into _generated/scene/."""
-    out_dir = GENERATED / "scene"
-    out_dir.mkdir(parents=True, exist_ok=True)
-    script = DOCS / "scene_figure.py"
-    argv = sys.argv
-    try:
-        sys.argv = [str(script), str(out_dir)]
-        with (out_dir / "output.txt").open("w", encoding="utf-8") as handle:
-            with redirect_stdout(handle):
-                runpy.run_path(str(script), run_name="__main__")
-    finally:
-        sys.argv = argv
+    _run_script("scene_figure.py", "scene")
 
 
 def setup(app: Sphinx) -> dict[str, Any]:
