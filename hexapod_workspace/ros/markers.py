@@ -76,8 +76,10 @@ class MarkerPublisher:
         self._node = node
         self.publisher = node.recorded_publisher(MarkerArray, relative_name("markers"), depth=1)
         self._stop = threading.Event()
-        self._published_key: tuple[Any, ...] | None = None
-        self._cone_key: tuple[Any, ...] | None = None
+        # what the last scene and the last cone were built from: the state object itself
+        # (held, so that its id is never reused) and the pose
+        self._published: tuple[Any, bytes, bytes] | None = None
+        self._cone_for: tuple[Any, bytes] | None = None
         self._cone: Cone | None = None
         #: scenes published (for the tests and the diagnostics)
         self.count = 0
@@ -114,16 +116,17 @@ class MarkerPublisher:
         node = self._node
         state = node.state
         if state is None or not getattr(node, "active", True):
-            self._published_key = None  # publish again on the next activation
+            self._published = None  # publish again on the next activation
             return False
         position, rotation = self._pose(state)
-        key = (id(state), position.tobytes(), rotation.tobytes())
-        if key == self._published_key:
+        pose = (position.tobytes(), rotation.tobytes())
+        last = self._published
+        if last is not None and last[0] is state and last[1:] == pose:
             return False
         scene = node_scene(state)
         manipulator = state.manipulator
-        cone_key = (id(state), position.tobytes())
-        if cone_key != self._cone_key:
+        cone_for = self._cone_for
+        if cone_for is None or cone_for[0] is not state or cone_for[1] != pose[0]:
             try:
                 workspace = projected_workspace(
                     manipulator,
@@ -135,7 +138,7 @@ class MarkerPublisher:
                 self._cone = cone_of(workspace, manipulator, scene)
             except HexapodWorkspaceError:  # unreachable reference, position out of bounds
                 self._cone = None
-            self._cone_key = cone_key
+            self._cone_for = (state, pose[0])
         view = scene_view(manipulator, rotation, position, scene, cone=self._cone)
         now = node.get_clock().now().to_msg()
         fields = marker_array_fields(
@@ -144,7 +147,7 @@ class MarkerPublisher:
             stamp={"sec": int(now.sec), "nanosec": int(now.nanosec)},
         )
         node.publish(self.publisher, to_message(MarkerArray, fields))
-        self._published_key = key
+        self._published = (state, *pose)
         self.count += 1
         return True
 

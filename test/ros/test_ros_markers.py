@@ -119,20 +119,16 @@ def test_markers_follow_the_current_pose(client, model, received):
     q = matrix_to_quaternion(rotation)
     o = stamped.pose.orientation
     o.x, o.y, o.z, o.w = (float(v) for v in q)
-    before = len(received)
     current.publish(stamped)
 
-    def moved() -> bool:
-        return (
-            len(received) > before
-            and np.allclose(centre_of(by_namespace(received[-1])["tool_directions"][0]), 0.0)
-            and np.allclose(
-                [received[-1].markers[-1].points[0].x, received[-1].markers[-1].points[0].y],
-                position[:2],
-            )
-        )
+    def tool_start(array: MarkerArray) -> np.ndarray:
+        (tool,) = by_namespace(array)["tool"]
+        return np.array([tool.points[0].x, tool.points[0].y, tool.points[0].z])
 
-    client.spin_until(moved, what="markers at the current pose")
+    client.spin_until(
+        lambda: bool(received) and np.allclose(tool_start(received[-1]), position, atol=1e-12),
+        what="markers at the current pose",
+    )
     assert_scene(received[-1], model, position, rotation)
 
 
@@ -148,3 +144,57 @@ def test_markers_are_recorded_and_read_by_every_reader(client, workspace_node, r
     foxglove = read_with_foxglove(log, tmp_path)[MARKERS]
     assert foxglove["schema"] == "visualization_msgs/msg/MarkerArray"
     assert foxglove["messages"] == [foxglove_form(m) for m in sent]
+
+
+def test_obstacles_appear_once_the_state_carries_a_collision_scene(ros_context, ros_client):
+    """The seam for the node's collision.* model (ros.markers.node_scene reads the state's
+    ``collision_scene``): a node in this process whose state carries a scene draws its
+    obstacles and colours the pair in violation."""
+    import dataclasses
+
+    from rclpy.parameter import Parameter
+
+    from hexapod_workspace.core.collision import CollisionScene, collision_scene
+    from hexapod_workspace.ros.markers import attach
+    from hexapod_workspace.ros.node import WorkspaceNode
+    from hexapod_workspace.ros.parameters import State
+
+    @dataclasses.dataclass(frozen=True)
+    class StateWithScene(State):
+        collision_scene: CollisionScene | None = None
+
+    node = WorkspaceNode(
+        context=ros_context,
+        namespace="/inproc",
+        parameter_overrides=[Parameter("recording.enabled", value=False)],
+        extensions=[attach],
+    )
+    try:
+        received = ros_client.collect(
+            MarkerArray, "/inproc/hexapod_workspace/markers", transient_local=True
+        )
+        leg = leg_endpoints(node.state.manipulator, np.eye(3), node.state.manipulator.position)
+        middle = 0.5 * (leg[0][0, 2] + leg[1][0, 2])  # leg 3 at the model's pose
+        scene = collision_scene(
+            {
+                "collision.obstacles.names": ["clamp"],
+                "collision.obstacles.clamp.shape": "sphere",
+                "collision.obstacles.clamp.position": middle.tolist(),
+                "collision.obstacles.clamp.radius": 0.05,
+            }
+        )
+        node.state = StateWithScene(node.state.manipulator, node.state.settings, scene)
+
+        def drawn() -> bool:
+            return bool(received) and "obstacles" in by_namespace(received[-1])
+
+        ros_client.spin_until(drawn, what="the obstacles on ~/markers")
+        spaces = by_namespace(received[-1])
+        (clamp,) = spaces["obstacles"]
+        assert clamp.type == Marker.SPHERE
+        np.testing.assert_allclose(centre_of(clamp), middle, atol=1e-12)
+        assert spaces["closest_pair"][1].text.startswith("VIOLATED leg 3 vs clamp: -")
+        legs = {m.id: m for m in spaces["legs"]}
+        assert legs[3].color.r > 0.8 and legs[3].color.g < 0.2  # red: the pair in violation
+    finally:
+        node.destroy_node()
