@@ -119,7 +119,7 @@ def test_the_pair_in_violation_and_every_obstacle_are_drawn():
     assert rgba(line) == m.VIOLATED and text.text.startswith("VIOLATED leg 1 vs ball: -")
     (platform,) = by_ns["platform"]
     assert platform.type == m.CYLINDER
-    np.testing.assert_allclose(centre_of(platform), HOME + [0.0, 0.0, 0.11], atol=1e-12)
+    np.testing.assert_allclose(centre_of(platform), HOME + np.array([0.0, 0.0, 0.11]), atol=1e-12)
     tool = by_ns["tool"]
     assert [x.type for x in tool] == [m.CYLINDER, m.SPHERE, m.SPHERE]
     (cone_marker,) = by_ns["tool_directions"]
