@@ -1,6 +1,8 @@
 """The figure of docs/collision.md, "Seeing the scene": the example machine with the page's
-collision scene (platform, tool, a vise and a column) at a tilted pose, drawn by the CLI's scene
-plot. Run by the docs build (``docs/_ext/hexapod_docs.py``) with the output folder as argument.
+collision scene (platform, tool, a vise and a column), the vise raised so that the tool, tilted
+15° at 1.45 m below the base, touches it within the clearance: the pair in violation is drawn in
+red. Drawn by the CLI's scene plot; run by the docs build (``docs/_ext/hexapod_docs.py``) with
+the output folder as argument.
 """
 
 from __future__ import annotations
@@ -16,7 +18,8 @@ from hexapod_workspace.cli.scene import view_at
 from hexapod_workspace.cli.scene_plot import plot_scene
 from hexapod_workspace.core.collision import collision_scene
 
-#: The scene of the page's YAML example (collision.* as the parameters file gives them).
+#: The scene of the page's YAML example (collision.* as the parameters file gives them), with
+#: the vise's top at z = -1.49 m instead of -1.70 m.
 SCENE = {
     "collision.clearance": 0.005,
     "collision.platform.radius": 0.33,
@@ -26,7 +29,7 @@ SCENE = {
     "collision.tool.length": 0.25,
     "collision.obstacles.names": ["vise", "column"],
     "collision.obstacles.vise.shape": "box",
-    "collision.obstacles.vise.position": [0.0, 0.0, -1.75],
+    "collision.obstacles.vise.position": [0.0, 0.0, -1.54],
     "collision.obstacles.vise.size": [0.3, 0.2, 0.1],
     "collision.obstacles.column.shape": "cylinder",
     "collision.obstacles.column.position": [0.75, 0.0, -0.8],
@@ -38,7 +41,7 @@ SCENE = {
 def main(out_dir: Path) -> None:
     manipulator = Manipulator.from_params_file(example_config_path())
     scene = collision_scene(SCENE, manipulator=manipulator)
-    view = view_at(manipulator, np.radians([0.0, 25.0, 0.0]), [0.1, 0.0, -1.45], scene)
+    view = view_at(manipulator, np.radians([0.0, 15.0, 0.0]), [0.05, 0.0, -1.45], scene)
     path = plot_scene(view, out_dir / "scene.png")
     pair = view.closest
     assert pair is not None

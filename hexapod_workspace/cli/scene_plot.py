@@ -204,15 +204,21 @@ def draw_scene(axes: Axes3D, view: SceneView, *, title: str | None = None) -> No
         axes.scatter(*np.transpose(pair.points), color=colour, s=16)
     for body in view.bodies:
         if not body.moving:
-            top = body.centre + np.array(
-                [0.0, 0.0, 0.5 * max(body.size[2], body.length, 2 * body.radius)]
+            # beside the body (+x, towards the viewer's right), where the machine seldom is
+            side = max(0.5 * float(np.linalg.norm(body.size[:2])), body.radius) + 0.06
+            axes.text(
+                *(body.centre + np.array([side, 0.0, 0.0])),
+                body.name,
+                fontsize=8,
+                color="0.15",
+                ha="left",
+                va="center",
             )
-            axes.text(*top, f" {body.name}", fontsize=8, color="0.15")
     low, high = _extent(view)
     axes.set_xlim(low[0], high[0])
     axes.set_ylim(low[1], high[1])
     axes.set_zlim(low[2], high[2])
-    axes.set_box_aspect(tuple(high - low))  # one scale on the three axes
+    axes.set_box_aspect(tuple(high - low), zoom=1.15)  # one scale on the three axes
     axes.view_init(elev=12.0, azim=-58.0)
     from matplotlib.ticker import MaxNLocator
 
@@ -228,7 +234,7 @@ def scene_figure(view: SceneView, *, title: str | None = None) -> Any:
     """A :class:`matplotlib.figure.Figure` with the scene and a legend, not saved."""
     from matplotlib.figure import Figure
 
-    figure = Figure(figsize=(7.5, 7.5), layout="constrained")
+    figure = Figure(figsize=(8.0, 6.8), layout="constrained")
     axes = cast("Axes3D", figure.add_subplot(projection="3d"))
     draw_scene(axes, view, title=title)
     add_legend(axes, view)

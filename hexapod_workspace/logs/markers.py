@@ -69,9 +69,7 @@ def _point(p: NDArray[np.float64]) -> dict[str, float]:
     return {"x": float(p[0]), "y": float(p[1]), "z": float(p[2])}
 
 
-def _pose(centre: NDArray[np.float64], rotation: NDArray[np.float64]) -> dict[str, Any]:
-    x, y, z, w = (float(v) for v in matrix_to_quaternion(rotation))
-    return {"position": _point(centre), "orientation": {"x": x, "y": y, "z": z, "w": w}}
+_IDENTITY = {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}
 
 
 def _colour(rgba: tuple[float, float, float, float]) -> dict[str, float]:
@@ -81,10 +79,13 @@ def _colour(rgba: tuple[float, float, float, float]) -> dict[str, float]:
 class _Builder:
     def __init__(self, frame_id: str, stamp: dict[str, int]) -> None:
         self.header = {"stamp": stamp, "frame_id": frame_id}
+        origin = {"position": _point(np.zeros(3)), "orientation": dict(_IDENTITY)}
         self.markers: list[dict[str, Any]] = [
-            {"header": self.header, "action": DELETEALL, "pose": _pose(np.zeros(3), np.eye(3))}
+            {"header": self.header, "action": DELETEALL, "pose": origin}
         ]
         self._ids: dict[str, int] = {}
+        # markers whose orientation is a rotation: converted to quaternions in one call
+        self._rotated: list[tuple[dict[str, Any], NDArray[np.float64]]] = []
 
     def add(
         self,
@@ -102,6 +103,12 @@ class _Builder:
         if marker_id is None:
             marker_id = self._ids.get(namespace, 0)
         self._ids[namespace] = marker_id + 1
+        pose = {
+            "position": _point(np.zeros(3) if centre is None else centre),
+            "orientation": dict(_IDENTITY),
+        }
+        if rotation is not None:
+            self._rotated.append((pose, rotation))
         self.markers.append(
             {
                 "header": self.header,
@@ -109,16 +116,21 @@ class _Builder:
                 "id": marker_id,
                 "type": kind,
                 "action": ADD,
-                "pose": _pose(
-                    np.zeros(3) if centre is None else centre,
-                    np.eye(3) if rotation is None else rotation,
-                ),
+                "pose": pose,
                 "scale": dict(zip("xyz", (float(s) for s in scale), strict=True)),
                 "color": _colour(colour),
                 "points": [] if points is None else [_point(p) for p in points],
                 "text": text,
             }
         )
+
+    def finish(self) -> list[dict[str, Any]]:
+        """The markers, with the orientations of the rotated ones filled in."""
+        if self._rotated:
+            quaternions = matrix_to_quaternion(np.array([r for _, r in self._rotated]))
+            for (pose, _), q in zip(self._rotated, quaternions.tolist(), strict=True):
+                pose["orientation"] = dict(zip("xyzw", q, strict=True))
+        return self.markers
 
 
 def _solid(builder: _Builder, namespace: str, body: Body, colour: Any) -> None:
@@ -257,4 +269,4 @@ def marker_array_fields(
         builder.add(
             "tool_directions", TRIANGLE_LIST, CONE, points=view.cone.triangles().reshape(-1, 3)
         )
-    return {"markers": builder.markers}
+    return {"markers": builder.finish()}
