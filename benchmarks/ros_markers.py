@@ -10,6 +10,10 @@ Phases alternate, so both see the same machine load. Prints p50/p95/p99 of each 
 (ms), their ratio, the scenes received, and the load average.
 
     tools/with_ros_env.sh python benchmarks/ros_markers.py [--phase-seconds 4] [--rounds 3]
+
+With ``--node-source DIR`` the node runs from another source tree (a ``git archive`` of the
+commit before ``~/markers``): the same phases against a node without markers, for a same-machine
+before/after.
 """
 
 from __future__ import annotations
@@ -41,6 +45,13 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--phase-seconds", type=float, default=4.0, help="length of a phase, s")
     parser.add_argument("--rounds", type=int, default=3, help="still + moving pairs")
+    parser.add_argument(
+        "--node-source",
+        type=Path,
+        metavar="DIR",
+        help="run the node from this source tree instead of the install space (e.g. a "
+        "`git archive` of the commit before ~/markers, for a same-machine before/after)",
+    )
     args = parser.parse_args(argv)
     if not NODE_EXECUTABLE.is_file():
         print(f"{NODE_EXECUTABLE} missing: run `make ros` first", file=sys.stderr)
@@ -50,10 +61,19 @@ def main(argv: list[str] | None = None) -> int:
     with domain_coordinator.domain_id() as domain, tempfile.TemporaryDirectory() as tmp:
         os.environ["ROS_DOMAIN_ID"] = str(domain)
         os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+        env = dict(os.environ)
+        command = [str(NODE_EXECUTABLE)]
+        if args.node_source is not None:
+            env["PYTHONPATH"] = f"{args.node_source.resolve()}:{env.get('PYTHONPATH', '')}"
+            command = [
+                sys.executable,
+                "-c",
+                "import sys; from hexapod_workspace.ros import main; sys.exit(main(sys.argv))",
+            ]
         with (Path(tmp) / "node.log").open("wb") as out:
             node = subprocess.Popen(
                 [
-                    str(NODE_EXECUTABLE),
+                    *command,
                     "--ros-args",
                     "--params-file",
                     str(REPO / "config" / "example_gpm.yaml"),
@@ -64,7 +84,7 @@ def main(argv: list[str] | None = None) -> int:
                 ],
                 stdout=out,
                 stderr=subprocess.STDOUT,
-                env=dict(os.environ),
+                env=env,
             )
         try:
             return run(args, domain)
@@ -121,8 +141,8 @@ def run(args: argparse.Namespace, domain: int) -> int:
 
     streamer = threading.Thread(target=stream, name="poses", daemon=True)
     try:
-        if not checks.wait_for_service(timeout_sec=60):
-            print("check_poses not discovered within 60 s", file=sys.stderr)
+        if not checks.wait_for_service(timeout_sec=120):  # a fresh source tree compiles first
+            print("check_poses not discovered within 120 s", file=sys.stderr)
             return 2
         streamer.start()
         request = CheckPoses.Request()

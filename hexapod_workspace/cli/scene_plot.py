@@ -139,11 +139,13 @@ def _draw_body(axes: Axes3D, body: Body, colour: str, alpha: float) -> None:
 def _extent(view: SceneView) -> NDArray[np.float64]:
     """Corners of a box holding every body (m), shape (2, 3)."""
     points = [view.position[None]]
+    corners = np.array([[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]])
     for body in view.bodies:
+        if body.points.size:  # segments and polygons: their points, widened by the radius
+            points += [body.points + body.radius * c for c in corners]
+            continue
         reach = max(body.radius, 0.5 * float(np.linalg.norm(body.size)), 0.5 * body.length)
-        points.append(body.centre[None] + reach * np.array([[-1, -1, -1], [1, 1, 1]]))
-        if body.points.size:
-            points.append(body.points)
+        points.append(body.centre[None] + reach * corners)
     return np.array([np.min(np.vstack(points), axis=0), np.max(np.vstack(points), axis=0)])
 
 
@@ -188,6 +190,8 @@ def draw_scene(axes: Axes3D, view: SceneView, *, title: str | None = None) -> No
     # The base: the polygon of the legs' base ends (where they are at this pose).
     base = np.array([view.body(f"leg {k}").points[0] for k in range(1, 7)])
     axes.plot(*np.transpose(np.vstack([base, base[:1]])), color="0.3", linewidth=1.0)
+    for k, end in enumerate(base, start=1):  # leg numbers, as the reports name them
+        axes.text(*end, f" {k}", fontsize=9, color="0.1", va="bottom")
     if view.cone is not None:
         axes.add_collection3d(
             Poly3DCollection(
@@ -237,11 +241,11 @@ def scene_figure(view: SceneView, *, title: str | None = None) -> Any:
     figure = Figure(figsize=(8.0, 6.8), layout="constrained")
     axes = cast("Axes3D", figure.add_subplot(projection="3d"))
     draw_scene(axes, view, title=title)
-    add_legend(axes, view)
+    add_legend(figure, view)
     return figure
 
 
-def add_legend(axes: Any, view: SceneView) -> None:
+def add_legend(figure: Any, view: SceneView) -> None:
     """The colour key of :func:`draw_scene` (only what is drawn)."""
     from matplotlib.lines import Line2D
 
@@ -254,7 +258,13 @@ def add_legend(axes: Any, view: SceneView) -> None:
     if view.cone is not None:
         entries.append((CONE, f"tool directions ({view.cone.method})"))
     handles = [Line2D([], [], color=c, linewidth=6) for c, _ in entries]
-    axes.legend(handles, [label for _, label in entries], loc="upper left", fontsize=8)
+    figure.legend(  # below the axes, so it hides no leg label
+        handles,
+        [label for _, label in entries],
+        loc="outside lower center",
+        ncols=min(len(entries), 3),
+        fontsize=8,
+    )
 
 
 def plot_scene(view: SceneView, path: str | Path, *, title: str | None = None) -> Path:
