@@ -85,6 +85,9 @@ def main(argv: list[str] | None = None) -> int:
                 stdout=out,
                 stderr=subprocess.STDOUT,
                 env=env,
+                # not the repository: `python -c` puts the working directory first on sys.path,
+                # before PYTHONPATH, so --node-source would run this tree's package instead
+                cwd=tmp,
             )
         try:
             return run(args, domain)
