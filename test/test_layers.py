@@ -37,6 +37,7 @@ THIRD_PARTY = {
         "geometry_msgs",
         "sensor_msgs",
         "diagnostic_msgs",
+        "visualization_msgs",
         "action_msgs",
         "rcl_interfaces",
         "nav_msgs",

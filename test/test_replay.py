@@ -392,23 +392,21 @@ def test_publish_counts_only_what_went_out(tmp_path: Path, monkeypatch) -> None:
     import importlib
 
     with pytest.raises(ImportError):
-        importlib.import_module("visualization_msgs.msg")  # in rosbags' Jazzy store, not here
+        importlib.import_module("shape_msgs.msg")  # in rosbags' Jazzy store, not here
     monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
     assert os.environ.get("ROS_DOMAIN_ID"), "tests that start rclpy need a test ROS_DOMAIN_ID"
     path = tmp_path / "mixed.mcap"
     cloud = messages.pointcloud_fields(np.zeros((3, 6)), frame_id="base", stamp_ns=1)
-    status = {"u": 0.5, "v": 0.25}
+    status = {"coef": [0.0, 0.0, 1.0, 0.5]}
     with logs.LogWriter(path) as writer:
         for i in range(3):
             writer.write_fields("/mixed/cloud", "sensor_msgs/msg/PointCloud2", cloud, 10 + i)
         for i in range(2):
-            writer.write_fields(
-                "/mixed/status", "visualization_msgs/msg/UVCoordinate", status, 20 + i
-            )
+            writer.write_fields("/mixed/status", "shape_msgs/msg/Plane", status, 20 + i)
     code, _, err = replay(path, publish=True, rate=0.0)
     assert code == 0, err
     assert (
-        "note: /mixed/status: type visualization_msgs/msg/UVCoordinate is not available in this "
+        "note: /mixed/status: type shape_msgs/msg/Plane is not available in this "
         "ROS environment; its 2 message(s) are not republished" in err
     )
     assert err.splitlines()[-1] == (

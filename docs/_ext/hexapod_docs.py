@@ -264,19 +264,32 @@ def _assigned_in_init(cls: type, attr: str) -> bool:
     return re.search(rf"self\.{re.escape(attr)}\s*[:=]", source) is not None
 
 
-def _run_tutorial(app: Sphinx) -> None:
-    """Run the tutorial script: figures and printed output into _generated/tutorial/."""
-    out_dir = GENERATED / "tutorial"
+def _run_script(script_name: str, folder: str) -> None:
+    """Run a docs script with its output folder as argument: its figures and its printed
+    output (``output.txt``) go to ``_generated/<folder>/``."""
+    out_dir = GENERATED / folder
     out_dir.mkdir(parents=True, exist_ok=True)
-    script = DOCS / "tutorial_two_positions.py"
-    printed = out_dir / "output.txt"
+    script = DOCS / script_name
     argv = sys.argv
     try:
         sys.argv = [str(script), str(out_dir)]
-        with printed.open("w", encoding="utf-8") as handle, redirect_stdout(handle):
+        with (
+            (out_dir / "output.txt").open("w", encoding="utf-8") as handle,
+            redirect_stdout(handle),
+        ):
             runpy.run_path(str(script), run_name="__main__")
     finally:
         sys.argv = argv
+
+
+def _run_tutorial(app: Sphinx) -> None:
+    """Run the tutorial script: figures and printed output into _generated/tutorial/."""
+    _run_script("tutorial_two_positions.py", "tutorial")
+
+
+def _run_scene(app: Sphinx) -> None:
+    """Run docs/scene_figure.py: the collision page's scene figure into _generated/scene/."""
+    _run_script("scene_figure.py", "scene")
 
 
 def setup(app: Sphinx) -> dict[str, Any]:
@@ -285,6 +298,7 @@ def setup(app: Sphinx) -> dict[str, Any]:
     app.add_directive("hexapod-parameters", ParametersDirective)
     app.add_directive("hexapod-interface-files", InterfaceFilesDirective)
     app.connect("builder-inited", _run_tutorial)
+    app.connect("builder-inited", _run_scene)
     app.connect("autodoc-process-docstring", _plain_docstring)
     app.connect("missing-reference", _resolve_own)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}

@@ -574,14 +574,22 @@ def cmd_check_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> i
             record, result, request, pairs=manipulator.leg_diameter > 0.0, baseline=baseline
         )
         err.write(f"{PROG}: recorded the path check to {written}\n")
+    scene_plot = None
     if plot is not None:
         plot_path(result, baseline, manipulator, plot)
+        from .scene import plot_first_violation  # the machine at the first violation
+
+        scene_plot = plot_first_violation(
+            result, manipulator, options.config, plot, force=options.force
+        )
     if options.json:
         write_json(document, out)
     else:
         _text(result, document, out)
         if plot is not None:
             out.write(f"  plot: {plot}\n")
+        if scene_plot is not None:
+            out.write(f"  scene at the first violation: {scene_plot}\n")
     if document["ok"]:
         return 0
     err.write(f"{PROG}: {_where(document, result)}\n")
@@ -642,7 +650,10 @@ def check_path_arguments(sub: argparse.ArgumentParser) -> None:
         f"{math.degrees(DEFAULT_PATH_TOLERANCE):g})",
     )
     sub.add_argument(
-        "--plot", metavar="FILE.png", help="margins along the path and tool directions"
+        "--plot",
+        metavar="FILE.png",
+        help="margins along the path and tool directions; a path that does not run also gets "
+        "FILE-scene.png, the machine at its first violation with the closest pair",
     )
     sub.add_argument("--record", metavar="FILE", help="also write the check to an MCAP log")
     sub.add_argument(

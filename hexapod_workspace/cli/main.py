@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from .. import __version__
 from ..core import kernels, resolution
 from ..errors import HexapodWorkspaceError
-from . import atlas, cam, check_path, commands, reach
+from . import atlas, cam, check_path, commands, reach, scene
 from .inputs import (
     PLOT_FORMATS,
     CliError,
@@ -430,6 +430,13 @@ for _command in (
         atlas.atlas_arguments,
         atlas.cmd_atlas,
         uses=("config", "json"),
+    ),
+    Command(
+        "scene",
+        scene.SCENE_HELP,
+        scene.SCENE_DESCRIPTION,
+        scene.scene_arguments,
+        scene.cmd_scene,
     ),
     Command(
         "reach",

@@ -197,6 +197,16 @@ INTERFACES: tuple[Interface, ...] = (
         depth=1,
     ),
     Interface(
+        "markers",
+        "publisher",
+        "visualization_msgs/msg/MarkerArray",
+        "the scene at the current pose: legs, platform, tool, obstacles, the closest pair "
+        "coloured, the cone of attainable tool directions (RViz, Foxglove)",
+        extension="hexapod_workspace.ros.markers",
+        durability="transient_local",
+        depth=1,
+    ),
+    Interface(
         "/diagnostics",
         "publisher",
         "diagnostic_msgs/msg/DiagnosticArray",

@@ -132,8 +132,15 @@ def _attach_atlas(node: WorkspaceNode) -> object:
     )
 
 
+def _attach_markers(node: WorkspaceNode) -> object:
+    """``~/markers`` (hexapod_workspace.ros.markers: the scene for RViz and Foxglove)."""
+    from .markers import attach
+
+    return attach(node)
+
+
 #: Functions ``attach(node)`` run by :func:`main` after the node is built (one per extension).
-EXTENSIONS: list[Callable[[WorkspaceNode], object]] = [_attach_atlas]
+EXTENSIONS: list[Callable[[WorkspaceNode], object]] = [_attach_atlas, _attach_markers]
 #: The commanded-pose subscription: nothing is dropped on the node's side.
 COMMAND_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_ALL, depth=1, reliability=ReliabilityPolicy.RELIABLE
@@ -552,6 +559,9 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         garbage collector, which may run after the context is shut down: a segfault was seen
         in the test process)."""
         self.stop_worker()
+        markers = getattr(self, "markers", None)  # the ~/markers thread (ros/markers.py)
+        if markers is not None:
+            markers.close()
         path = self.recorder.status().path
         self.recorder.shutdown()
         self.get_logger().info(

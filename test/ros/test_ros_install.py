@@ -155,6 +155,12 @@ def test_rviz_layout_shows_the_node_clouds(node_topics):
         assert display["Topic"]["Durability Policy"] == "Transient Local"
         assert display["Channel Name"] in {"phi", "theta", "psi"}
     assert layout["Visualization Manager"]["Global Options"]["Fixed Frame"] == "base"
+    (scene,) = [d for d in displays if d["Class"] == "rviz_default_plugins/MarkerArray"]
+    assert node_topics[scene["Topic"]["Value"]] == ["visualization_msgs/msg/MarkerArray"]
+    assert scene["Topic"]["Durability Policy"] == "Transient Local"
+    from hexapod_workspace.logs.markers import NAMESPACES
+
+    assert set(scene["Namespaces"]) == set(NAMESPACES)
 
 
 def test_node_offers_every_interface_of_the_issue(node_topics):
