@@ -183,7 +183,10 @@ def test_obstacles_appear_once_the_state_carries_a_collision_scene(ros_context, 
                 "collision.obstacles.clamp.radius": 0.05,
             }
         )
-        node.state = StateWithScene(node.state.manipulator, node.state.settings, scene)
+        fields = {
+            field.name: getattr(node.state, field.name) for field in dataclasses.fields(State)
+        }
+        node.state = StateWithScene(**fields, collision_scene=scene)
 
         def drawn() -> bool:
             return bool(received) and "obstacles" in by_namespace(received[-1])
