@@ -231,6 +231,15 @@ def parameter_specs() -> dict[str, Spec]:
             float_range=(0.0, 1e9),
         ),
         Spec(
+            "recording.cloud_points",
+            20_000,
+            "Most points of each boundary cloud written to the log: evenly spaced along the "
+            "cloud (first and last kept), as in the action's result; the cloud topic always "
+            "gets the full cloud. 0 = the full cloud in the log too (a 274k-point 3-D boundary "
+            "is 6.6 MB a goal, written by the node's process: see the latency figures).",
+            int_range=(0, 100_000_000),
+        ),
+        Spec(
             "recording.directory",
             "",
             "Folder of the MCAP logs (one per run, named by start time); empty = "
@@ -255,6 +264,8 @@ class Settings:
     recording_enabled: bool
     recording_directory: Path
     recording_rotation: Rotation
+    #: most points of a boundary cloud in the log (0 = all)
+    recording_cloud_points: int = 20_000
 
 
 @dataclass(frozen=True)
@@ -364,6 +375,7 @@ def state_from(values: dict[str, Any]) -> State:
             max_file_seconds=float(values["recording.max_file_duration"]),
             max_total_bytes=int(float(values["recording.max_total_mb"]) * 1e6),
         ),
+        recording_cloud_points=int(values["recording.cloud_points"]),
     )
     return State(manipulator, settings)
 

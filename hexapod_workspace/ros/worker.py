@@ -89,6 +89,11 @@ class WorkspaceJob:
         Header frame and the request's id, copied into the results.
     result_points : int
         Most points of the returned cloud when the worker publishes the full one (0 = all).
+    record : bool
+        Hand the published cloud's CDR bytes back for the node's log (False: the node does
+        not record, nothing crosses the pipe).
+    record_points : int
+        Most points of the cloud handed back for the log (0 = the full cloud as published).
     """
 
     manipulator: Manipulator
@@ -101,6 +106,8 @@ class WorkspaceJob:
     frame_id: str
     request_id: str = ""
     result_points: int = 0
+    record: bool = True
+    record_points: int = 0
 
 
 def compute_fields(
@@ -164,11 +171,11 @@ def _reporter(connection: Connection, cancel: Any) -> Callable[[float], None]:
 
 def _published(
     publisher: Any, job: WorkspaceJob, fields: tuple[dict[str, Any], dict[str, Any]]
-) -> tuple[tuple[dict[str, Any], dict[str, Any]], PublishedCloud]:
+) -> tuple[tuple[dict[str, Any], dict[str, Any]], PublishedCloud | None]:
     """Publish the full cloud of ``fields``; return the fields with the cloud bounded to
-    ``job.result_points`` and what was published."""
+    ``job.result_points`` and what the node records (None when ``job.record`` is False)."""
     summary, cloud = fields
-    published = publisher.publish(job.kind, cloud)
+    published = publisher.publish(job.kind, cloud, job.record_points if job.record else None)
     return (summary, decimated_cloud_fields(cloud, job.result_points)), published
 
 
@@ -210,7 +217,8 @@ def _serve(connection: Connection, cancel: Any, topics: CloudTopics | None = Non
             fields = compute_fields(job, _reporter(connection, cancel))
             if publisher is not None:
                 fields, published = _published(publisher, job, fields)
-                connection.send(("published", published))
+                if published is not None:
+                    connection.send(("published", published))
             reply: tuple[str, Any] = ("ok", fields)
         except CanceledError:
             reply = ("canceled", None)

@@ -142,6 +142,8 @@ class WorkspaceServer:
             frame_id=self._node.state.manipulator.frame_id,
             request_id=request.request_id,
             result_points=RESULT_MAX_POINTS,
+            record=settings.recording_enabled,
+            record_points=settings.recording_cloud_points,
         )
 
     def _submit(self, request: WorkspaceRequest, **callbacks: Any) -> Ticket | None:
