@@ -544,6 +544,7 @@ def main(args: list[str] | None = None) -> int:
             override_names=command_line_override_names(args, NODE_NAME),
             autostart=autostart,
         )
+        node.exit_when_finalized = True  # the shutdown transition ends the process
         executor = SingleThreadedExecutor()
         executor.add_node(node)
         executor.spin()
