@@ -48,17 +48,15 @@ NODE = "/hexapod_workspace"
 FLOOR = "/latency_floor/check_poses"
 
 
-def floor_server_source(service: str, node_name: str) -> str:
-    """The reference measured in the same run: the cheapest rclpy server of the same service
-    type (single-threaded executor, constant answer, no check), run as ``python -c SOURCE``."""
+def _server_source(node_name: str, setup: str) -> str:
+    """``python -c`` source of an rclpy node ``node_name`` spun by a single-threaded executor
+    until SIGINT; ``setup`` (source text) creates its service on ``node``."""
     return f"""
 import rclpy
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
-from hexapod_workspace_msgs.srv import CheckPoses
 rclpy.init()
 node = rclpy.create_node("{node_name}")
-node.create_service(CheckPoses, "{service}", lambda request, response: CheckPoses.Response(
-    success=True, message="1/1 reachable"))
+{setup}
 executor = SingleThreadedExecutor()
 executor.add_node(node)
 try:
@@ -71,7 +69,46 @@ finally:
 """
 
 
+def floor_server_source(service: str, node_name: str) -> str:
+    """The reference measured in the same run: the cheapest rclpy server of the same service
+    type (single-threaded executor, constant answer, no check), run as ``python -c SOURCE``."""
+    return _server_source(
+        node_name,
+        f"""
+from hexapod_workspace_msgs.srv import CheckPoses
+node.create_service(CheckPoses, "{service}", lambda request, response: CheckPoses.Response(
+    success=True, message="1/1 reachable"))
+""",
+    )
+
+
 FLOOR_SERVER = floor_server_source(FLOOR, "latency_floor")
+FLAT_FLOOR = "/latency_floor/check_poses_flat"
+
+
+def flat_floor_server_source(service: str, node_name: str, poses: int = 1000) -> str:
+    """The floor of the flat form: the cheapest rclpy server of CheckPosesFlat answering every
+    request with the same prebuilt answer of ``poses`` poses (every array as large as the
+    node's, no check), run as ``python -c SOURCE``: what moving those bytes through rclpy and
+    DDS costs."""
+    return _server_source(
+        node_name,
+        f"""
+import array
+from hexapod_workspace.core.constraints import CONSTRAINT_NAMES
+from hexapod_workspace_msgs.srv import CheckPosesFlat
+count, names = {poses}, list(CONSTRAINT_NAMES)
+answer = CheckPosesFlat.Response(success=True, message=f"{{count}}/{{count}} reachable")
+answer.constraint_names = names
+answer.margins = array.array("d", [0.5]) * (count * len(names))
+answer.reachable = [True] * count
+answer.limiting_leg = array.array("i", [0]) * count
+node.create_service(CheckPosesFlat, "{service}", lambda request, response: answer)
+""",
+    )
+
+
+FLAT_FLOOR_SERVER = flat_floor_server_source(FLAT_FLOOR, "latency_flat_floor")
 
 
 def check_requests(count: int = 1000, seed: int = 1) -> tuple[Any, Any, np.ndarray]:
@@ -142,14 +179,27 @@ def main(argv: list[str] | None = None) -> int:
         help="extra --ros-args argument of the node, e.g. --node-arg=-p "
         "--node-arg=recording.enabled:=false",
     )
+    parser.add_argument(
+        "--domain-id",
+        type=int,
+        metavar="ID",
+        help="DDS domain of the run (default: a free one, picked by domain_coordinator)",
+    )
     args = parser.parse_args(argv)
     if not NODE_EXECUTABLE.is_file():
         print(f"{NODE_EXECUTABLE} missing: run `make ros` first", file=sys.stderr)
         return 2
 
+    import contextlib
+
     import domain_coordinator
 
-    with domain_coordinator.domain_id() as domain, tempfile.TemporaryDirectory() as tmp:
+    chosen = (
+        contextlib.nullcontext(args.domain_id)
+        if args.domain_id is not None
+        else domain_coordinator.domain_id()
+    )
+    with chosen as domain, tempfile.TemporaryDirectory() as tmp:
         os.environ["ROS_DOMAIN_ID"] = str(domain)
         os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
         log = Path(tmp) / "node.log"
@@ -168,16 +218,19 @@ def main(argv: list[str] | None = None) -> int:
                 stderr=subprocess.STDOUT,
                 env=dict(os.environ),
             )
-            floor = subprocess.Popen(
-                [sys.executable, "-c", FLOOR_SERVER],
-                stdout=out,
-                stderr=subprocess.STDOUT,
-                env=dict(os.environ),
-            )
+            floors = [
+                subprocess.Popen(
+                    [sys.executable, "-c", source],
+                    stdout=out,
+                    stderr=subprocess.STDOUT,
+                    env=dict(os.environ),
+                )
+                for source in (FLOOR_SERVER, FLAT_FLOOR_SERVER)
+            ]
         try:
             return run(args, domain)
         finally:
-            for process in (node, floor):
+            for process in (node, *floors):
                 if process.poll() is None:
                     process.send_signal(signal.SIGINT)
                     try:
@@ -210,8 +263,9 @@ def run(args: argparse.Namespace, domain: int) -> int:
     flat_checks = client_node.create_client(CheckPosesFlat, f"{NODE}/check_poses_flat")
     computes = ActionClient(client_node, ComputeWorkspace, f"{NODE}/compute_workspace")
     floor_checks = client_node.create_client(CheckPoses, FLOOR)
+    flat_floor_checks = client_node.create_client(CheckPosesFlat, FLAT_FLOOR)
     try:
-        clients = (checks, flat_checks, floor_checks)
+        clients = (checks, flat_checks, floor_checks, flat_floor_checks)
         if not all(client.wait_for_service(timeout_sec=60) for client in clients) or not (
             computes.wait_for_server(timeout_sec=60)
         ):
@@ -234,7 +288,11 @@ def run(args: argparse.Namespace, domain: int) -> int:
         flat = flat_request(angles)
         for _ in range(10):
             timed(flat, flat_checks)
-        flat_batched = [timed(flat, flat_checks) for _ in range(args.batch_samples)]
+            timed(flat, flat_floor_checks)
+        flat_batched, flat_floor = [], []
+        for _ in range(args.batch_samples):  # interleaved with its floor
+            flat_batched.append(timed(flat, flat_checks))
+            flat_floor.append(timed(flat, flat_floor_checks))
         manipulator = Manipulator.from_params_file(example_config_path())
         core = []
         for _ in range(args.batch_samples):
@@ -274,6 +332,7 @@ def run(args: argparse.Namespace, domain: int) -> int:
     batch_med, batch_p95 = percentiles(batched)
     core_med, _ = percentiles(core)
     flat_med, flat_p95 = percentiles(flat_batched)
+    flat_floor_med, flat_floor_p95 = percentiles(flat_floor)
     print(
         f"check_poses, 1 pose, idle:        median {idle_med:7.3f} ms  p95 {idle_p95:7.3f} ms"
         f"  (ratio to the floor {idle_med / floor_med:.2f}x)"
@@ -292,7 +351,20 @@ def run(args: argparse.Namespace, domain: int) -> int:
         f"to floor + core {flat_med / (floor_med + core_med):.2f}x; "
         f"{batch_med / flat_med:.1f}x faster than nested)"
     )
-    print(f"load average {os.getloadavg()[0]:.2f} (1 min)")
+    print(
+        f"floor: flat, 1000 poses, no work: median {flat_floor_med:7.3f} ms  p95 "
+        f"{flat_floor_p95:7.3f} ms  (same arrays both ways, prebuilt answer; the node's flat "
+        f"call is {flat_med / (flat_floor_med + core_med):.2f}x this floor + the core)"
+    )
+    goal_ms = GOAL_FLAT_CORE_RATIO * core_med
+    if min(floor_med, flat_floor_med) > goal_ms:
+        print(
+            f"the flat goal ({GOAL_FLAT_CORE_RATIO:g}x the core = {goal_ms:.3f} ms) is below "
+            f"the round trip of a server that does nothing ({floor_med:.3f} ms with one pose, "
+            f"{flat_floor_med:.3f} ms with the 1000-pose arrays): no rclpy service can meet it "
+            "on this machine"
+        )
+    print(f"load average {'/'.join(f'{v:.2f}' for v in os.getloadavg())} (1, 5, 15 min)")
     ok = idle_med <= GOAL_MS and flat_med <= GOAL_FLAT_CORE_RATIO * core_med
     if loaded:
         load_med, load_p95 = percentiles(loaded)

@@ -171,6 +171,10 @@ def commander(rate: float, duration: float) -> dict:
         "duplicates": duplicates[0],
         "latency_ms": percentiles_ms(latencies),
         "cpu_s": cpu,
+        # the timeline (CLOCK_MONOTONIC, shared by the processes): send time, latency (NaN:
+        # missing or overloaded)
+        "sent": sent.tolist(),
+        "latency": np.where(answered & ~overloaded, received - sent, np.nan).tolist(),
     }
 
 
@@ -194,13 +198,15 @@ def checker(duration: float) -> dict:
     for _ in range(20):
         client.call(request, timeout_sec=30)
     print(json.dumps({"ready": True}), flush=True)
-    samples, failures = [], 0
+    samples, failures, reasons = [], 0, set()
     end = time.perf_counter() + duration
     while time.perf_counter() < end:
         start = time.perf_counter()
         response = client.call(request, timeout_sec=30)
         samples.append(time.perf_counter() - start)
-        failures += response is None or not response.success
+        if response is None or not response.success:
+            failures += 1
+            reasons.add("no answer in 30 s" if response is None else response.message)
     cpu = time.process_time()
     executor.shutdown()
     node.destroy_node()
@@ -208,6 +214,7 @@ def checker(duration: float) -> dict:
     return {
         "calls": len(samples),
         "failures": failures,
+        "reasons": sorted(reasons),
         "latency_ms": percentiles_ms(samples),
         "cpu_s": cpu,
     }
@@ -294,6 +301,9 @@ class Computations:
         self.spinner.start()
         self.stop = threading.Event()
         self.done = 0
+        self.finished_at: list[float] = []  # time.perf_counter() of each result
+        self.failures: list[str] = []  # messages of the goals that did not succeed
+        self.lost_goals = 0  # goals sent again after 5 s without an answer
         self.kind = ""
         self.thread = threading.Thread(target=self._run, daemon=True)
 
@@ -314,6 +324,7 @@ class Computations:
             client = ActionClient(self.node, ComputeWorkspace, f"{NODE}/compute_workspace")
             if client.wait_for_server(timeout_sec=10):
                 self.kind, self.client = "action", client
+                time.sleep(1.0)  # the server's answer writers must have matched our readers
         except ImportError:
             pass
         if not self.kind:
@@ -332,7 +343,13 @@ class Computations:
 
                 goal = ComputeWorkspace.Goal(request=self._request())
                 handle_future = self.client.send_goal_async(goal)
+                sent = time.monotonic()
                 while not handle_future.done():
+                    if time.monotonic() - sent > 5.0:
+                        # discovery race: the goal (or its answer) was lost; ask again
+                        self.lost_goals += 1
+                        handle_future = self.client.send_goal_async(goal)
+                        sent = time.monotonic()
                     time.sleep(0.01)
                 handle = handle_future.result()
                 result_future = handle.get_result_async()
@@ -346,6 +363,9 @@ class Computations:
                     time.sleep(0.01)
                 if getattr(self, "stop_after", False):
                     return
+                result = result_future.result().result
+                if not result.summary.success:
+                    self.failures.append(result.summary.message)
             else:
                 from hexapod_workspace_msgs.srv import ComputeWorkspace
 
@@ -353,6 +373,7 @@ class Computations:
                 while not future.done():
                     time.sleep(0.01)
             self.done += 1
+            self.finished_at.append(time.perf_counter())
             self.stop.wait(max(0.0, self.every - (time.monotonic() - started)))
 
     def close(self) -> None:
@@ -386,6 +407,16 @@ def run(args: argparse.Namespace, node: subprocess.Popen, out_dir: Path) -> int:
         after = {k: sum(cpu_seconds(p) for p in v) for k, v in pids.items()}
         clients = [json.loads(p.communicate(timeout=args.duration + 120)[0]) for p in roles]
         computations.close()
+        if args.timeline is not None:
+            args.timeline.write_text(
+                json.dumps(
+                    {
+                        "sent": command.pop("sent"),
+                        "latency": command.pop("latency"),
+                        "goal_results": computations.finished_at,
+                    }
+                )
+            )
         # the roles report their own CPU time (whole life, setup included)
         before["commander"], after["commander"] = 0.0, command["cpu_s"]
         before["clients"], after["clients"] = 0.0, sum(c["cpu_s"] for c in clients)
@@ -405,7 +436,9 @@ def run(args: argparse.Namespace, node: subprocess.Popen, out_dir: Path) -> int:
     )
     print(
         f"load: {args.clients} check_poses clients, 3-D computations ({computations.kind}, "
-        f"{computations.done} finished, every {args.compute_every:g} s), commands at "
+        f"{computations.done} finished, {len(computations.failures)} failed, "
+        f"{computations.lost_goals} sent again, every "
+        f"{args.compute_every:g} s), commands at "
         f"{args.rate:g}/s for {args.duration:g} s"
     )
     print(
@@ -422,6 +455,7 @@ def run(args: argparse.Namespace, node: subprocess.Popen, out_dir: Path) -> int:
         print(
             f"client {index}: {client['calls']} check_poses calls ({client['failures']} failed), "
             f"p50 {lat['p50']:.3f} ms  p99 {lat['p99']:.3f} ms"
+            + "".join(f"\n  failed: {reason}" for reason in client["reasons"])
         )
     total = sum(after[k] - before[k] for k in after)
     split = ", ".join(
@@ -443,6 +477,8 @@ def run(args: argparse.Namespace, node: subprocess.Popen, out_dir: Path) -> int:
         + ", after "
         + "/".join(f"{v:.2f}" for v in load_after)
     )
+    for message in sorted(set(computations.failures)):
+        print(f"failed goal: {message}")
     print(f"goals: {'met' if ok else 'MISSED'}")
     return 0 if ok else 1
 
@@ -473,6 +509,19 @@ def main(argv: list[str] | None = None) -> int:
         help="run the node of another checkout (e.g. a git worktree of an older commit) "
         "instead of the install space's, for a before/after comparison in the same conditions",
     )
+    parser.add_argument(
+        "--timeline",
+        type=Path,
+        metavar="JSON",
+        help="write each command's send time and latency and each goal's result time (s, "
+        "CLOCK_MONOTONIC) to this file",
+    )
+    parser.add_argument(
+        "--domain-id",
+        type=int,
+        metavar="ID",
+        help="DDS domain of the run (default: a free one, picked by domain_coordinator)",
+    )
     args = parser.parse_args(argv)
     if args.role == "commander":
         print(json.dumps(commander(args.rate, args.duration)), flush=True)
@@ -484,9 +533,16 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{NODE_EXECUTABLE} missing: run `make ros` first", file=sys.stderr)
         return 2
 
+    import contextlib
+
     import domain_coordinator
 
-    with domain_coordinator.domain_id() as domain, tempfile.TemporaryDirectory() as tmp:
+    chosen = (
+        contextlib.nullcontext(args.domain_id)
+        if args.domain_id is not None
+        else domain_coordinator.domain_id()
+    )
+    with chosen as domain, tempfile.TemporaryDirectory() as tmp:
         os.environ["ROS_DOMAIN_ID"] = str(domain)
         os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
         out_dir = Path(tmp)

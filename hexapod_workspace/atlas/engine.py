@@ -39,6 +39,7 @@ from .store import (
     mark_done,
     open_atlas,
     set_complete,
+    settle_store_io,
     store_attrs,
     write_chunk,
 )
@@ -315,9 +316,13 @@ def run_atlas(
     try:
         if jobs:
             engine.run(jobs, finished)
-    finally:
+    except BaseException:  # an interrupt too: the cluster closes, the chunk being written ends
         if isinstance(engine, _OnDask):
             engine.close()
+        settle_store_io()
+        raise
+    if isinstance(engine, _OnDask):
+        engine.close()
     set_complete(path, True)
     dataset = open_atlas(path).load()
     return AtlasRun(

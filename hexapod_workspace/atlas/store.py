@@ -41,6 +41,7 @@ __all__ = [
     "mark_done",
     "open_atlas",
     "set_complete",
+    "settle_store_io",
     "store_attrs",
     "write_chunk",
 ]
@@ -256,3 +257,33 @@ def open_atlas(path: str | Path) -> xr.Dataset:
     order = [v.name for v in ATLAS_VARIABLES if v.name in dataset.data_vars]
     rest = [name for name in dataset.data_vars if name not in order]
     return dataset[order + rest]
+
+
+def settle_store_io(timeout: float = 10.0) -> None:
+    """Wait (at most ``timeout`` s) until zarr's I/O thread has nothing left running.
+
+    An interrupt (SIGINT: KeyboardInterrupt in the main thread) can land while the main thread
+    waits for zarr to write a chunk; the write goes on in zarr's I/O thread. zarr's exit
+    handler stops that thread and waits only 0.2 s for it, then writes "Thread did not finish
+    cleanly; forcefully closing the event loop" to stderr (a loaded machine is slower than
+    that). Called on the way out of an interrupted run, this lets the write finish first, so
+    the handler finds the thread idle. Reads zarr's module state (``zarr.core.sync.loop``);
+    does nothing when it is not there (another zarr version) or not running.
+    """
+    import asyncio
+    import contextlib
+
+    with contextlib.suppress(Exception):
+        from zarr.core import sync
+
+        loop = sync.loop[0]
+        if loop is None or not loop.is_running():
+            return
+
+        async def drained() -> None:
+            current = asyncio.current_task()
+            pending = [task for task in asyncio.all_tasks() if task is not current]
+            if pending:
+                await asyncio.wait(pending, timeout=timeout)
+
+        asyncio.run_coroutine_threadsafe(drained(), loop).result(timeout + 1.0)

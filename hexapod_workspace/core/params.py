@@ -45,6 +45,7 @@ NODE_PARAMETERS = (
     "recording.max_file_mb",
     "recording.max_file_duration",
     "recording.max_total_mb",
+    "recording.cloud_points",
     "motion.current_pose_topic",
     "axis_limits.frame",
     "axis_limits.rate",

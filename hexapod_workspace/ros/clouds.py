@@ -67,7 +67,9 @@ class PublishedCloud:
     topic : str
         Fully qualified topic it was published on.
     data : bytes
-        Its CDR bytes (what the node's log records).
+        What the node's log records: the CDR bytes published, or those of the same cloud
+        bounded to ``recording.cloud_points`` points (the same header, fields and stamp; evenly
+        spaced points), so that the node's process never handles a multi-megabyte cloud.
     log_time_ns : int
         When it was published, ns since the epoch.
     """
@@ -148,8 +150,15 @@ class CloudPublisher:
         self._topics = dict(topics.topics)
         self._message_class = PointCloud2
 
-    def publish(self, kind: int, fields: dict[str, Any]) -> PublishedCloud:
-        """Build, serialise once and publish the cloud ``fields`` of a ``kind`` workspace."""
+    def publish(
+        self, kind: int, fields: dict[str, Any], record_points: int | None = 0
+    ) -> PublishedCloud | None:
+        """Build, serialise once and publish the cloud ``fields`` of a ``kind`` workspace.
+
+        Returns what the node's log records: the published bytes (``record_points`` 0, or a
+        cloud no larger), the CDR bytes of a cloud of at most ``record_points`` points
+        (:func:`decimated_cloud_fields`), or None (``record_points`` None: not recorded).
+        """
         from rclpy.serialization import serialize_message
 
         from .conversions import to_message
@@ -158,6 +167,11 @@ class CloudPublisher:
         log_time_ns = time.time_ns()
         topic = self._topics[kind]
         self._publishers[topic].publish(data)  # rclpy publishes serialised bytes as they are
+        if record_points is None:
+            return None
+        recorded = decimated_cloud_fields(fields, record_points)
+        if recorded is not fields:
+            data = serialize_message(to_message(self._message_class, recorded))
         return PublishedCloud(topic, data, log_time_ns)
 
     def close(self) -> None:

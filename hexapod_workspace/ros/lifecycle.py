@@ -26,8 +26,11 @@ deactivate
     recorded. State *inactive*.
 cleanup, shutdown (and error processing)
     Cancel the jobs, end the worker process and finish the log (a playable file). Cleanup
-    returns to *unconfigured*; shutdown to *finalized*, where the process may be stopped (the
-    node keeps answering "inactive" until it is).
+    returns to *unconfigured*; shutdown to *finalized*: ``workspace_node`` then exits with
+    status 0 :data:`FINALIZED_GRACE` s later (time for the ChangeState answer and the
+    transition event to reach their readers; a command arriving meanwhile is answered
+    "inactive"), as a finalized managed node has nothing left to do. A node built in another
+    program (``exit_when_finalized`` False) stays, answering "inactive", until destroyed.
 
 *Autostart* (default; ``workspace_node --autostart=false`` or the launch argument
 ``autostart:=false`` turn it off) runs configure and activate as the node starts, so today's
@@ -39,6 +42,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import rclpy
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.lifecycle import LifecycleState, TransitionCallbackReturn
 
@@ -49,10 +53,18 @@ from .parameters import state_from
 #: What rclpy's lifecycle state machine raises for a transition the state does not allow.
 RCLError = _rclpy.RCLError
 
-__all__ = ["AUTOSTART_OPTION", "INACTIVE", "ManagedTransitions", "autostart_from_argv"]
+__all__ = [
+    "AUTOSTART_OPTION",
+    "FINALIZED_GRACE",
+    "INACTIVE",
+    "ManagedTransitions",
+    "autostart_from_argv",
+]
 
 #: The prefix of every answer given while the node is not active.
 INACTIVE = "inactive"
+#: Seconds between the shutdown transition and the end of ``workspace_node``'s process.
+FINALIZED_GRACE = 0.5
 #: Command-line option of ``workspace_node`` (before ``--ros-args``): ``--autostart=false``
 #: leaves the node unconfigured at start (default ``true``).
 AUTOSTART_OPTION = "--autostart"
@@ -93,6 +105,9 @@ class ManagedTransitions:
     active: bool = False
     #: why the last configure failed ("" when it did not)
     configure_error: str = ""
+    #: end the node's context :data:`FINALIZED_GRACE` s after the shutdown transition, which
+    #: ends ``workspace_node``'s spin (set by its ``main``; a node in another program stays)
+    exit_when_finalized: bool = False
 
     # ------------------------------------------------------------------ queries
     @property
@@ -198,7 +213,12 @@ class ManagedTransitions:
         return self._release("cleaned up (unconfigured)")
 
     def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:
-        return self._release("shut down (finalized)")
+        outcome = self._release("shut down (finalized)")
+        if self.exit_when_finalized:
+            node: Any = self
+            node.get_logger().info(f"finalized: the process exits in {FINALIZED_GRACE:g} s")
+            node.create_timer(FINALIZED_GRACE, lambda: rclpy.try_shutdown(context=node.context))
+        return outcome
 
     def on_error(self, state: LifecycleState) -> TransitionCallbackReturn:
         return self._release("error processed (unconfigured)")

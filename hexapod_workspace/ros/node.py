@@ -145,6 +145,18 @@ EXTENSIONS: list[Callable[[WorkspaceNode], object]] = [_attach_atlas, _attach_ma
 COMMAND_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_ALL, depth=1, reliability=ReliabilityPolicy.RELIABLE
 )
+#: The services' answers: reliable, volatile, the last 1000 kept until every client has them.
+#: rmw's default keeps 10: under load a client whose answer was lost in transport (a full
+#: shared-memory port) asks again once it sees the gap, and when the node has answered ten other
+#: calls meanwhile the answer is gone and the client waits forever. Fast DDS drops a volatile
+#: writer's sample once every reader has acknowledged it, so the depth costs memory only while
+#: a client lags.
+SERVICE_QOS_PROFILE = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST,
+    depth=1000,
+    reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.VOLATILE,
+)
 #: ~/reachability keeps 1000 results (1 s at 1 kHz) for a reliable reader that lags.
 REACHABILITY_DEPTH = 1000
 #: GIL switch interval of the node process, s: a callback waits at most about this long for the
@@ -333,7 +345,9 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
             return answer
 
         handler = recorded_async if _is_coroutine(callback) else recorded
-        return self.create_service(service_class, name, handler, callback_group=group)
+        return self.create_service(
+            service_class, name, handler, qos_profile=SERVICE_QOS_PROFILE, callback_group=group
+        )
 
     def recorded_subscription(
         self, message_class: type, topic: str, callback: Callable, group: Any = None
@@ -612,6 +626,7 @@ def main(args: list[str] | None = None) -> int:
             override_names=command_line_override_names(args, NODE_NAME),
             autostart=autostart,
         )
+        node.exit_when_finalized = True  # the shutdown transition ends the process
         executor = SingleThreadedExecutor()
         executor.add_node(node)
         executor.spin()

@@ -235,6 +235,15 @@ def parameter_specs() -> dict[str, Spec]:
         ),
         *_cell_specs(),
         Spec(
+            "recording.cloud_points",
+            20_000,
+            "Most points of each boundary cloud written to the log: evenly spaced along the "
+            "cloud (first and last kept), as in the action's result; the cloud topic always "
+            "gets the full cloud. 0 = the full cloud in the log too (a 274k-point 3-D boundary "
+            "is 6.6 MB a goal, written by the node's process: see the latency figures).",
+            int_range=(0, 100_000_000),
+        ),
+        Spec(
             "recording.directory",
             "",
             "Folder of the MCAP logs (one per run, named by start time); empty = "
@@ -341,6 +350,8 @@ class Settings:
     recording_rotation: Rotation
     axis_limits_frame: str = "base"
     axis_limits_rate: float = 2.0
+    #: most points of a boundary cloud in the log (0 = all)
+    recording_cloud_points: int = 20_000
 
 
 @dataclass(frozen=True)
@@ -485,6 +496,7 @@ def state_from(values: dict[str, Any]) -> State:
         ),
         axis_limits_frame=frame,
         axis_limits_rate=float(values.get("axis_limits.rate", 2.0)),
+        recording_cloud_points=int(values["recording.cloud_points"]),
     )
     return State(manipulator, settings, platform, cell)
 

@@ -6,12 +6,14 @@ disk. The recorder's thread is the only one that touches the
 finishes logs (requests to do so travel through the same queue, so they keep their order with
 the messages), flushes, and turns recording off on the first write failure.
 
-Flush bound (end to end, for the node): the thread writes a message as soon as it gets the
-interpreter and flushes whatever has been pending for :data:`FLUSH_INTERVAL` s, waking at least
-every :data:`WAKE_INTERVAL` s; so a message is in the file (the operating system's hands; a
-SIGKILL of the node does not lose it) at most about ``FLUSH_INTERVAL + WAKE_INTERVAL`` s after
-the callback queued it. :data:`FLUSH_BOUND` is the bound docs/log_format.md states and
-``test_node_recording`` proves under a 200 Hz stream with some margin for a loaded machine.
+Flush bound (end to end, for the node): the thread writes a message :data:`BATCH_DELAY` s after
+it arrives (with everything queued behind it: the callback that queued it has finished by then
+and does not wait for the interpreter while the thread writes) and flushes whatever has been
+pending for :data:`FLUSH_INTERVAL` s, waking at least every :data:`WAKE_INTERVAL` s; so a
+message is in the file (the operating system's hands; a SIGKILL of the node does not lose it) at
+most about ``BATCH_DELAY + FLUSH_INTERVAL + WAKE_INTERVAL`` s after the callback queued it.
+:data:`FLUSH_BOUND` is the bound docs/log_format.md states and ``test_node_recording`` proves
+under a 200 Hz stream with some margin for a loaded machine.
 
 Rotation (:class:`Rotation`, the ``recording.max_*`` parameters), as rosbag2 splits a bag: the
 current log is finished and a new one started (named by its own start time, in the same folder)
@@ -37,6 +39,7 @@ from hexapod_workspace.errors import RecordingError
 from hexapod_workspace.logs import LogWriter, run_log_path
 
 __all__ = [
+    "BATCH_DELAY",
     "FLUSH_BOUND",
     "FLUSH_INTERVAL",
     "LOG_PREFIX",
@@ -50,6 +53,9 @@ __all__ = [
 FLUSH_INTERVAL = 0.1
 #: Seconds between two looks at the writer when nothing arrives.
 WAKE_INTERVAL = 0.05
+#: Seconds the recorder waits after a message arrives before it writes it and those queued
+#: behind it (well inside the flush bound).
+BATCH_DELAY = 0.002
 #: What the node promises: everything acknowledged this many seconds before a SIGKILL is in
 #: the log.
 FLUSH_BOUND = 0.5
@@ -196,10 +202,20 @@ class Recorder:
                 item = self._queue.get(timeout=WAKE_INTERVAL)
             except queue.Empty:
                 item = None
-            if item is not None:
+            if item is not None and item[0] not in (_OPEN, _CLOSE, _STOP):
+                # A message arrives while its callback still runs (a request is queued before
+                # the answer is computed): wait for the callback to finish, then write
+                # everything queued meanwhile in one go, instead of taking the interpreter
+                # from the executor message by message.
+                time.sleep(BATCH_DELAY)
+            while item is not None:
                 if item[0] == _STOP:
                     return
                 self._handle(item)
+                try:
+                    item = self._queue.get_nowait()
+                except queue.Empty:
+                    item = None
             writer = self._writer
             if writer is not None:
                 try:

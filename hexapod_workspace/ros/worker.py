@@ -92,6 +92,11 @@ class WorkspaceJob:
     frames : dict, optional
         CellFrames fields of the node's tool and work frames when the job was made (copied
         into the summary).
+    record : bool
+        Hand the published cloud's CDR bytes back for the node's log (False: the node does
+        not record, nothing crosses the pipe).
+    record_points : int
+        Most points of the cloud handed back for the log (0 = the full cloud as published).
     """
 
     manipulator: Manipulator
@@ -105,6 +110,8 @@ class WorkspaceJob:
     request_id: str = ""
     result_points: int = 0
     frames: dict[str, Any] | None = None
+    record: bool = True
+    record_points: int = 0
 
 
 def compute_fields(
@@ -168,11 +175,11 @@ def _reporter(connection: Connection, cancel: Any) -> Callable[[float], None]:
 
 def _published(
     publisher: Any, job: WorkspaceJob, fields: tuple[dict[str, Any], dict[str, Any]]
-) -> tuple[tuple[dict[str, Any], dict[str, Any]], PublishedCloud]:
+) -> tuple[tuple[dict[str, Any], dict[str, Any]], PublishedCloud | None]:
     """Publish the full cloud of ``fields``; return the fields with the cloud bounded to
-    ``job.result_points`` and what was published."""
+    ``job.result_points`` and what the node records (None when ``job.record`` is False)."""
     summary, cloud = fields
-    published = publisher.publish(job.kind, cloud)
+    published = publisher.publish(job.kind, cloud, job.record_points if job.record else None)
     return (summary, decimated_cloud_fields(cloud, job.result_points)), published
 
 
@@ -214,7 +221,8 @@ def _serve(connection: Connection, cancel: Any, topics: CloudTopics | None = Non
             fields = compute_fields(job, _reporter(connection, cancel))
             if publisher is not None:
                 fields, published = _published(publisher, job, fields)
-                connection.send(("published", published))
+                if published is not None:
+                    connection.send(("published", published))
             reply: tuple[str, Any] = ("ok", fields)
         except CanceledError:
             reply = ("canceled", None)

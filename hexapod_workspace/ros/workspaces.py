@@ -144,6 +144,8 @@ class WorkspaceServer:
             request_id=request.request_id,
             result_points=RESULT_MAX_POINTS,
             frames=cell_frames_fields(self._node.state.cell),
+            record=settings.recording_enabled,
+            record_points=settings.recording_cloud_points,
         )
 
     def _submit(self, request: WorkspaceRequest, **callbacks: Any) -> Ticket | None:

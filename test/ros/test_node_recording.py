@@ -146,6 +146,12 @@ def test_sigint_log_holds_exactly_what_the_node_did(ros_domain, ros_client, tmp_
         compute.request.position.z = -1.3
         # the action's goal and result are recorded in the service's form (same fields)
         result = ros_client.compute(f"{node_name}/compute_workspace", compute.request)
+        # The cloud topic keeps one cloud (KEEP_LAST 1, as a latched topic should): the next
+        # one may replace this one before it reaches a busy subscriber, so the second
+        # computation starts once the first cloud is here (the log must then hold both).
+        ros_client.spin_until(
+            lambda: len(clouds) >= 1, what="the first cloud", timeout=DISCOVERY_TIMEOUT
+        )
         compute_response = ComputeWorkspace.Response(
             success=result.success,
             message=result.message,
