@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from . import kernels
-from .constraint_table import CONSTRAINT_NAMES, N_CONSTRAINTS, SINGULARITY
+from .constraint_table import CONSTRAINT_NAMES, N_CONSTRAINTS, SINGULARITY, applicable
 from .resolution import MAX_POSITION_NORM, validate_position
 
 if TYPE_CHECKING:
@@ -297,7 +297,10 @@ class CheckResult:
     reachable : ndarray, shape (N,), bool
         Every constraint holds.
     margins : dict of str to ndarray, shape (N,)
-        Signed margin of each constraint (keys :data:`CONSTRAINT_NAMES`), m or rad.
+        Signed margin of each constraint that applies to the model's architecture (keys from
+        :data:`CONSTRAINT_NAMES`, in its order: ``leg_length`` for 6-UPS, ``actuator``, ``ik``
+        and ``transmission`` for pus/rus), m, rad or 1. NaN where undefined (a leg without an
+        inverse-kinematics solution: every margin that needs its actuated coordinate).
     limiting_legs : dict of str to ndarray, shape (N,), int
         1-based leg with the smallest margin of each constraint (``leg_interference``: the lower
         leg of the closest pair; 0 when the check is disabled).
@@ -326,7 +329,11 @@ class CheckResult:
     @property
     def violated(self) -> list[list[str]]:
         """Per pose, the names of the violated constraints (in :data:`CONSTRAINT_NAMES` order)."""
-        return violated_names(np.stack([self.margins[name] for name in CONSTRAINT_NAMES]))
+        count = len(self)
+        absent = np.full(count, np.inf)
+        return violated_names(
+            np.stack([self.margins.get(name, absent) for name in CONSTRAINT_NAMES])
+        )
 
 
 def violated_names(margins: NDArray[np.float64]) -> list[list[str]]:
@@ -443,6 +450,7 @@ def check(
         msg = f"position: expected 3 finite values (x, y, z) in m, got {position.tolist()}"
         raise InputError(msg)
     legs = ints[:N_CONSTRAINTS]
+    rows = applicable(manipulator)
     limiting_constraint, limiting_leg = ints[N_CONSTRAINTS], ints[N_CONSTRAINTS + 1]
     if singularity and manipulator.singularity_min == 0.0:
         # Reported, not enforced: the singularity margin never limits a pose. The limiting
@@ -456,8 +464,8 @@ def check(
         position=position,
         angles=angles,
         reachable=reachable,
-        margins={name: margins[k] for k, name in enumerate(CONSTRAINT_NAMES)},
-        limiting_legs={name: legs[k] for k, name in enumerate(CONSTRAINT_NAMES)},
+        margins={CONSTRAINT_NAMES[k]: margins[k] for k in rows},
+        limiting_legs={CONSTRAINT_NAMES[k]: legs[k] for k in rows},
         limiting_pair=pairs,
         limiting_constraint=limiting_constraint,
         limiting_leg=limiting_leg,

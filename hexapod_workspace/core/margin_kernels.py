@@ -21,38 +21,55 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .constraint_table import (
+    ACTUATOR,
     BASE_JOINT,
+    IK,
     LEG_INTERFERENCE,
     LEG_LENGTH,
     N_CONSTRAINTS,
     PLATFORM_JOINT,
     SINGULARITY,
+    TRANSMISSION,
 )
 from .model_layout import (
     ALPHA,
     ALPHA_EQUAL,
+    ARCH,
+    AXIS_ALONG,
+    AXIS_CROSS,
     BETA,
     BETA_EQUAL,
+    BRANCH,
+    CRANK,
+    CROSS,
     DIAMETER,
     INTERFERENCE,
     JA,
     JB,
+    LEG,
+    LENGTH_FLOOR,
     LMAX,
     LMIN,
     ORDER,
     PAIR_I,
     PAIR_J,
+    QCENTRE,
+    QMAX,
+    QMIN,
+    RAIL,
     RHO,
     RPAIR,
     RR,
     SCALE,
     SINGULARITY_MIN,
     SINGULARITY_ON,
+    TAU_MIN,
+    ZERO,
     A,
     B,
 )
 
-__all__ = ["ONE_SIZE", "check_angles", "check_one", "margins_rotations"]
+__all__ = ["ONE_SIZE", "SCRATCH_ROWS", "check_angles", "check_one", "margins_rotations"]
 
 # ------------------------------------------------------------------------------ one pose
 # Slots of the per-pose result vector ``out``.
@@ -64,6 +81,9 @@ OUT_SIZE = OUT_SHORTEST + 1
 #: Size of :func:`check_one`'s result: margins, legs, pair (2), limiting constraint and leg,
 #: reachable (1.0 or 0.0).
 ONE_SIZE = 2 * N_CONSTRAINTS + 5
+#: Rows of the per-pose scratch (6 legs each): leg vector planes, squared length, 1/ℓ², and the
+#: base-side ends of pus/rus legs (three planes).
+SCRATCH_ROWS = 8
 
 
 @_helper
@@ -94,8 +114,18 @@ def _pose(
     (test/reference.py, BatchedMargins) operation by operation, so margins agree to rounding:
     the smallest margin of each constraint and its leg (first one on ties; NaN, a zero-length
     leg, wins), the closest pair by Ericson's clamped closest points.
-    ``want_pair`` False skips the interference check (margin +inf).
+    ``want_pair`` False skips the interference check (margin +inf). Models with moving base
+    joints (pus, rus) go to :func:`_pose_moving`.
     """
+    if model[ARCH] != 0.0:
+        _pose_moving(model, r, px, py, pz, scratch, out, want_pair)
+        return
+    out[ACTUATOR] = np.inf
+    out[IK] = np.inf
+    out[TRANSMISSION] = np.inf
+    out[OUT_LEG + ACTUATOR] = 0
+    out[OUT_LEG + IK] = 0
+    out[OUT_LEG + TRANSMISSION] = 0
     lx = scratch[0]
     ly = scratch[1]
     lz = scratch[2]
@@ -169,25 +199,7 @@ def _pose(
     out[OUT_LEG + PLATFORM_JOINT] = leg_b
     out[OUT_SHORTEST] = shortest
     out[OUT_LEG + SINGULARITY] = 0
-    if model[SINGULARITY_ON] != 0.0:
-        rows = np.empty(ROWS_SCRATCH)
-        for k in range(6):
-            bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
-            _plucker_row(
-                rows,
-                k,
-                lx[k],
-                ly[k],
-                lz[k],
-                sq[k],
-                r00 * bx + r01 * by + r02 * bz,
-                r10 * bx + r11 * by + r12 * bz,
-                r20 * bx + r21 * by + r22 * bz,
-                model[RHO],
-            )
-        out[SINGULARITY] = _smallest_singular_value(rows) - model[SINGULARITY_MIN]
-    else:
-        out[SINGULARITY] = np.inf
+    out[SINGULARITY] = _pose_singularity(model, r, scratch)
     if not want_pair or model[INTERFERENCE] == 0.0:
         out[LEG_INTERFERENCE] = np.inf
         out[OUT_LEG + LEG_INTERFERENCE] = 0
@@ -246,6 +258,264 @@ def _pose(
                 best = distance
                 best_pair = pair
             best_squared = min(squared, best_squared)
+    out[LEG_INTERFERENCE] = best - model[DIAMETER]
+    out[OUT_LEG + LEG_INTERFERENCE] = PAIR_I[best_pair]
+    out[OUT_PAIR] = PAIR_I[best_pair]
+    out[OUT_PAIR + 1] = PAIR_J[best_pair]
+
+
+@_helper
+def _pose_singularity(
+    model: NDArray[np.float64], r: NDArray[np.float64], scratch: NDArray[np.float64]
+) -> float:
+    """The singularity margin of one pose from its leg vector planes (scratch rows 0..3) and
+    its rotation ``r`` (9,); +inf when the margin is not evaluated."""
+    if model[SINGULARITY_ON] == 0.0:
+        return np.inf
+    rows = np.empty(ROWS_SCRATCH)
+    for k in range(6):
+        bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
+        _plucker_row(
+            rows,
+            k,
+            scratch[0, k],
+            scratch[1, k],
+            scratch[2, k],
+            scratch[3, k],
+            r[0] * bx + r[1] * by + r[2] * bz,
+            r[3] * bx + r[4] * by + r[5] * bz,
+            r[6] * bx + r[7] * by + r[8] * bz,
+            model[RHO],
+        )
+    value: float = _smallest_singular_value(rows) - model[SINGULARITY_MIN]
+    return value
+
+
+# ------------------------------------------------------------------------------ moving base joints
+@_helper
+def _pose_moving(
+    model: NDArray[np.float64],
+    r: NDArray[np.float64],
+    px: float,
+    py: float,
+    pz: float,
+    scratch: NDArray[np.float64],
+    out: NDArray[np.float64],
+    want_pair: bool,
+) -> None:
+    """Margins of one pose of a pus or rus model into ``out`` (OUT_SIZE,), as :func:`_pose`.
+
+    Per leg, the inverse kinematics of :mod:`hexapod_workspace.core.architectures.pus` or
+    :mod:`~hexapod_workspace.core.architectures.rus` (the same closed forms), the leg vector
+    ``L_k = B_k − A_k(q_k)`` in the scratch planes (lx, ly, lz, sq, 1/ℓ²) and the base-side end
+    A_k in planes 5..7. Where some leg has no solution (``ik`` < 0) every margin that needs its
+    q is NaN (``leg_length`` +inf: it does not apply; ``singularity`` +inf when not evaluated,
+    ``leg_interference`` +inf when disabled).
+    """
+    lx = scratch[0]
+    ly = scratch[1]
+    lz = scratch[2]
+    sq = scratch[3]
+    inverse_sq = scratch[4]
+    ax = scratch[5]
+    ay = scratch[6]
+    az = scratch[7]
+    r00, r01, r02 = r[0], r[1], r[2]
+    r10, r11, r12 = r[3], r[4], r[5]
+    r20, r21, r22 = r[6], r[7], r[8]
+    rus = model[ARCH] == 2.0
+    tau_min = model[TAU_MIN]
+    m_act = np.inf
+    leg_act = 0
+    m_ik = np.inf
+    leg_ik = 0
+    m_tau = np.inf
+    leg_tau = 0
+    m_a = np.inf
+    leg_a = 0
+    m_b = np.inf
+    leg_b = 0
+    solved = True
+    for k in range(6):
+        bx = model[B + 3 * k]
+        by = model[B + 3 * k + 1]
+        bz = model[B + 3 * k + 2]
+        platform_x = (r00 * bx + r01 * by + r02 * bz) + px
+        platform_y = (r10 * bx + r11 * by + r12 * bz) + py
+        platform_z = (r20 * bx + r21 * by + r22 * bz) + pz
+        dx = platform_x - model[A + 3 * k]
+        dy = platform_y - model[A + 3 * k + 1]
+        dz = platform_z - model[A + 3 * k + 2]
+        length = model[LEG + k]
+        branch = model[BRANCH + k]
+        ux = model[RAIL + 3 * k]
+        uy = model[RAIL + 3 * k + 1]
+        uz = model[RAIL + 3 * k + 2]
+        jx = model[JA + 3 * k]
+        jy = model[JA + 3 * k + 1]
+        jz = model[JA + 3 * k + 2]
+        if not rus:
+            # Slide: q = u·d + branch·sqrt(L² − h²), h the distance from B_k to the rail line.
+            along = ux * dx + uy * dy + uz * dz
+            hx = dx - along * ux
+            hy = dy - along * uy
+            hz = dz - along * uz
+            h = math.sqrt(hx * hx + hy * hy + hz * hz)
+            ik = length - h
+            q = along + branch * math.sqrt(max(ik * (length + h), 0.0)) if ik >= 0.0 else np.nan
+            base_x = model[A + 3 * k] + q * ux
+            base_y = model[A + 3 * k + 1] + q * uy
+            base_z = model[A + 3 * k + 2] + q * uz
+            tx, ty, tz = ux, uy, uz
+        else:
+            # Crank: a cos q + b sin q = c; u holds the crank axis w.
+            crank = model[CRANK + k]
+            ex, ey, ez = model[ZERO + 3 * k], model[ZERO + 3 * k + 1], model[ZERO + 3 * k + 2]
+            fx, fy, fz = model[CROSS + 3 * k], model[CROSS + 3 * k + 1], model[CROSS + 3 * k + 2]
+            a = 2.0 * crank * (dx * ex + dy * ey + dz * ez)
+            b = 2.0 * crank * (dx * fx + dy * fy + dz * fz)
+            c = (dx * dx + dy * dy + dz * dz) + crank * crank - length * length
+            along = ux * dx + uy * dy + uz * dz
+            hx = dx - along * ux
+            hy = dy - along * uy
+            hz = dz - along * uz
+            across = math.sqrt(hx * hx + hy * hy + hz * hz)
+            ik = min(
+                length - math.hypot(along, across - crank),
+                math.hypot(along, across + crank) - length,
+            )
+            if ik >= 0.0:
+                norm = math.hypot(a, b)
+                ratio = min(max(c / norm, -1.0), 1.0) if norm > 0.0 else 1.0
+                raw = math.atan2(b, a) + branch * math.acos(ratio)
+                centre = model[QCENTRE + k]
+                shifted = raw - centre + math.pi
+                wrapped = shifted - 2.0 * math.pi * math.floor(shifted / (2.0 * math.pi))
+                q = centre + wrapped - math.pi
+            else:
+                q = np.nan
+            cq = math.cos(q)
+            sq_ = math.sin(q)
+            base_x = model[A + 3 * k] + crank * (cq * ex + sq_ * fx)
+            base_y = model[A + 3 * k + 1] + crank * (cq * ey + sq_ * fy)
+            base_z = model[A + 3 * k + 2] + crank * (cq * ez + sq_ * fz)
+            # The crank end's unit velocity, and the joint axis turned by q about w (Rodrigues).
+            tx, ty, tz = cq * fx - sq_ * ex, cq * fy - sq_ * ey, cq * fz - sq_ * ez
+            jx = cq * jx + sq_ * model[AXIS_CROSS + 3 * k] + (1.0 - cq) * model[AXIS_ALONG + 3 * k]
+            jy = (
+                cq * jy
+                + sq_ * model[AXIS_CROSS + 3 * k + 1]
+                + (1.0 - cq) * model[AXIS_ALONG + 3 * k + 1]
+            )
+            jz = (
+                cq * jz
+                + sq_ * model[AXIS_CROSS + 3 * k + 2]
+                + (1.0 - cq) * model[AXIS_ALONG + 3 * k + 2]
+            )
+        if not ik >= 0.0:
+            solved = False
+        if ik < m_ik or (ik != ik and m_ik == m_ik):
+            m_ik = ik
+            leg_ik = k
+        x = platform_x - base_x
+        y = platform_y - base_y
+        z = platform_z - base_z
+        ax[k] = base_x
+        ay[k] = base_y
+        az[k] = base_z
+        lx[k] = x
+        ly[k] = y
+        lz[k] = z
+        squared = x * x + y * y + z * z
+        sq[k] = squared
+        inverse = 1.0 / math.sqrt(squared)
+        inverse_sq[k] = inverse * inverse
+        value = min(q - model[QMIN + k], model[QMAX + k] - q)
+        if value < m_act or (value != value and m_act == m_act):
+            m_act = value
+            leg_act = k
+        value = abs(tx * x + ty * y + tz * z) * inverse - tau_min
+        if value < m_tau or (value != value and m_tau == m_tau):
+            m_tau = value
+            leg_tau = k
+        cos_a = (jx * x + jy * y + jz * z) * inverse
+        value = model[ALPHA + k] - math.acos(min(max(cos_a, -1.0), 1.0))
+        if value < m_a or (value != value and m_a == m_a):
+            m_a = value
+            leg_a = k
+        kx = model[JB + 3 * k]
+        ky = model[JB + 3 * k + 1]
+        kz = model[JB + 3 * k + 2]
+        cos_b = (
+            (r00 * kx + r01 * ky + r02 * kz) * x
+            + (r10 * kx + r11 * ky + r12 * kz) * y
+            + (r20 * kx + r21 * ky + r22 * kz) * z
+        ) * -inverse
+        value = model[BETA + k] - math.acos(min(max(cos_b, -1.0), 1.0))
+        if value < m_b or (value != value and m_b == m_b):
+            m_b = value
+            leg_b = k
+    out[LEG_LENGTH] = np.inf
+    out[OUT_LEG + LEG_LENGTH] = 0
+    out[ACTUATOR] = m_act
+    out[OUT_LEG + ACTUATOR] = leg_act
+    out[IK] = m_ik
+    out[OUT_LEG + IK] = leg_ik
+    out[TRANSMISSION] = m_tau
+    out[OUT_LEG + TRANSMISSION] = leg_tau
+    out[BASE_JOINT] = m_a
+    out[OUT_LEG + BASE_JOINT] = leg_a
+    out[PLATFORM_JOINT] = m_b
+    out[OUT_LEG + PLATFORM_JOINT] = leg_b
+    out[OUT_SHORTEST] = model[LENGTH_FLOOR]
+    out[OUT_LEG + SINGULARITY] = 0
+    out[OUT_LEG + LEG_INTERFERENCE] = 0
+    out[OUT_PAIR] = 0
+    out[OUT_PAIR + 1] = 0
+    if not solved:
+        # Margins that need the unsolved leg's q are undefined (NaN counts as violated).
+        out[ACTUATOR] = np.nan
+        out[TRANSMISSION] = np.nan
+        out[BASE_JOINT] = np.nan
+        out[PLATFORM_JOINT] = np.nan
+        out[SINGULARITY] = np.nan if model[SINGULARITY_ON] != 0.0 else np.inf
+        out[LEG_INTERFERENCE] = np.nan if want_pair and model[INTERFERENCE] != 0.0 else np.inf
+        return
+    out[SINGULARITY] = _pose_singularity(model, r, scratch)
+    if not want_pair or model[INTERFERENCE] == 0.0:
+        out[LEG_INTERFERENCE] = np.inf
+        return
+    # Every pair in index order (the base-side ends move: no pruning by fixed A_i − A_j),
+    # Ericson's clamped closest points as in _pose; the first pair wins ties.
+    best = np.inf
+    best_pair = 0
+    for pair in range(15):
+        i = PAIR_I[pair]
+        j = PAIR_J[pair]
+        rx = ax[i] - ax[j]
+        ry = ay[i] - ay[j]
+        rz = az[i] - az[j]
+        rr = rx * rx + ry * ry + rz * rz
+        xi, yi, zi = lx[i], ly[i], lz[i]
+        xj, yj, zj = lx[j], ly[j], lz[j]
+        c = xi * rx + yi * ry + zi * rz
+        f = xj * rx + yj * ry + zj * rz
+        a = sq[i]
+        e = sq[j]
+        b = xi * xj + yi * yj + zi * zj
+        denom = a * e - b * b
+        if denom > 1e-14 * a * e:
+            s = min(max((b * f - c * e) / denom, 0.0), 1.0)
+            t = min(max((b * s + f) * inverse_sq[j], 0.0), 1.0)
+            s = min(max((b * t - c) * inverse_sq[i], 0.0), 1.0)
+        else:
+            t = 0.0 if e <= 1e-300 else _clamp01(f / e)
+            s = 0.0 if a <= 1e-300 else _clamp01((b * t - c) / a)
+        squared = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
+        distance = math.sqrt(max(squared, 0.0))
+        if distance < best or (distance != distance and best == best):
+            best = distance
+            best_pair = pair
     out[LEG_INTERFERENCE] = best - model[DIAMETER]
     out[OUT_LEG + LEG_INTERFERENCE] = PAIR_I[best_pair]
     out[OUT_PAIR] = PAIR_I[best_pair]
@@ -549,8 +819,8 @@ BLOCK = 128
 _CA, _SA, _CB, _SB, _CG, _SG = 0, 1, 2, 3, 4, 5
 _R = 6  # 9 rows: rotation matrix, row-major
 _PHI, _THETA, _PSI = 15, 16, 17
-_MIN = 18  # 9 rows: running minima, see the offsets below
-_LEGS = 27  # 7 rows per leg, see the offsets below
+_MIN = max(18, OUT_SHORTEST)  # 9 rows: running minima (below the outputs' rows), see below
+_LEGS = _MIN + 9  # 7 rows per leg, see the offsets below
 _SIGMA = _LEGS + 6 * 7  # σ_min − σ_lim of each pose (when the singularity margin is on)
 _BLOCK_ROWS = _SIGMA + 1
 # Rows of the running minima (offsets from _MIN): margins or cosines and their leg or pair.
@@ -681,6 +951,14 @@ def _check_block(
     in 8..9 (as floats).
     """
     px, py, pz = position[0], position[1], position[2]
+    if model[ARCH] != 0.0:
+        # Moving base joints (pus, rus): every pose through the scalar kernel.
+        for n in range(count):
+            _tt_matrix(angles[first + n, 0], angles[first + n, 1], angles[first + n, 2], r)
+            _pose(model, r, px, py, pz, scratch, out, True)
+            for slot in range(OUT_SHORTEST):
+                work[slot * BLOCK + n] = out[slot]
+        return
     for n in range(count):  # strided reads: a loop of its own (it does not vectorise)
         work[_PHI * BLOCK + n] = angles[first + n, 0]
         work[_THETA * BLOCK + n] = angles[first + n, 1]
@@ -774,6 +1052,9 @@ def _check_block(
             work[(OUT_PAIR + 1) * BLOCK + n] = 0.0
         work[SINGULARITY * BLOCK + n] = work[_SIGMA * BLOCK + n] if singular else np.inf
         work[(OUT_LEG + SINGULARITY) * BLOCK + n] = 0.0
+        for row in (ACTUATOR, IK, TRANSMISSION):  # rows of the moving-base architectures
+            work[row * BLOCK + n] = np.inf
+            work[(OUT_LEG + row) * BLOCK + n] = 0.0
 
 
 @_helper
@@ -832,7 +1113,7 @@ def check_angles(
     for k in range(3):
         if not math.isfinite(position[k]):
             return -2
-    scratch = np.empty((5, 6))
+    scratch = np.empty((SCRATCH_ROWS, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
     work = np.empty(_BLOCK_ROWS * BLOCK)
@@ -874,7 +1155,7 @@ def check_one(
     (N_CONSTRAINTS; the interference leg 0 when the check is disabled), closest pair (2, 1-based;
     0 when disabled), the limiting constraint and its leg, and 1.0 when reachable (else 0.0).
     """
-    scratch = np.empty((5, 6))
+    scratch = np.empty((SCRATCH_ROWS, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
     _tt_matrix(phi, theta, psi, r)
@@ -909,7 +1190,7 @@ def margins_rotations(
     Writes ``margins`` (C, N), ``legs`` (C, N) (C = N_CONSTRAINTS) and ``pairs`` (N, 2) as
     :func:`check_angles`.
     """
-    scratch = np.empty((5, 6))
+    scratch = np.empty((SCRATCH_ROWS, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
     shared = positions.shape[0] == 1
