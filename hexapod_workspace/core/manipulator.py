@@ -166,7 +166,10 @@ def _directions(name: str, value: Any, what: str) -> NDArray[np.float64]:
             f"length ({rows[zero[0]].tolist()})"
         )
         raise GeometryError(msg)
-    unit: NDArray[np.float64] = rows / norms[:, None]
+    # Rows already of unit length to rounding are kept as given, so that a model written back
+    # by to_parameters reads as the same model.
+    scale = np.where(np.abs(norms - 1.0) <= 4e-16, 1.0, norms)
+    unit: NDArray[np.float64] = rows / scale[:, None]
     return unit
 
 
