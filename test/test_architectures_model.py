@@ -92,25 +92,40 @@ def test_leg_endpoints_close_the_legs(architecture, rng):
     np.testing.assert_allclose(base[solved], ra.base_points(reference, q)[solved], atol=1e-12)
 
 
-@pytest.mark.parametrize(
-    ("architecture", "section", "name", "value", "expected"),
-    [
-        ("pus", "geometry", "rail_directions", [0.0] * 18, "geometry.rail_directions: expected non-zero directions, the rail of leg 1 has zero length"),
-        ("rus", "geometry", "crank_zero_directions", [1.0, 0.0, 0.0] * 6, "geometry.crank_zero_directions: expected each perpendicular to its crank axis"),
-        ("pus", "geometry", "branch", [0], "geometry.branch: expected +1 or -1 for every leg, got 0 for leg 1"),
-        ("rus", "geometry", "branch", [1, 1, 1, 0.5, 1, 1], "geometry.branch: expected +1 or -1 for every leg, got 0.5 for leg 4"),
-        ("pus", "geometry", "leg_lengths", [0.2], "geometry.home_position: expected a pose every leg can reach, leg 1 has no inverse-kinematics solution"),
-        ("rus", "geometry", "leg_lengths", [2.0], "geometry.home_position: expected a pose every leg can reach, leg 1 has no inverse-kinematics solution"),
-        ("pus", "limits", "leg_length_min", [0.8], "limits.leg_length_min: a parameter of geometry.architecture ups, given for pus"),
-        ("rus", "geometry", "rail_directions", [1.0, 0.0, 0.0] * 6, "geometry.rail_directions: a parameter of geometry.architecture pus, given for rus"),
-        ("pus", "geometry", "crank_lengths", [0.1], "geometry.crank_lengths: a parameter of geometry.architecture rus, given for pus"),
-        ("pus", "geometry", "architecture", "prs", "geometry.architecture: expected one of ups, pus, rus, got 'prs'"),
-        ("rus", "limits", "actuator_max", [8.0], "limits.actuator_min: expected limits.actuator_min < limits.actuator_max < limits.actuator_min + 2 pi"),
-        ("pus", "limits", "actuator_max", [-0.5], "limits.actuator_min: expected < limits.actuator_max for every leg, got -0.45 >= -0.5 m for leg 1"),
-        ("pus", "limits", "transmission_min", 0.0, "limits.transmission_min: expected one value in (0, 1), got 0.0"),
-        ("rus", "geometry", "crank_lengths", [0.0], "geometry.crank_lengths: expected values > 0 m, got 0 for leg 1"),
-    ],
-)  # fmt: skip
+#: (architecture, section, parameter, bad value, what the one-line refusal says)
+REFUSALS = [
+    ("pus", "geometry", "rail_directions", [0.0] * 18,
+     "geometry.rail_directions: expected non-zero directions, the rail of leg 1 has zero length"),
+    ("rus", "geometry", "crank_zero_directions", [1.0, 0.0, 0.0] * 6,
+     "geometry.crank_zero_directions: expected each perpendicular to its crank axis"),
+    ("pus", "geometry", "branch", [0],
+     "geometry.branch: expected +1 or -1 for every leg, got 0 for leg 1"),
+    ("rus", "geometry", "branch", [1, 1, 1, 0.5, 1, 1],
+     "geometry.branch: expected +1 or -1 for every leg, got 0.5 for leg 4"),
+    ("pus", "geometry", "leg_lengths", [0.2],
+     "geometry.home_position: expected a pose every leg can reach, leg 1 has no inverse-kin"),
+    ("rus", "geometry", "leg_lengths", [2.0],
+     "geometry.home_position: expected a pose every leg can reach, leg 1 has no inverse-kin"),
+    ("pus", "limits", "leg_length_min", [0.8],
+     "limits.leg_length_min: a parameter of geometry.architecture ups, given for pus"),
+    ("rus", "geometry", "rail_directions", [1.0, 0.0, 0.0] * 6,
+     "geometry.rail_directions: a parameter of geometry.architecture pus, given for rus"),
+    ("pus", "geometry", "crank_lengths", [0.1],
+     "geometry.crank_lengths: a parameter of geometry.architecture rus, given for pus"),
+    ("pus", "geometry", "architecture", "prs",
+     "geometry.architecture: expected one of ups, pus, rus, got 'prs'"),
+    ("rus", "limits", "actuator_max", [8.0],
+     "limits.actuator_min: expected limits.actuator_min < limits.actuator_max < limits.actu"),
+    ("pus", "limits", "actuator_max", [-0.5],
+     "limits.actuator_min: expected < limits.actuator_max for every leg, got -0.45 >= -0.5 m"),
+    ("pus", "limits", "transmission_min", 0.0,
+     "limits.transmission_min: expected one value in (0, 1), got 0.0"),
+    ("rus", "geometry", "crank_lengths", [0.0],
+     "geometry.crank_lengths: expected values > 0 m, got 0 for leg 1"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("architecture", "section", "name", "value", "expected"), REFUSALS)
 def test_bad_architecture_parameters_are_refused_in_one_line(
     architecture, section, name, value, expected
 ):
