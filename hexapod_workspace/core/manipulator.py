@@ -31,7 +31,13 @@ from .params import (
 from .resolution import MAX_POSITION_NORM
 from .validation import coincident_joints_reason, require_usable, unusable_reason
 
-__all__ = ["ARCHITECTURE_PARAMETERS", "PARAMETER_DEFAULTS", "HomePoseWarning", "Manipulator"]
+__all__ = [
+    "ARCHITECTURE_PARAMETERS",
+    "PARAMETER_DEFAULTS",
+    "HomePoseWarning",
+    "Manipulator",
+    "required_parameters",
+]
 
 #: Parameters of the model with their defaults; ``None`` means required.
 PARAMETER_DEFAULTS: dict[str, Any] = {
@@ -104,6 +110,19 @@ _MODEL_GROUPS = ("geometry.", "limits.", "pose.")
 
 #: Every parameter that belongs to one architecture only.
 _SPECIFIC = frozenset(name for names in ARCHITECTURE_PARAMETERS.values() for name in names)
+
+
+def required_parameters(architecture: str) -> tuple[str, ...]:
+    """The model parameters a model of this architecture must be given (``pose.position``
+    excluded: it defaults to the home position), in :data:`PARAMETER_DEFAULTS` order."""
+    needed = set(_REQUIRED.get(architecture, ()))
+    return tuple(
+        name
+        for name, default in PARAMETER_DEFAULTS.items()
+        if name != "pose.position"
+        and name.startswith(_MODEL_GROUPS)
+        and (name in needed or (default is None and name not in _SPECIFIC))
+    )
 
 
 def _unset(value: Any) -> bool:

@@ -347,7 +347,10 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         if unknown is not None:
             raise ConfigError(f"unknown parameter given to the node: {unknown}")
         given = model_given(names)
-        missing = missing_model_parameters(given) if given else None
+        overrides = getattr(self, "_parameter_overrides", {})
+        chosen = overrides.get("geometry.architecture")
+        architecture = str(chosen.value) if chosen is not None else "ups"
+        missing = missing_model_parameters(given, architecture) if given else None
         if missing is not None:
             raise ConfigError(missing)
         declared: dict[str, Any] = {}

@@ -32,7 +32,13 @@ from rclpy.parameter import Parameter
 
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import resolution
-from hexapod_workspace.core.manipulator import PARAMETER_DEFAULTS, Manipulator
+from hexapod_workspace.core.architectures import ARCHITECTURES
+from hexapod_workspace.core.manipulator import (
+    ARCHITECTURE_PARAMETERS,
+    PARAMETER_DEFAULTS,
+    Manipulator,
+    required_parameters,
+)
 from hexapod_workspace.core.validation import require_usable
 from hexapod_workspace.errors import ConfigError
 
@@ -77,8 +83,8 @@ MODEL_DESCRIPTIONS = {
         "Axes of symmetry of the platform joints, mobile frame, pointing into the legs: 18 "
         "floats, or empty/unset = reversed leg directions at the home pose."
     ),
-    "limits.leg_length_min": "Minimum leg length |A_iB_i|, m: 1 value (all legs) or 6.",
-    "limits.leg_length_max": "Maximum leg length |A_iB_i|, m: 1 value (all legs) or 6.",
+    "limits.leg_length_min": "ups: minimum leg length |A_iB_i|, m: 1 value (all legs) or 6.",
+    "limits.leg_length_max": "ups: maximum leg length |A_iB_i|, m: 1 value (all legs) or 6.",
     "limits.base_joint_max_angle": (
         "Maximum angle between a base joint axis and its leg, rad, in (0, pi): 1 or 6 values."
     ),
@@ -95,11 +101,54 @@ MODEL_DESCRIPTIONS = {
     "pose.position": (
         "Default tool-tip position OC, base frame, m (3 floats): used by the Trigger services."
     ),
+    "geometry.architecture": (
+        "Leg architecture: ups (legs of variable length between fixed joints), pus (slides on "
+        "rails, legs of fixed length) or rus (cranks, rods of fixed length)."
+    ),
+    "geometry.rail_directions": (
+        "pus: direction u_i of each rail, base frame, 18 floats (normalised); "
+        "A_i(q) = A0_i + q u_i with A0_i = geometry.base_joints. Empty for ups and rus."
+    ),
+    "geometry.crank_axes": (
+        "rus: crank (motor) axis w_i through A0_i = geometry.base_joints, base frame, 18 floats "
+        "(normalised). Empty for ups and pus."
+    ),
+    "geometry.crank_zero_directions": (
+        "rus: crank direction e_i at q = 0, perpendicular to w_i, 18 floats (normalised). "
+        "Empty for ups and pus."
+    ),
+    "geometry.crank_lengths": "rus: crank length r_i, m: 1 value (all legs) or 6.",
+    "geometry.leg_lengths": "pus, rus: fixed leg (rod) length L_i, m: 1 value or 6.",
+    "geometry.branch": (
+        "pus, rus: assembly branch of each leg, +1 or -1: 1 value or 6 (empty = +1)."
+    ),
+    "limits.actuator_min": (
+        "pus: slide stroke minimum along the rail, m; rus: crank angle minimum, rad: 1 or 6."
+    ),
+    "limits.actuator_max": (
+        "pus: slide stroke maximum, m; rus: crank angle maximum, rad (max - min < 2 pi): 1 or 6."
+    ),
+    "limits.transmission_min": (
+        "pus, rus: smallest |tau_i| allowed (tau: the leg direction against the actuator's "
+        "motion), in (0, 1)."
+    ),
 }
 #: Ranges of the model's scalar parameters (the model validation says the same).
-_FLOAT_RANGES = {"limits.leg_diameter": (0.0, 10.0), "limits.singularity_min": (0.0, 1.0)}
+_FLOAT_RANGES = {
+    "limits.leg_diameter": (0.0, 10.0),
+    "limits.singularity_min": (0.0, 1.0),
+    "limits.transmission_min": (0.0, 1.0),
+}
 #: Axes that may be empty: an empty YAML list arrives as an unset parameter of any type.
 _OPTIONAL_AXES = ("geometry.base_joint_axes", "geometry.platform_joint_axes")
+#: Arrays that are empty for some architecture (the model refuses non-numbers): typed at run
+#: time, like the optional axes.
+_ARCHITECTURE_ARRAYS = tuple(
+    name
+    for names in ARCHITECTURE_PARAMETERS.values()
+    for name in names
+    if isinstance(PARAMETER_DEFAULTS[name], list) or PARAMETER_DEFAULTS[name] is None
+)
 
 
 @dataclass(frozen=True)
@@ -149,8 +198,12 @@ def parameter_specs() -> dict[str, Spec]:
             [] if name in _OPTIONAL_AXES else default,
             MODEL_DESCRIPTIONS[name],
             read_only=name == "frame_id",
-            dynamic_typing=name in _OPTIONAL_AXES,  # the model validation refuses non-numbers
+            # the model validation refuses non-numbers
+            dynamic_typing=name in _OPTIONAL_AXES or name in _ARCHITECTURE_ARRAYS,
             float_range=_FLOAT_RANGES.get(name),
+            constraints=(
+                f"one of: {', '.join(ARCHITECTURES)}" if name == "geometry.architecture" else ""
+            ),
         )
         for name, default in example.items()
     ]
@@ -377,18 +430,15 @@ def model_given(names: Iterable[str]) -> list[str]:
     return sorted({name for name in names if name.startswith(MODEL_GROUPS)})
 
 
-def missing_model_parameters(given: Iterable[str]) -> str | None:
+def missing_model_parameters(given: Iterable[str], architecture: str = "ups") -> str | None:
     """Why a start with model parameters ``given`` (non-empty) is refused, or None.
 
-    A node given any model parameter must be given every required one: the packaged example
-    never fills in the rest of a user's machine.
+    A node given any model parameter must be given every required one of its architecture
+    (``geometry.architecture`` as given, else ups): the packaged example never fills in the
+    rest of a user's machine.
     """
     given = set(given)
-    required = [
-        name
-        for name, default in PARAMETER_DEFAULTS.items()
-        if default is None and name.startswith(MODEL_GROUPS) and name != "pose.position"
-    ]
+    required = list(required_parameters(architecture))
     missing = [name for name in required if name not in given]
     if not missing:
         return None
@@ -406,6 +456,8 @@ def model_default(name: str, declared: dict[str, Any]) -> Any:
     ``pose.position`` = ``geometry.home_position``), not the packaged example's value."""
     if name == "pose.position":
         return list(declared["geometry.home_position"])
+    if name in _ARCHITECTURE_ARRAYS:
+        return []  # not this architecture's: left empty
     return PARAMETER_DEFAULTS[name]
 
 
