@@ -24,11 +24,11 @@ with the six coefficients of its row and the rates of the model's leg architectu
 * 6-UPS (fixed base joints A_i, leg length actuated): with ``ℓ_f`` a lower bound of every leg
   length, ``N = V/ℓ_f`` (``|dn| ≤ |dL|/ℓ``), ``Q = V`` (``|dℓ| ≤ |dL|``), ``K = 0``, ``E = V``;
 * 6-PUS and 6-RUS (legs of fixed length L_i, base-side end A_i(q) moving): with ``τ_f`` a lower
-  bound of every |τ_i| (row ``transmission``) over the interval, the base-side end moves at
+  bound of every ``|τ_i|`` (row ``transmission``) over the interval, the base-side end moves at
   ``W ≤ V/τ_f``: differentiating the leg closure ``|B − A(q)|² = L²`` gives
   ``n·dB = n·A'(q)·dq``, with ``n·A' = τ`` (pus: A' = u) or ``r·τ`` (rus: A' = w × (C − A0),
   of norm r), so ``|dq| ≤ V/|τ|`` (pus, m) or ``V/(r·|τ|)`` (rus, rad) and ``|dA| = |A'||dq|
-  ≤ V/|τ|``. Hence ``E = max(V, W) = V/τ_f`` (|τ| ≤ 1), ``Q = V/τ_f`` (pus) or
+  ≤ V/|τ|``. Hence ``E = max(V, W) = V/τ_f`` (as ``|τ| ≤ 1``), ``Q = V/τ_f`` (pus) or
   ``V/(r_min·τ_f)`` (rus), ``K = V/(r_min·τ_f)`` (rus; 0 for pus), and, since
   ``dn = (dB − dA)/L`` projected, ``N = V(1 + 1/τ_f)/L_min``.
 
@@ -60,13 +60,13 @@ smallest and largest distance from B_i to the crank circle, both 1-Lipschitz in 
 ``|ik|/V`` (the searches' recovery step where no other margin is defined).
 
 *Transmission floor.* The rates of the pus/rus rows depend on τ_f, which the searches obtain
-like the leg-length floor of 6-UPS: from the rate of |τ| itself, ``N + K`` with τ_f in it. Along
+like the leg-length floor of 6-UPS: from the rate of ``|τ|`` itself, ``N + K`` with τ_f in it. Along
 a ray from a feasible pose (:func:`~hexapod_workspace.core.search_kernels.certified_step`),
 τ_f = max(τ_lim, τ_now/2) and the step is limited to (τ_now − τ_f)/rate_τ(τ_f): the first
-point where |τ| fell to τ_f would contradict the rate that holds until then. Over an interval
+point where ``|τ|`` fell to τ_f would contradict the rate that holds until then. Over an interval
 [a, b] of a move (:mod:`~hexapod_workspace.core.path_certificate`), any τ_f ≤ min(τ(a), τ(b))
 with ``τ(a) + τ(b) − 2τ_f ≥ rate_τ(τ_f)·w`` holds: the stretches [a, a + (τ(a) − τ_f)/rate] and
-[b − (τ(b) − τ_f)/rate, b], on which |τ| ≥ τ_f by the same first-point argument, then cover the
+[b − (τ(b) − τ_f)/rate, b], on which ``|τ| ≥ τ_f`` by the same first-point argument, then cover the
 interval. That is a quadratic inequality in τ_f; the certificate takes the largest admissible
 value, and no floor (the rows that need one unbounded) when the interval may contain a pose
 without a solution (ik's lower bound < 0) or none is admissible.

@@ -1,7 +1,10 @@
 """Inverse kinematics, exact segment distance and the constraint margins, batched.
 
 Inverse kinematics of leg i (docs/theory.md, *Conventions*): ``L_i = p + R·b_i − a_i``, length
-``ℓ_i = |L_i|``, unit direction ``n_i = L_i / ℓ_i`` (from base joint A_i to platform joint B_i).
+``ℓ_i = |L_i|``, unit direction ``n_i = L_i / ℓ_i`` (from base joint A_i to platform joint B_i);
+:func:`inverse_kinematics` is that of the 6-UPS model. For 6-PUS and 6-RUS models the base-side
+end moves (:mod:`hexapod_workspace.core.architectures`,
+:func:`~hexapod_workspace.core.legs.leg_endpoints`).
 
 Each constraint has a signed margin, ≥ 0 when it holds and < 0 when it is violated; the
 constraints, their units, scales and rate bounds are the rows of

@@ -15,14 +15,26 @@ The rates are constant along the move and β = θ(s) is linear in [0, π], where
 so the maximum over the move is at an end: ``Ω = max over θ ∈ {θ₀, θ₁} of |ω|``.
 
 *Joint speed.* Platform joint i is at ``B_i(s) = p(s) + R(s)·b_i``, so
-``|dB_i/ds| = |Δp + ω × R b_i| ≤ |Δp| + Ω·ρ =: V`` with ρ = max_i |b_i|. The base joints
-A_i are fixed, so each leg vector ``L_i = B_i − A_i`` moves at most at V.
+``|dB_i/ds| = |Δp + ω × R b_i| ≤ |Δp| + Ω·ρ =: V`` with ρ = max_i |b_i|. For 6-UPS the base
+joints A_i are fixed, so each leg vector ``L_i = B_i − A_i`` moves at most at V; for 6-PUS and
+6-RUS the base-side end moves too, at most at V/τ_f with τ_f a lower bound of the transmission
+``|τ_i|`` over the interval (:mod:`hexapod_workspace.core.constraint_table`).
 
 *Margins.* With ``ℓ_f`` a lower bound on every leg length over the interval considered, each
 margin is Lipschitz in s with the rate of its row of
-:mod:`hexapod_workspace.core.constraint_table`, ``speed·V + turn·V/ℓ_f + spin·Ω`` (V for
-``leg_length``, V / ℓ_f for ``base_joint``, Ω + V / ℓ_f for ``platform_joint``, 2V for
-``leg_interference``; the derivations are written there).
+:mod:`hexapod_workspace.core.constraint_table`, ``speed·V + turn·N + spin·Ω + actuate·Q +
+crank·K + ends·E`` (for 6-UPS: V for ``leg_length``, V / ℓ_f for ``base_joint``, Ω + V / ℓ_f for
+``platform_joint``, 2V for ``leg_interference``; the derivations are written there).
+
+*Moving base joints (pus, rus).* The legs have fixed lengths (ℓ_f = min L_i) and the rates
+need a transmission floor τ_f. On an interval [a, b] of width w, ``|τ|`` changes at most at
+``rate_τ(τ_f) = V/L + V(1/L + c)/τ_f`` (c = 1/r_min for rus, 0 for pus) while ``|τ| ≥ τ_f``;
+any τ_f ≤ min(τ(a), τ(b)) with ``2τ_f ≤ τ(a) + τ(b) − rate_τ(τ_f)·w`` then holds on the whole
+interval (from each end, ``|τ|`` cannot reach τ_f before the two stretches meet). Multiplied by
+τ_f this is ``2τ_f² − S·τ_f + V·w(1/L + c) ≤ 0`` with ``S = τ(a) + τ(b) − V·w/L``: the
+certificate takes the larger root, capped at min(τ(a), τ(b)), when it is admissible and the
+``ik`` bound (rate V, no floor needed) shows every leg solvable on the interval; otherwise the
+bounds that need τ_f are −inf and the interval is split.
 
 *Interval certificate.* On an interval [a, b] of width w = b − a, with margins m(a), m(b) and
 constant L, ``m(s) ≥ max(m(a) − L(s − a), m(b) − L(b − s))`` whose minimum over the interval is

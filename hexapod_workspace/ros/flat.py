@@ -119,7 +119,12 @@ def attach(node: Any, name: str) -> Any:
         try:
             angles = angles_from_flat(request.angles, state.settings.max_poses)
             answer = flat_response(
-                check(state.manipulator, angles, position_from_point(request.position))
+                check(
+                    state.manipulator,
+                    angles,
+                    position_from_point(request.position),
+                    singularity=state.settings.report_singularity,
+                )
             )
         except InputError as error:
             answer = flat_response(None, message=str(error), names=names)

@@ -458,6 +458,7 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
                     state.manipulator,
                     angles_from_orientations(request.orientations),
                     position_from_point(request.position),
+                    singularity=state.settings.report_singularity,
                 )
                 return messages.check_poses_response_fields(result)
             except InputError as error:

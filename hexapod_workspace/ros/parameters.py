@@ -255,6 +255,14 @@ def parameter_specs() -> dict[str, Spec]:
             float_range=(0.0, 3600.0),
         ),
         Spec(
+            "check.report_singularity",
+            False,
+            "Report the singularity margin (sigma_min of the legs' Pluecker matrix) in the "
+            "answers of check_poses, check_poses_flat and the command stream even when "
+            "limits.singularity_min is 0 (then it never changes a verdict); false: null/+inf "
+            "there, at no cost.",
+        ),
+        Spec(
             "recording.enabled",
             True,
             "Record every request and result to an MCAP log (rosbag2 form); false stops.",
@@ -305,6 +313,7 @@ class Settings:
     projected_method: str
     max_poses: int
     max_command_age: float
+    report_singularity: bool
     recording_enabled: bool
     recording_directory: Path
     recording_rotation: Rotation
@@ -410,6 +419,7 @@ def state_from(values: dict[str, Any]) -> State:
         projected_method=method,
         max_poses=int(values["check.max_poses"]),
         max_command_age=age,
+        report_singularity=bool(values["check.report_singularity"]),
         recording_enabled=bool(values["recording.enabled"]),
         recording_directory=folder,
         recording_rotation=Rotation(

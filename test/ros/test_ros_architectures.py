@@ -1,7 +1,8 @@
 """workspace_node started with the 6-PUS and 6-RUS example files, over real Fast DDS from
 another process: it serves them (the margins by name of each architecture, ``ik`` violated and
-NaN margins where a leg has no solution), computes their workspaces, and refuses a file that
-mixes architectures, naming the parameter.
+NaN margins where a leg has no solution; the singularity margin reported on request with
+``check.report_singularity``), computes their workspaces, and refuses a file that mixes
+architectures, naming the parameter.
 """
 
 from __future__ import annotations
@@ -47,6 +48,11 @@ def params_text(architecture: str, directory: Path, **changes: object) -> str:
     return yaml.safe_dump(tree, sort_keys=False)
 
 
+def unsolved_legs(result) -> np.ndarray:
+    """Poses where some leg has no inverse-kinematics solution (NaN actuator margin)."""
+    return np.isnan(result.margins["actuator"])
+
+
 def check_request(angles: np.ndarray, position) -> CheckPoses.Request:
     request = CheckPoses.Request()
     request.position.x, request.position.y, request.position.z = (float(v) for v in position)
@@ -58,7 +64,7 @@ def check_request(angles: np.ndarray, position) -> CheckPoses.Request:
 
 @pytest.mark.parametrize("architecture", ["pus", "rus"])
 def test_node_serves_an_architecture_file(architecture, ros_domain, ros_client, tmp_path):
-    text = params_text(architecture, tmp_path)
+    text = params_text(architecture, tmp_path, **{"check.report_singularity": True})
     with running_node(tmp_path, params_text=text) as node:
         model = Manipulator.from_params_file(node.params_path)
         assert model.architecture == architecture
@@ -71,7 +77,8 @@ def test_node_serves_an_architecture_file(architecture, ros_domain, ros_client, 
                 rng.uniform(-0.6, 0.6, 200),
             ]
         )
-        expected = check(model, angles, model.position)
+        expected = check(model, angles, model.position, singularity=True)  # the node reports it
+        assert np.all(np.isfinite(expected.margins["singularity"]) | unsolved_legs(expected))
         assert np.any(np.isnan(expected.margins["actuator"])), "need poses without IK"
         response = ros_client.call(
             CheckPoses, f"{NODE}/check_poses", check_request(angles, model.position)
