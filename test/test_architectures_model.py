@@ -187,3 +187,58 @@ def test_cli_refuses_a_bad_architecture_file_with_exit_2(tmp_path):
     assert "geometry.branch: expected +1 or -1 for every leg, got 0 for leg 1" in one_error_line(
         err
     )
+
+
+@pytest.mark.parametrize("architecture", ["pus", "rus"])
+def test_rate_bounds_hold_along_moves(architecture, rng):
+    """Finite differences of every margin along dense moves stay below the rates derived in
+    the constraint table's documentation (written out here, not read from the table), with
+    τ_f the smallest |τ| met along the move: Q = V/τ_f (pus) or V/(r_min·τ_f) (rus),
+    K = V/(r_min·τ_f) (rus), N = V(1 + 1/τ_f)/L_min, E = V/τ_f."""
+    path = EXAMPLES[architecture]
+    model = Manipulator.from_mapping(
+        {**Manipulator.from_params_file(path).to_parameters(), "limits.singularity_min": 0.01},
+        warn=False,
+    )
+    rho = float(np.max(np.linalg.norm(model.platform_joints, axis=1)))
+    length = float(np.min(model.leg_lengths))
+    crank = 1.0 / float(np.min(model.crank_lengths)) if architecture == "rus" else 0.0
+    steps = 2001
+    s = np.linspace(0.0, 1.0, steps)
+    checked = 0
+    for _ in range(30):
+        a0 = np.array(
+            [rng.uniform(-math.pi, math.pi), rng.uniform(0, 0.35), rng.uniform(-0.4, 0.4)]
+        )
+        a1 = np.array(
+            [rng.uniform(-math.pi, math.pi), rng.uniform(0, 0.35), rng.uniform(-0.4, 0.4)]
+        )
+        p0 = model.position + rng.uniform(-0.04, 0.04, 3)
+        p1 = model.position + rng.uniform(-0.04, 0.04, 3)
+        angles = a0 + s[:, None] * (a1 - a0)
+        positions = p0 + s[:, None] * (p1 - p0)
+        rotations = tt_to_matrix(angles)
+        results = [check(model, angles[k], positions[k]).margins for k in range(steps)]
+        margins = {name: np.array([r[name][0] for r in results]) for name in MOVING_NAMES}
+        if np.any(np.isnan(margins["actuator"])):
+            continue  # a leg loses its solution on the way: no rate there
+        checked += 1
+        relative = np.einsum("nji,njk->nik", rotations[:-1], rotations[1:])
+        cosine = np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+        omega = np.arccos(cosine).max() * (steps - 1)
+        speed = np.linalg.norm(p1 - p0) + rho * omega
+        tau_f = float(np.min(margins["transmission"])) + model.transmission_min
+        turn = speed * (1.0 + 1.0 / tau_f) / length
+        bounds = {
+            "actuator": speed / tau_f * (crank if architecture == "rus" else 1.0),
+            "ik": speed,
+            "transmission": turn + speed * crank / tau_f,
+            "base_joint": turn + speed * crank / tau_f,
+            "platform_joint": turn + omega,
+            "leg_interference": 2.0 * speed / tau_f,
+            "singularity": math.sqrt(12.0) * (turn + omega),
+        }
+        for name, bound in bounds.items():
+            rate = np.abs(np.diff(margins[name])).max() * (steps - 1)
+            assert rate <= bound * (1 + 1e-3) + 1e-9, (name, rate, bound)
+    assert checked >= 10

@@ -124,27 +124,38 @@ def _certified_step_moving(model: NDArray[np.float64], out: NDArray[np.float64])
 
 @_helper
 def _recovery_step_moving(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
-    """recovery_step for pus/rus: a violated ``ik`` stays violated for |ik|/ρ (1-Lipschitz in
-    each B_i, which moves at ≤ ρ). Other violated margins count only where every leg has its q
-    (their margins are not NaN), with τ_f = τ_now/2 and the step kept within
-    (τ_now − τ_f)/rate_τ(τ_f) (|τ| stays above τ_f) and ik/ρ (every leg stays solvable, q
-    continuous): within that, the violated margin cannot climb back to zero."""
+    """recovery_step for pus/rus, the largest of three valid bounds:
+
+    * a violated ``ik`` stays violated for |ik|/ρ (1-Lipschitz in each B_i, which moves at ≤ ρ);
+    * a violated ``transmission`` (every leg solved, τ_now = min |τ_i| < τ_lim): to climb back
+      to τ_lim, |τ| must cross [τ_now, τ_lim] on a stretch where it stays ≥ τ_now, so the legs
+      stay solved (a leg loses its solution only through τ = 0: at ik = 0 the leg is tangent
+      to its actuator's locus) and its rate is at most rate_τ(τ_now): it stays violated for
+      (τ_lim − τ_now)/rate_τ(τ_now);
+    * another violated margin (every leg solved, τ_now > 0): with τ_f = τ_now/2 and the step
+      kept within (τ_now − τ_f)/rate_τ(τ_f), |τ| stays above τ_f (the legs stay solved, q is
+      continuous) and the margin cannot climb back to zero within |m_c|/rate_c(τ_f).
+
+    NaN margins (a leg without a solution) give no bound but ik's."""
     rho: float = model[RHO]
     recover = 0.0
     if out[IK] < 0.0:
         recover = -out[IK] / rho
     tau_now = out[TRANSMISSION] + model[TAU_MIN]
-    if tau_now > 0.0 and out[IK] >= 0.0:
+    if out[IK] >= 0.0 and tau_now > 0.0:
+        if out[TRANSMISSION] < 0.0:
+            climb = -out[TRANSMISSION] / _rate_moving(model, TRANSMISSION, tau_now)
+            if climb > recover:
+                recover = climb
         tau_f = 0.5 * tau_now
         other = 0.0
         for c in range(N_CONSTRAINTS):
-            if c == IK:
+            if c == IK or c == TRANSMISSION:
                 continue
             value = -out[c] / _rate_moving(model, c, tau_f) if out[c] < 0.0 else 0.0
             if value > other:
                 other = value
         other = min(other, (tau_now - tau_f) / _rate_moving(model, TRANSMISSION, tau_f))
-        other = min(other, out[IK] / rho)
         if other > recover:
             recover = other
     return recover * SAFETY
