@@ -150,7 +150,7 @@ def _recovery_step_moving(model: NDArray[np.float64], out: NDArray[np.float64]) 
         tau_f = 0.5 * tau_now
         other = 0.0
         for c in range(N_CONSTRAINTS):
-            if c == IK or c == TRANSMISSION:
+            if c == IK or c == TRANSMISSION:  # noqa: SIM109 - plain comparisons for numba
                 continue
             value = -out[c] / _rate_moving(model, c, tau_f) if out[c] < 0.0 else 0.0
             if value > other:
