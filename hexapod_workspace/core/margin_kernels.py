@@ -822,7 +822,12 @@ _PHI, _THETA, _PSI = 15, 16, 17
 _MIN = max(18, OUT_SHORTEST)  # 9 rows: running minima (below the outputs' rows), see below
 _LEGS = _MIN + 9  # 7 rows per leg, see the offsets below
 _SIGMA = _LEGS + 6 * 7  # σ_min − σ_lim of each pose (when the singularity margin is on)
-_BLOCK_ROWS = _SIGMA + 1
+# Moving base joints (pus, rus): the base-side end of each leg (3 rows per leg: x, y, z) and the
+# running minima of the architecture's own margins with their legs.
+_BASE = _SIGMA + 1
+_MOVE = _BASE + 18
+_M_ACT, _LEG_ACT, _M_IK, _LEG_IK, _M_TAU, _LEG_TAU = range(6)
+_BLOCK_ROWS = _MOVE + 6
 # Rows of the running minima (offsets from _MIN): margins or cosines and their leg or pair.
 _M_LEN, _LEG_LEN, _M_A, _LEG_A, _M_B, _LEG_B, _BEST, _PAIR, _FIX = range(9)
 # Rows of one leg (offsets from _LEGS + 7·k): vector, squared length, 1/ℓ², joint cosines.
@@ -833,6 +838,27 @@ _LX, _LY, _LZ, _SQ, _INV, _COS_A, _COS_B = range(7)
 def _planes(work: NDArray[np.float64], row: int, rows: int) -> NDArray[np.float64]:
     """The planes [row, row + rows) of a block scratch, as one flat view."""
     return work[row * BLOCK : (row + rows) * BLOCK]
+
+
+@_inline
+def _store_cosines(
+    leg: NDArray[np.float64],
+    minima: NDArray[np.float64],
+    n: int,
+    kf: float,
+    cos_a: float,
+    cos_b: float,
+) -> None:
+    """Pose n of leg planes: both joint cosines, and their running minima with the leg (first
+    leg on ties; one select per statement, so that the loops vectorise)."""
+    leg[_COS_A * BLOCK + n] = cos_a
+    leg[_COS_B * BLOCK + n] = cos_b
+    smallest = minima[_M_A * BLOCK + n]
+    minima[_LEG_A * BLOCK + n] = kf if cos_a < smallest else minima[_LEG_A * BLOCK + n]
+    minima[_M_A * BLOCK + n] = min(cos_a, smallest)
+    smallest = minima[_M_B * BLOCK + n]
+    minima[_LEG_B * BLOCK + n] = kf if cos_b < smallest else minima[_LEG_B * BLOCK + n]
+    minima[_M_B * BLOCK + n] = min(cos_b, smallest)
 
 
 # The leg and pair stages take their planes as separate views with constant row offsets inside:
@@ -882,16 +908,77 @@ def _leg_planes(
             + (r10 * jbx + r11 * jby + r12 * jbz) * y
             + (r20 * jbx + r21 * jby + r22 * jbz) * z
         ) * -inverse
-        leg[_COS_A * BLOCK + n] = cos_a
-        leg[_COS_B * BLOCK + n] = cos_b
-        smallest = minima[_M_A * BLOCK + n]
-        minima[_LEG_A * BLOCK + n] = kf if cos_a < smallest else minima[_LEG_A * BLOCK + n]
-        minima[_M_A * BLOCK + n] = min(cos_a, smallest)
-        smallest = minima[_M_B * BLOCK + n]
-        minima[_LEG_B * BLOCK + n] = kf if cos_b < smallest else minima[_LEG_B * BLOCK + n]
-        minima[_M_B * BLOCK + n] = min(cos_b, smallest)
+        _store_cosines(leg, minima, n, kf, cos_a, cos_b)
         degenerate = 0.0 if squared > 1e-300 else 1.0
         minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], degenerate)
+
+
+@_inline
+def _pair_squared(
+    rx: float,
+    ry: float,
+    rz: float,
+    rr: float,
+    xi: float,
+    yi: float,
+    zi: float,
+    xj: float,
+    yj: float,
+    zj: float,
+    a: float,
+    e: float,
+    inverse_i: float,
+    inverse_j: float,
+) -> tuple[float, float]:
+    """Squared distance of two leg segments A_i + s·L_i, A_j + t·L_j (r = A_i − A_j, rr = |r|²,
+    a = |L_i|², e = |L_j|², inverse_* = 1/|L|²) by Ericson's clamped closest points, and 1.0
+    when the segments are parallel or point-like (for the exact path), else 0.0."""
+    b = xi * xj + yi * yj + zi * zj
+    c = xi * rx + yi * ry + zi * rz
+    f = xj * rx + yj * ry + zj * rz
+    denom = a * e - b * b
+    s = min(max((b * f - c * e) / denom, 0.0), 1.0)
+    t = min(max((b * s + f) * inverse_j, 0.0), 1.0)
+    s = min(max((b * t - c) * inverse_i, 0.0), 1.0)
+    squared = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
+    return squared, (0.0 if denom > 1e-14 * a * e else 1.0)
+
+
+@_inline
+def _pair_at(
+    leg_i: NDArray[np.float64],
+    leg_j: NDArray[np.float64],
+    minima: NDArray[np.float64],
+    n: int,
+    rx: float,
+    ry: float,
+    rz: float,
+    rr: float,
+    pf: float,
+) -> None:
+    """Pose n of a pair plane: the segment distance of legs i and j (r = A_i − A_j) into the
+    running minimum and its pair (first pair on ties), parallel or point-like legs flagged."""
+    squared, regular = _pair_squared(
+        rx,
+        ry,
+        rz,
+        rr,
+        leg_i[_LX * BLOCK + n],
+        leg_i[_LY * BLOCK + n],
+        leg_i[_LZ * BLOCK + n],
+        leg_j[_LX * BLOCK + n],
+        leg_j[_LY * BLOCK + n],
+        leg_j[_LZ * BLOCK + n],
+        leg_i[_SQ * BLOCK + n],
+        leg_j[_SQ * BLOCK + n],
+        leg_i[_INV * BLOCK + n],
+        leg_j[_INV * BLOCK + n],
+    )
+    distance = math.sqrt(max(squared, 0.0))
+    smallest = minima[_BEST * BLOCK + n]
+    minima[_PAIR * BLOCK + n] = pf if distance < smallest else minima[_PAIR * BLOCK + n]
+    minima[_BEST * BLOCK + n] = min(distance, smallest)
+    minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], regular)
 
 
 @_helper
@@ -911,23 +998,135 @@ def _pair_plane(
     rz = model[RPAIR + 3 * pair + 2]
     rr, pf = model[RR + pair], float(pair)
     for n in range(count):
-        xi, yi, zi = leg_i[_LX * BLOCK + n], leg_i[_LY * BLOCK + n], leg_i[_LZ * BLOCK + n]
-        xj, yj, zj = leg_j[_LX * BLOCK + n], leg_j[_LY * BLOCK + n], leg_j[_LZ * BLOCK + n]
-        a, e = leg_i[_SQ * BLOCK + n], leg_j[_SQ * BLOCK + n]
-        b = xi * xj + yi * yj + zi * zj
-        c = xi * rx + yi * ry + zi * rz
-        f = xj * rx + yj * ry + zj * rz
-        denom = a * e - b * b
-        s = min(max((b * f - c * e) / denom, 0.0), 1.0)
-        t = min(max((b * s + f) * leg_j[_INV * BLOCK + n], 0.0), 1.0)
-        s = min(max((b * t - c) * leg_i[_INV * BLOCK + n], 0.0), 1.0)
-        squared = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
-        distance = math.sqrt(max(squared, 0.0))
-        smallest = minima[_BEST * BLOCK + n]
-        minima[_PAIR * BLOCK + n] = pf if distance < smallest else minima[_PAIR * BLOCK + n]
-        minima[_BEST * BLOCK + n] = min(distance, smallest)
-        regular = 0.0 if denom > 1e-14 * a * e else 1.0
-        minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], regular)
+        _pair_at(leg_i, leg_j, minima, n, rx, ry, rz, rr, pf)
+
+
+@_helper
+def _pair_plane_moving(
+    leg_i: NDArray[np.float64],
+    leg_j: NDArray[np.float64],
+    base_i: NDArray[np.float64],
+    base_j: NDArray[np.float64],
+    minima: NDArray[np.float64],
+    count: int,
+    pair: int,
+) -> None:
+    """:func:`_pair_plane` for moving base joints: r = A_i − A_j per pose, from the base-end
+    planes (x, y, z rows of each leg)."""
+    pf = float(pair)
+    for n in range(count):
+        rx = base_i[n] - base_j[n]
+        ry = base_i[BLOCK + n] - base_j[BLOCK + n]
+        rz = base_i[2 * BLOCK + n] - base_j[2 * BLOCK + n]
+        _pair_at(leg_i, leg_j, minima, n, rx, ry, rz, rx * rx + ry * ry + rz * rz, pf)
+
+
+@_helper
+def _leg_planes_moving(
+    model: NDArray[np.float64],
+    rotation: NDArray[np.float64],
+    leg: NDArray[np.float64],
+    base: NDArray[np.float64],
+    minima: NDArray[np.float64],
+    moves: NDArray[np.float64],
+    count: int,
+    k: int,
+    px: float,
+    py: float,
+    pz: float,
+) -> None:
+    """Leg k of a pus or rus model over a block: the inverse kinematics of
+    :func:`_pose_moving` (the same closed forms), the base-side end into ``base`` (x, y, z
+    rows), the leg vector, squared length, 1/ℓ² and joint cosines into ``leg``, the running
+    minima of both cosines, of ``actuator``, ``ik`` and ``transmission`` with their legs (first
+    leg on ties); a leg without a solution flags the pose for the exact path (NaN margins)."""
+    bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
+    ox, oy, oz = model[A + 3 * k], model[A + 3 * k + 1], model[A + 3 * k + 2]
+    ux, uy, uz = model[RAIL + 3 * k], model[RAIL + 3 * k + 1], model[RAIL + 3 * k + 2]
+    ex, ey, ez = model[ZERO + 3 * k], model[ZERO + 3 * k + 1], model[ZERO + 3 * k + 2]
+    fx, fy, fz = model[CROSS + 3 * k], model[CROSS + 3 * k + 1], model[CROSS + 3 * k + 2]
+    j0x, j0y, j0z = model[JA + 3 * k], model[JA + 3 * k + 1], model[JA + 3 * k + 2]
+    cx, cy, cz = (
+        model[AXIS_CROSS + 3 * k],
+        model[AXIS_CROSS + 3 * k + 1],
+        model[AXIS_CROSS + 3 * k + 2],
+    )
+    gx, gy, gz = (
+        model[AXIS_ALONG + 3 * k],
+        model[AXIS_ALONG + 3 * k + 1],
+        model[AXIS_ALONG + 3 * k + 2],
+    )
+    jbx, jby, jbz = model[JB + 3 * k], model[JB + 3 * k + 1], model[JB + 3 * k + 2]
+    length, branch, crank = model[LEG + k], model[BRANCH + k], model[CRANK + k]
+    qmin, qmax, centre = model[QMIN + k], model[QMAX + k], model[QCENTRE + k]
+    tau_min, kf = model[TAU_MIN], float(k)
+    rus = model[ARCH] == 2.0
+    for n in range(count):
+        r00, r01, r02 = rotation[n], rotation[BLOCK + n], rotation[2 * BLOCK + n]
+        r10, r11, r12 = rotation[3 * BLOCK + n], rotation[4 * BLOCK + n], rotation[5 * BLOCK + n]
+        r20, r21, r22 = rotation[6 * BLOCK + n], rotation[7 * BLOCK + n], rotation[8 * BLOCK + n]
+        platform_x = (r00 * bx + r01 * by + r02 * bz) + px
+        platform_y = (r10 * bx + r11 * by + r12 * bz) + py
+        platform_z = (r20 * bx + r21 * by + r22 * bz) + pz
+        dx, dy, dz = platform_x - ox, platform_y - oy, platform_z - oz
+        along = ux * dx + uy * dy + uz * dz
+        hx, hy, hz = dx - along * ux, dy - along * uy, dz - along * uz
+        h = math.sqrt(hx * hx + hy * hy + hz * hz)
+        if rus:
+            a = 2.0 * crank * (dx * ex + dy * ey + dz * ez)
+            b = 2.0 * crank * (dx * fx + dy * fy + dz * fz)
+            c = (dx * dx + dy * dy + dz * dz) + crank * crank - length * length
+            ik = min(length - math.hypot(along, h - crank), math.hypot(along, h + crank) - length)
+            norm = math.hypot(a, b)
+            ratio = min(max(c / norm, -1.0), 1.0) if norm > 0.0 else 1.0
+            shifted = math.atan2(b, a) + branch * math.acos(ratio) - centre + math.pi
+            q = centre + (shifted - 2.0 * math.pi * math.floor(shifted / (2.0 * math.pi))) - math.pi
+            cq, sq_ = math.cos(q), math.sin(q)
+            base_x = ox + crank * (cq * ex + sq_ * fx)
+            base_y = oy + crank * (cq * ey + sq_ * fy)
+            base_z = oz + crank * (cq * ez + sq_ * fz)
+            tx, ty, tz = cq * fx - sq_ * ex, cq * fy - sq_ * ey, cq * fz - sq_ * ez
+            jx = cq * j0x + sq_ * cx + (1.0 - cq) * gx
+            jy = cq * j0y + sq_ * cy + (1.0 - cq) * gy
+            jz = cq * j0z + sq_ * cz + (1.0 - cq) * gz
+        else:
+            ik = length - h
+            q = along + branch * math.sqrt(max(ik * (length + h), 0.0))
+            base_x, base_y, base_z = ox + q * ux, oy + q * uy, oz + q * uz
+            tx, ty, tz = ux, uy, uz
+            jx, jy, jz = j0x, j0y, j0z
+        x, y, z = platform_x - base_x, platform_y - base_y, platform_z - base_z
+        base[n] = base_x
+        base[BLOCK + n] = base_y
+        base[2 * BLOCK + n] = base_z
+        leg[_LX * BLOCK + n] = x
+        leg[_LY * BLOCK + n] = y
+        leg[_LZ * BLOCK + n] = z
+        squared = x * x + y * y + z * z
+        leg[_SQ * BLOCK + n] = squared
+        inverse = 1.0 / math.sqrt(squared)
+        leg[_INV * BLOCK + n] = inverse * inverse
+        cos_a = (jx * x + jy * y + jz * z) * inverse
+        cos_b = (
+            (r00 * jbx + r01 * jby + r02 * jbz) * x
+            + (r10 * jbx + r11 * jby + r12 * jbz) * y
+            + (r20 * jbx + r21 * jby + r22 * jbz) * z
+        ) * -inverse
+        _store_cosines(leg, minima, n, kf, cos_a, cos_b)
+        value = min(q - qmin, qmax - q)
+        smallest = moves[_M_ACT * BLOCK + n]
+        moves[_LEG_ACT * BLOCK + n] = kf if value < smallest else moves[_LEG_ACT * BLOCK + n]
+        moves[_M_ACT * BLOCK + n] = min(value, smallest)
+        smallest = moves[_M_IK * BLOCK + n]
+        moves[_LEG_IK * BLOCK + n] = kf if ik < smallest else moves[_LEG_IK * BLOCK + n]
+        moves[_M_IK * BLOCK + n] = min(ik, smallest)
+        value = abs(tx * x + ty * y + tz * z) * inverse - tau_min
+        smallest = moves[_M_TAU * BLOCK + n]
+        moves[_LEG_TAU * BLOCK + n] = kf if value < smallest else moves[_LEG_TAU * BLOCK + n]
+        moves[_M_TAU * BLOCK + n] = min(value, smallest)
+        # Unsolved (ik < 0 or NaN), a NaN coordinate or a zero-length leg: the exact path.
+        unusable = 0.0 if (ik >= 0.0 and q == q and squared > 1e-300) else 1.0
+        minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], unusable)
 
 
 @_helper
@@ -951,14 +1150,7 @@ def _check_block(
     in 8..9 (as floats).
     """
     px, py, pz = position[0], position[1], position[2]
-    if model[ARCH] != 0.0:
-        # Moving base joints (pus, rus): every pose through the scalar kernel.
-        for n in range(count):
-            _tt_matrix(angles[first + n, 0], angles[first + n, 1], angles[first + n, 2], r)
-            _pose(model, r, px, py, pz, scratch, out, True)
-            for slot in range(OUT_SHORTEST):
-                work[slot * BLOCK + n] = out[slot]
-        return
+    moving = model[ARCH] != 0.0
     for n in range(count):  # strided reads: a loop of its own (it does not vectorise)
         work[_PHI * BLOCK + n] = angles[first + n, 0]
         work[_THETA * BLOCK + n] = angles[first + n, 1]
@@ -995,8 +1187,31 @@ def _check_block(
         work[(_R + 8) * BLOCK + n] = cb
     rotation = _planes(work, _R, 9)
     minima = _planes(work, _MIN, 9)
+    moves = _planes(work, _MOVE, 6)
+    if moving:
+        for n in range(count):
+            for row in (_M_ACT, _M_IK, _M_TAU):
+                moves[row * BLOCK + n] = np.inf
+                moves[(row + 1) * BLOCK + n] = 0.0
     for k in range(6):
-        _leg_planes(model, rotation, _planes(work, _LEGS + 7 * k, 7), minima, count, k, px, py, pz)
+        if moving:
+            _leg_planes_moving(
+                model,
+                rotation,
+                _planes(work, _LEGS + 7 * k, 7),
+                _planes(work, _BASE + 3 * k, 3),
+                minima,
+                moves,
+                count,
+                k,
+                px,
+                py,
+                pz,
+            )
+        else:
+            _leg_planes(
+                model, rotation, _planes(work, _LEGS + 7 * k, 7), minima, count, k, px, py, pz
+            )
     interference = model[INTERFERENCE] != 0.0
     if interference:
         pair = 0
@@ -1004,7 +1219,18 @@ def _check_block(
             for j in range(i + 1, 6):
                 leg_i = _planes(work, _LEGS + 7 * i, 7)
                 leg_j = _planes(work, _LEGS + 7 * j, 7)
-                _pair_plane(model, leg_i, leg_j, minima, count, pair)
+                if moving:
+                    _pair_plane_moving(
+                        leg_i,
+                        leg_j,
+                        _planes(work, _BASE + 3 * i, 3),
+                        _planes(work, _BASE + 3 * j, 3),
+                        minima,
+                        count,
+                        pair,
+                    )
+                else:
+                    _pair_plane(model, leg_i, leg_j, minima, count, pair)
                 pair += 1
     singular = model[SINGULARITY_ON] != 0.0
     if singular:
@@ -1019,8 +1245,12 @@ def _check_block(
             for slot in range(OUT_SHORTEST):
                 work[(slot) * BLOCK + n] = out[slot]
             continue
-        work[LEG_LENGTH * BLOCK + n] = work[(_MIN + _M_LEN) * BLOCK + n]
-        work[(OUT_LEG + LEG_LENGTH) * BLOCK + n] = work[(_MIN + _LEG_LEN) * BLOCK + n]
+        if moving:
+            work[LEG_LENGTH * BLOCK + n] = np.inf
+            work[(OUT_LEG + LEG_LENGTH) * BLOCK + n] = 0.0
+        else:
+            work[LEG_LENGTH * BLOCK + n] = work[(_MIN + _M_LEN) * BLOCK + n]
+            work[(OUT_LEG + LEG_LENGTH) * BLOCK + n] = work[(_MIN + _LEG_LEN) * BLOCK + n]
         if alpha_equal:
             work[BASE_JOINT * BLOCK + n] = model[ALPHA] - math.acos(
                 min(max(work[(_MIN + _M_A) * BLOCK + n], -1.0), 1.0)
@@ -1052,9 +1282,10 @@ def _check_block(
             work[(OUT_PAIR + 1) * BLOCK + n] = 0.0
         work[SINGULARITY * BLOCK + n] = work[_SIGMA * BLOCK + n] if singular else np.inf
         work[(OUT_LEG + SINGULARITY) * BLOCK + n] = 0.0
-        for row in (ACTUATOR, IK, TRANSMISSION):  # rows of the moving-base architectures
-            work[row * BLOCK + n] = np.inf
-            work[(OUT_LEG + row) * BLOCK + n] = 0.0
+        # Rows of the moving-base architectures (+inf where they do not apply).
+        for row, slot in ((ACTUATOR, _M_ACT), (IK, _M_IK), (TRANSMISSION, _M_TAU)):
+            work[row * BLOCK + n] = moves[slot * BLOCK + n] if moving else np.inf
+            work[(OUT_LEG + row) * BLOCK + n] = moves[(slot + 1) * BLOCK + n] if moving else 0.0
 
 
 @_helper
