@@ -430,11 +430,14 @@ def check(
     if not angles.flags.writeable:
         angles = angles.copy()
 
-    margins = np.empty((N_CONSTRAINTS, count))
-    ints = np.empty((N_CONSTRAINTS + 2, count), dtype=np.int64)
+    model = kernels.model_vector(manipulator, report_singularity=singularity)
+    # Only the rows up to the last one that applies (6-UPS: 5 of the table's rows): the others
+    # are +inf for every pose, and allocating them would cost more than the check itself.
+    used = int(model[kernels.ROWS_USED])
+    margins = np.empty((used, count))
+    ints = np.empty((used + 2, count), dtype=np.int64)
     pairs = np.empty((count, 2), dtype=np.int64)
     reachable = np.empty(count, dtype=np.bool_)
-    model = kernels.model_vector(manipulator, report_singularity=singularity)
     outputs = (margins, ints, pairs, reachable)
     workers = _cores() if count >= PARALLEL_POSES else 1
     if workers == 1:
@@ -452,13 +455,15 @@ def check(
     if status == -2:  # not reached: validate_position refused it above
         msg = f"position: expected 3 finite values (x, y, z) in m, got {position.tolist()}"
         raise InputError(msg)
-    legs = ints[:N_CONSTRAINTS]
+    legs = ints[:used]
     rows = applicable(manipulator)
-    limiting_constraint, limiting_leg = ints[N_CONSTRAINTS], ints[N_CONSTRAINTS + 1]
+    limiting_constraint, limiting_leg = ints[used], ints[used + 1]
     if singularity and manipulator.singularity_min == 0.0:
         # Reported, not enforced: the singularity margin never limits a pose. The limiting
         # constraint is the one with the smallest relative margin among the others.
-        relative = relative_margins(manipulator, margins)
+        full = np.full((N_CONSTRAINTS, count), np.inf)
+        full[:used] = margins
+        relative = relative_margins(manipulator, full)
         relative[SINGULARITY] = np.inf
         relative = np.where(np.isnan(relative), -np.inf, relative)  # NaN is violated
         limiting_constraint = np.argmin(relative, axis=0).astype(np.int64)

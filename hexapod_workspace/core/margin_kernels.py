@@ -58,6 +58,7 @@ from .model_layout import (
     QMIN,
     RAIL,
     RHO,
+    ROWS_USED,
     RPAIR,
     RR,
     SCALE,
@@ -1320,7 +1321,9 @@ def check_angles(
 ) -> int:
     """Check poses ``angles[start:stop]`` (N, 3) of T&T angles (rad) at ``position`` (3,), m.
 
-    Writes, for each pose n in [start, stop): ``margins[:, n]`` (C, N) with C = N_CONSTRAINTS;
+    Writes, for each pose n in [start, stop): ``margins[:, n]`` (C, N) with C the rows in use
+    (``model[ROWS_USED]``: the rows after the last one that applies to the model are +inf for
+    every pose and not written; the arrays may have more rows);
     ``ints[:C, n]`` (C + 2, N), the 1-based leg with the smallest margin of each constraint,
     ``ints[C, n]`` the constraint with the smallest relative margin and ``ints[C + 1, n]`` its
     leg; ``pairs[n]`` (N, 2), the
@@ -1349,6 +1352,7 @@ def check_angles(
     r = np.empty(9)
     work = np.empty(_BLOCK_ROWS * BLOCK)
     enabled = 1 if model[INTERFERENCE] != 0.0 else 0
+    used = int(model[ROWS_USED])
     for first in range(start, stop, BLOCK):
         count = min(BLOCK, stop - first)
         _check_block(model, angles, position, first, count, work, scratch, out, r)
@@ -1356,6 +1360,7 @@ def check_angles(
             n = first + m
             for c in range(N_CONSTRAINTS):
                 out[c] = work[c * BLOCK + m]
+            for c in range(used):
                 margins[c, n] = out[c]
                 ints[c, n] = int(work[(OUT_LEG + c) * BLOCK + m]) + 1
             ints[LEG_INTERFERENCE, n] *= enabled
@@ -1363,8 +1368,8 @@ def check_angles(
             pairs[n, 0] = (int(work[OUT_PAIR * BLOCK + m]) + 1) * enabled
             pairs[n, 1] = (int(work[(OUT_PAIR + 1) * BLOCK + m]) + 1) * enabled
             worst = _limiting_constraint(model, out)
-            ints[N_CONSTRAINTS, n] = worst
-            ints[N_CONSTRAINTS + 1, n] = ints[worst, n]
+            ints[used, n] = worst
+            ints[used + 1, n] = ints[worst, n] if worst < used else 0
             reachable[n] = _feasible(out)
     return -1
 

@@ -13,12 +13,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .architectures import CODES
-from .constraint_table import CONSTRAINTS, N_CONSTRAINTS, scales
+from .constraint_table import CONSTRAINTS, N_CONSTRAINTS, applicable, scales
 
 if TYPE_CHECKING:
     from .manipulator import Manipulator
 
-__all__ = ["MODEL_SIZE", "PAIR_I", "PAIR_J", "model_vector"]
+__all__ = ["MODEL_SIZE", "PAIR_I", "PAIR_J", "ROWS_USED", "model_vector"]
 
 # ------------------------------------------------------------------------------ model layout
 # Offsets into the model vector. Per-leg 3-vectors are stored leg-major (x, y, z of leg 0, ...).
@@ -66,7 +66,10 @@ TAU_MIN = QCENTRE + 6  # limits.transmission_min
 # Rates along the rays for pus/rus (constraint_table): with τ_f a lower bound of |τ_i|,
 # rate = RAY_CONSTANT + RAY_TURN·(1 + 1/τ_f)/LENGTH_FLOOR + RAY_DRIVE/τ_f.
 RAY_DRIVE = TAU_MIN + 1  # (actuate·g + crank/r_min + ends)·ρ, g = 1 (pus) or 1/r_min (rus)
-MODEL_SIZE = RAY_DRIVE + N_CONSTRAINTS
+# Rows of the table the batch check writes: 1 + the last row that applies to the model (the
+# rows after it are +inf for every pose; check() neither allocates nor fills them).
+ROWS_USED = RAY_DRIVE + N_CONSTRAINTS
+MODEL_SIZE = ROWS_USED + 1
 
 #: Leg pairs (i < j) in the order of numpy.triu_indices(6, 1).
 PAIR_I = np.array([i for i in range(6) for j in range(i + 1, 6)], dtype=np.int64)
@@ -153,6 +156,7 @@ def model_vector(manipulator: Manipulator, report_singularity: bool = False) -> 
                 + model[RAY_TURN + c] * (1.0 + 1.0 / tau) / model[LENGTH_FLOOR]
                 + model[RAY_DRIVE + c] / tau
             )
+    model[ROWS_USED] = max(applicable(manipulator)) + 1
     model[SINGULARITY_MIN] = manipulator.singularity_min
     model[SINGULARITY_ON] = 1.0 if manipulator.singularity_min > 0.0 or report_singularity else 0.0
     model.setflags(write=False)
