@@ -242,3 +242,29 @@ def test_rate_bounds_hold_along_moves(architecture, rng):
             rate = np.abs(np.diff(margins[name])).max() * (steps - 1)
             assert rate <= bound * (1 + 1e-3) + 1e-9, (name, rate, bound)
     assert checked >= 10
+
+
+@pytest.mark.parametrize("singularity_min", [0.0, 0.05])
+@pytest.mark.parametrize("architecture", ["pus", "rus"])
+def test_batch_check_equals_the_one_pose_kernel(architecture, singularity_min, rng):
+    """The vectorised block path (legs without a solution included: NaN margins, the first
+    unsolved leg) gives exactly what the one-pose kernel gives."""
+    from hexapod_workspace.core.constraint_table import INDEX
+    from hexapod_workspace.core.constraints import check_pose
+
+    base = Manipulator.from_params_file(EXAMPLES[architecture]).to_parameters()
+    model = Manipulator.from_mapping({**base, "limits.singularity_min": singularity_min})
+    angles = np.column_stack(
+        [rng.uniform(-math.pi, math.pi, 800), rng.uniform(0, 0.9, 800), rng.uniform(-1, 1, 800)]
+    )
+    batch = check(model, angles, model.position)
+    unsolved = np.isnan(batch.margins["actuator"])
+    assert 0.05 < unsolved.mean() < 0.95
+    for k in range(len(angles)):
+        one = check_pose(model, *angles[k], model.position)
+        for name in batch.margins:
+            np.testing.assert_equal(batch.margins[name][k], one.margins[INDEX[name]], name)
+            assert batch.limiting_legs[name][k] == one.limiting_legs[INDEX[name]], name
+        assert tuple(batch.limiting_pair[k]) == one.limiting_pair
+        assert bool(batch.reachable[k]) == one.reachable
+        assert batch.limiting_constraint[k] == one.limiting_constraint

@@ -672,8 +672,11 @@ def _block_singularity(
     """The singularity margin of the poses of a block that take the vectorised path (the
     others are computed whole by :func:`_pose`) into the _SIGMA row, from the leg and rotation
     planes (before the outputs overwrite the rotation planes)."""
+    moving = model[ARCH] != 0.0  # pus/rus poses with an unsolved leg: NaN, not computed
     for n in range(count):
-        if work[(_MIN + _FIX) * BLOCK + n] != 0.0:
+        if work[(_MIN + _FIX) * BLOCK + n] != 0.0 or (
+            moving and work[(_MOVE + _UNSOLVED) * BLOCK + n] != 0.0
+        ):
             continue
         for k in range(6):
             leg = (_LEGS + 7 * k) * BLOCK + n
@@ -827,8 +830,9 @@ _SIGMA = _LEGS + 6 * 7  # σ_min − σ_lim of each pose (when the singularity m
 # running minima of the architecture's own margins with their legs.
 _BASE = _SIGMA + 1
 _MOVE = _BASE + 18
-_M_ACT, _LEG_ACT, _M_IK, _LEG_IK, _M_TAU, _LEG_TAU = range(6)
-_BLOCK_ROWS = _MOVE + 6
+# _UNSOLVED: 1.0 when some leg has no inverse-kinematics solution; _UNSOLVED_LEG: the first.
+_M_ACT, _LEG_ACT, _M_IK, _LEG_IK, _M_TAU, _LEG_TAU, _UNSOLVED, _UNSOLVED_LEG = range(8)
+_BLOCK_ROWS = _MOVE + 8
 # Rows of the running minima (offsets from _MIN): margins or cosines and their leg or pair.
 _M_LEN, _LEG_LEN, _M_A, _LEG_A, _M_B, _LEG_B, _BEST, _PAIR, _FIX = range(9)
 # Rows of one leg (offsets from _LEGS + 7·k): vector, squared length, 1/ℓ², joint cosines.
@@ -1126,8 +1130,42 @@ def _leg_planes_moving(
         moves[_LEG_TAU * BLOCK + n] = kf if value < smallest else moves[_LEG_TAU * BLOCK + n]
         moves[_M_TAU * BLOCK + n] = min(value, smallest)
         # Unsolved (ik < 0 or NaN), a NaN coordinate or a zero-length leg: the exact path.
-        unusable = 0.0 if (ik >= 0.0 and q == q and squared > 1e-300) else 1.0
+        # A leg without a solution: its margins are NaN (the outputs, below); a NaN coordinate
+        # of a solved leg or a zero-length leg: the exact path.
+        unsolved = 0.0 if ik >= 0.0 else 1.0
+        first = moves[_UNSOLVED * BLOCK + n] == 0.0 and unsolved != 0.0
+        moves[_UNSOLVED_LEG * BLOCK + n] = kf if first else moves[_UNSOLVED_LEG * BLOCK + n]
+        moves[_UNSOLVED * BLOCK + n] = max(moves[_UNSOLVED * BLOCK + n], unsolved)
+        unusable = 0.0 if ((q == q or unsolved != 0.0) and squared > 1e-300) else 1.0
         minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], unusable)
+
+
+@_helper
+def _unsolved_outputs(
+    work: NDArray[np.float64],
+    moves: NDArray[np.float64],
+    n: int,
+    singular: bool,
+    interference: bool,
+) -> None:
+    """Outputs of pose n of a pus/rus block where some leg has no inverse-kinematics solution,
+    as :func:`_pose_moving` gives them: ``ik`` and its leg; NaN, with the first unsolved leg,
+    for every margin that needs the legs' coordinates; ``leg_length`` +inf; ``singularity`` and
+    ``leg_interference`` NaN when evaluated (+inf otherwise), leg and pair 0."""
+    leg = moves[_UNSOLVED_LEG * BLOCK + n]
+    for c in range(N_CONSTRAINTS):
+        work[c * BLOCK + n] = np.nan
+        work[(OUT_LEG + c) * BLOCK + n] = leg
+    work[LEG_LENGTH * BLOCK + n] = np.inf
+    work[(OUT_LEG + LEG_LENGTH) * BLOCK + n] = 0.0
+    work[IK * BLOCK + n] = moves[_M_IK * BLOCK + n]
+    work[(OUT_LEG + IK) * BLOCK + n] = moves[_LEG_IK * BLOCK + n]
+    work[SINGULARITY * BLOCK + n] = np.nan if singular else np.inf
+    work[(OUT_LEG + SINGULARITY) * BLOCK + n] = 0.0
+    work[LEG_INTERFERENCE * BLOCK + n] = np.nan if interference else np.inf
+    work[(OUT_LEG + LEG_INTERFERENCE) * BLOCK + n] = 0.0
+    work[OUT_PAIR * BLOCK + n] = 0.0
+    work[(OUT_PAIR + 1) * BLOCK + n] = 0.0
 
 
 @_helper
@@ -1191,8 +1229,8 @@ def _check_block(
     moves = _planes(work, _MOVE, 6)
     if moving:
         for n in range(count):
-            for row in (_M_ACT, _M_IK, _M_TAU):
-                moves[row * BLOCK + n] = np.inf
+            for row in (_M_ACT, _M_IK, _M_TAU, _UNSOLVED):
+                moves[row * BLOCK + n] = 0.0 if row == _UNSOLVED else np.inf
                 moves[(row + 1) * BLOCK + n] = 0.0
     for k in range(6):
         if moving:
@@ -1245,6 +1283,9 @@ def _check_block(
             _pose(model, r, px, py, pz, scratch, out, True)
             for slot in range(OUT_SHORTEST):
                 work[(slot) * BLOCK + n] = out[slot]
+            continue
+        if moving and moves[_UNSOLVED * BLOCK + n] != 0.0:
+            _unsolved_outputs(work, moves, n, singular, interference)
             continue
         if moving:
             work[LEG_LENGTH * BLOCK + n] = np.inf
