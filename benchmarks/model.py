@@ -8,8 +8,10 @@ architecture), extracted with ``git archive`` and imported as ``hexapod_workspac
 are the best of several runs on one core (the machine is shared). Printed: per-pose time of a
 batch check, one-pose check, the exact projected workspace, the orientation workspace and a
 toolpath check, for the packaged 6-UPS example; the ratio is baseline time / new time (≥ 1:
-not slower). Then the cost of an enforced singularity margin (new code, limit 0.3 against 0):
-enforced time / free time.
+not slower). Then the leg architectures: the same figures for the packaged 6-PUS and 6-RUS
+examples against the 6-UPS one (new code, same run; ratio pus or rus time / ups time). Then the
+cost of an enforced singularity margin (new code, limit 0.3 against 0): enforced time / free
+time.
 
 Usage: python benchmarks/model.py [--poses N]
 """
@@ -44,6 +46,8 @@ def figures(package, check_one, poses: np.ndarray) -> dict[str, float]:
     # limits.singularity_min, 0 here).
     parameters = new.Manipulator.from_params_file(example_config_path()).to_parameters()
     parameters.pop("limits.singularity_min")
+    known = package.core.manipulator.PARAMETER_DEFAULTS  # the leg-architecture keys are newer
+    parameters = {name: value for name, value in parameters.items() if name in known}
     machine = package.Manipulator.from_mapping(parameters)
     rng = np.random.default_rng(3)
     waypoints = POSITION + rng.normal(scale=0.05, size=(200, 3))
@@ -85,6 +89,39 @@ def singularity_figures(poses: np.ndarray) -> list[tuple[str, float, float]]:
     return rows
 
 
+def architecture_figures(poses: np.ndarray) -> list[tuple[str, float, float, float]]:
+    """(figure, ups, pus, rus seconds), new code, each packaged example at its home position
+    (the same random orientations; a different share of them is reachable on each machine)."""
+    config = example_config_path().parent
+    machines = [
+        new.Manipulator.from_params_file(config / name)
+        for name in ("example_gpm.yaml", "example_pus.yaml", "example_rus.yaml")
+    ]
+    rows = []
+    for name, run, scale in (
+        ("check, per pose", lambda m: new.check(m, poses, m.position), poses.shape[0]),
+        (
+            "check_pose, per call",
+            lambda m: check_pose(m, 0.3, 0.2, 0.1, m.position),
+            1,
+        ),
+        (
+            "projected exact (360 rays)",
+            lambda m: new.projected_workspace(m, m.position, method="exact"),
+            1,
+        ),
+    ):
+        if name.startswith("check_pose"):
+            times = [per_call(functools.partial(run, m)) for m in machines]
+        else:
+            times = [
+                min(best_of(5, functools.partial(run, m)) for _ in range(2)) / scale
+                for m in machines
+            ]
+        rows.append((name, *times))
+    return rows
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--poses", type=int, default=200_000)
@@ -114,6 +151,14 @@ def main() -> None:
         print(
             f"  {name:<32} {now * scale:>9.3f} {unit} {before * scale:>9.3f} {unit}"
             f" {before / now:>7.3f}"
+        )
+    print("leg architectures, new code, each example at its home position (ratio to ups):")
+    print(f"  {'figure':<32} {'ups':>12} {'pus':>12} {'rus':>12} {'pus/ups':>8} {'rus/ups':>8}")
+    for name, ups, pus, rus in architecture_figures(poses):
+        unit, scale = ("µs", 1e6) if ups < 1e-3 else ("ms", 1e3)
+        print(
+            f"  {name:<32} {ups * scale:>9.3f} {unit} {pus * scale:>9.3f} {unit}"
+            f" {rus * scale:>9.3f} {unit} {pus / ups:>8.2f} {rus / ups:>8.2f}"
         )
     print("singularity margin enforced (limit 0.3) against free (limit 0), new code:")
     print(f"  {'figure':<32} {'free':>12} {'enforced':>12} {'ratio':>7}")

@@ -30,6 +30,13 @@ EXAMPLES = {"ups": "example_gpm.yaml", "pus": "example_pus.yaml", "rus": "exampl
 OFFSETS = {"ups": (0.2, 0.2, 0.35), "pus": (0.15, -0.08, 0.06), "rus": (0.04, 0.03, 0.02)}
 TOLERANCE = 1e-6  # rad: boundary tolerance asked of the package
 GRID = 1e-3  # rad: the reference's sampling step
+#: Waypoint cone of the move test, (tilt, |torsion|) in rad: a little wider than each example's
+#: workspace, so that about half the waypoints are reachable.
+WAYPOINTS = {
+    "ups": (math.radians(45.0), 0.6),
+    "pus": (math.radians(35.0), 0.6),
+    "rus": (math.radians(22.0), 0.35),
+}
 
 
 def machines(architecture: str):
@@ -43,7 +50,7 @@ def reachable(model: ra.ReferenceModel, angles, position) -> np.ndarray:
     return ra.evaluate(model, np.asarray(angles, dtype=float), position).reachable
 
 
-@pytest.mark.parametrize("architecture", ["ups"])
+@pytest.mark.parametrize("architecture", ["ups", "pus", "rus"])
 def test_projected_boundaries_against_reference_sampling(architecture):
     manipulator, model, positions = machines(architecture)
     for position in positions:
@@ -66,7 +73,7 @@ def test_projected_boundaries_against_reference_sampling(architecture):
         assert np.all(exact.theta >= 0.0)
 
 
-@pytest.mark.parametrize("architecture", ["ups"])
+@pytest.mark.parametrize("architecture", ["ups", "pus", "rus"])
 def test_torsion_ranges_against_reference_sampling(architecture):
     manipulator, model, positions = machines(architecture)
     psi = np.linspace(-math.pi, math.pi, math.ceil(2 * math.pi / GRID) + 1)
@@ -96,7 +103,7 @@ def interpolate(angles0, angles1, position0, position1, s):
     return angles0 + s * delta, position0 + s * (np.asarray(position1) - position0)
 
 
-@pytest.mark.parametrize("architecture", ["ups"])
+@pytest.mark.parametrize("architecture", ["ups", "pus", "rus"])
 def test_certified_moves_against_reference_sampling(architecture):
     manipulator, model, positions = machines(architecture)
     rng = np.random.default_rng(1717)
@@ -104,11 +111,12 @@ def test_certified_moves_against_reference_sampling(architecture):
     # out of a reachable waypoint into an unreachable one locate a first violation, and the
     # moves between reachable ones are mostly certified ok.
     count = 40
+    tilt, torsion = WAYPOINTS[architecture]
     angles = np.column_stack(
         [
             rng.uniform(-math.pi, math.pi, count),
-            rng.uniform(math.radians(2.0), math.radians(45.0), count),
-            rng.uniform(-0.6, 0.6, count),
+            rng.uniform(math.radians(2.0), tilt, count),
+            rng.uniform(-torsion, torsion, count),
         ]
     )
     points = positions[0] + rng.uniform(-0.06, 0.06, (count, 3))

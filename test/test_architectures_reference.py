@@ -1,11 +1,11 @@
 """The package's ``check`` against the plain-numpy reference (test/reference_arch.py), per leg
 architecture, over at least 10⁵ random poses each: the packaged example of each architecture
-(10⁵ poses over six positions) and one variant with per-leg limits, explicit joint axes and
-architecture-specific changes (4·10⁴ more poses). Runs for 6-UPS on this branch; pus and rus
-join when the package has the pus and rus leg architectures.
+(10⁵ poses over six positions) and one variant with per-leg limits, explicit joint axes, an
+enforced singularity margin and architecture-specific changes (4·10⁴ more poses).
 
 Written against the planned public contract only: ``Manipulator.from_params_file`` reads
-the architecture keys; ``check(manipulator, angles, position)`` returns ``margins`` by name
+the architecture keys; ``check(manipulator, angles, position, singularity=True)`` (σ_min
+reported even where not enforced) returns ``margins`` by name
 (``leg_length`` for ups, ``actuator`` for pus/rus, ``ik``, ``transmission``, ``base_joint``,
 ``platform_joint``, ``leg_interference``, ``singularity``), shape (N,), NaN where undefined,
 ``reachable`` and ``violated`` by name.
@@ -54,8 +54,8 @@ def document(path: Path) -> dict[str, Any]:
 
 
 def variant_document(architecture: str, rng: np.random.Generator) -> dict[str, Any]:
-    """The example with six different values per limit, explicit (tilted) joint axes and, per
-    architecture, a less regular geometry."""
+    """The example with six different values per limit, explicit (tilted) joint axes, an
+    enforced singularity margin and, per architecture, a less regular geometry."""
     path = CONFIG / EXAMPLES[architecture]
     tree = document(path)
     parameters = tree["hexapod_workspace"]["ros__parameters"]
@@ -78,6 +78,7 @@ def variant_document(architecture: str, rng: np.random.Generator) -> dict[str, A
         geometry["rail_directions"] = rails.ravel().tolist()
     if architecture == "rus":
         geometry["crank_lengths"] = (reference.crank_lengths * (1.0 + 0.05 * spread)).tolist()
+    limits["singularity_min"] = 0.05
     limits["base_joint_max_angle"] = (0.75 + 0.05 * spread).tolist()
     limits["platform_joint_max_angle"] = (0.75 - 0.05 * spread).tolist()
     tilt = rng.uniform(-0.15, 0.15, (2, 6, 3))
@@ -106,7 +107,7 @@ def disagreements(
 ) -> list[str]:
     """Every difference between the package and the reference on these poses, one line each
     (pose, margin, both values)."""
-    result = check(manipulator, angles, position)
+    result = check(manipulator, angles, position, singularity=True)
     reference = ra.evaluate(reference_model, angles, position)
     lines: list[str] = []
 
@@ -219,7 +220,7 @@ def check_mix(counts: dict[str, int]) -> None:
     assert counts["ties"] <= 1e-4 * counts["poses"], counts
 
 
-@pytest.mark.parametrize("architecture", ["ups"])
+@pytest.mark.parametrize("architecture", ["ups", "pus", "rus"])
 def test_packaged_example_agrees_with_the_reference(architecture):
     rng = np.random.default_rng({"ups": 1701, "pus": 1702, "rus": 1703}[architecture])
     counts = run(architecture, CONFIG / EXAMPLES[architecture], rng, EXAMPLE_POSES)
@@ -229,11 +230,12 @@ def test_packaged_example_agrees_with_the_reference(architecture):
         assert counts["no ik"] > 0, counts
 
 
-@pytest.mark.parametrize("architecture", ["ups"])
+@pytest.mark.parametrize("architecture", ["ups", "pus", "rus"])
 def test_variant_agrees_with_the_reference(architecture, tmp_path):
     rng = np.random.default_rng({"ups": 1711, "pus": 1712, "rus": 1713}[architecture])
     path = tmp_path / f"variant_{architecture}.yaml"
     path.write_text(yaml.safe_dump(variant_document(architecture, rng)), encoding="utf-8")
     counts = run(f"{architecture} variant", path, rng, VARIANT_POSES)
     assert counts["poses"] >= 39_996
+    assert counts["compared singularity"] > 0.5 * (counts["poses"] - counts["no ik"]), counts
     check_mix(counts)

@@ -8,9 +8,13 @@ import numpy as np
 import pytest
 from reference import pose_margins_literal, segment_distance_literal
 
-from hexapod_workspace import CONSTRAINT_NAMES, InputError, Manipulator, check
+from hexapod_workspace import InputError, Manipulator, check
 from hexapod_workspace.core.constraints import inverse_kinematics, pose_margins, segment_distance
 from hexapod_workspace.core.rotations import tt_to_matrix
+
+#: The 6-UPS model's constraints (the rows of the table that apply to it), as before the leg
+#: architectures: ``check`` gives exactly these names for a 6-UPS manipulator.
+CONSTRAINT_NAMES = ("leg_length", "base_joint", "platform_joint", "leg_interference", "singularity")
 
 
 def brute_segment_distance(p0, p1, q0, q1, samples: int = 4001) -> float:

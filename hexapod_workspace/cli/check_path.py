@@ -24,7 +24,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core.baseline import psi_zero_baseline, reported_baseline
-from ..core.constraints import CONSTRAINT_NAMES
 from ..core.manipulator import Manipulator
 from ..core.paths import (
     DEFAULT_PATH_TOLERANCE,
@@ -169,7 +168,8 @@ def path_to_json(
     waypoints, segments = path.waypoints, path.segments
     angles_deg = np.degrees(waypoints.angles) if degrees is None else degrees
     violated = waypoints.violated
-    margins = {name: waypoints.margins[name].tolist() for name in CONSTRAINT_NAMES}
+    names = list(waypoints.margins)  # the constraints of the model's architecture
+    margins = {name: waypoints.margins[name].tolist() for name in names}
     document: dict[str, Any] = {
         "ok": bool(path.ok and (plan is None or plan.ok)),
         "planned_torsion": plan is not None,
@@ -184,7 +184,7 @@ def path_to_json(
                 "psi_deg": float(angles_deg[k, 2]),
                 "reachable": bool(waypoints.reachable[k]),
                 "violated": violated[k],
-                "margins": {name: _number(margins[name][k]) for name in CONSTRAINT_NAMES},
+                "margins": {name: _number(margins[name][k]) for name in names},
                 "limiting_leg": int(waypoints.limiting_leg[k]),
                 "relative_margin": _number(waypoints.relative[k]),
             }

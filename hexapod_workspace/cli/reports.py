@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core.constraint_table import CONSTRAINTS, SINGULARITY
-from ..core.constraints import CONSTRAINT_NAMES, CheckResult
+from ..core.constraints import CheckResult
 from ..core.orientation import OrientationWorkspace, TorsionRange
 from ..core.projected import ProjectedWorkspace
 from ..core.resolution import WorkspaceKind
@@ -88,17 +88,16 @@ def check_json(result: CheckResult, out: IO[str], degrees: NDArray[np.float64]) 
     """
     texts: dict[tuple[str, ...], str] = {}
     violated = [texts.setdefault(tuple(v), json.dumps(v)) for v in result.violated]
-    finite = {name: bool(np.all(np.isfinite(result.margins[name]))) for name in CONSTRAINT_NAMES}
+    names = list(result.margins)  # the constraints of the model's architecture, table order
+    finite = {name: bool(np.all(np.isfinite(result.margins[name]))) for name in names}
     margins = [
         result.margins[name].tolist()
         if finite[name]
         else ["null" if not math.isfinite(v) else repr(v) for v in result.margins[name].tolist()]
-        for name in CONSTRAINT_NAMES
+        for name in names
     ]
     # 12 significant digits: exact to 1e-12 relative, and twice as fast to format as repr().
-    margin_fields = ", ".join(
-        f'"{name}": {"%.12g" if finite[name] else "%s"}' for name in CONSTRAINT_NAMES
-    )
+    margin_fields = ", ".join(f'"{name}": {"%.12g" if finite[name] else "%s"}' for name in names)
     template = (
         '{"phi_deg": %.12g, "theta_deg": %.12g, "psi_deg": %.12g, "reachable": %s, "violated": %s, '
         f'"margins": {{{margin_fields}}}, "limiting_leg": %d}}'
@@ -128,7 +127,10 @@ def check_table(result: CheckResult, out: IO[str], degrees: NDArray[np.float64])
     shown = [
         row
         for row in CONSTRAINTS
-        if row is not CONSTRAINTS[SINGULARITY] or not np.all(np.isposinf(result.margins[row.name]))
+        if row.name in result.margins
+        and (
+            row is not CONSTRAINTS[SINGULARITY] or not np.all(np.isposinf(result.margins[row.name]))
+        )
     ]
     names = " ".join(f"{row.column:>11}" for row in shown)
     units = " ".join(f"{'[' + row.report_unit + ']':>11}" for row in shown)

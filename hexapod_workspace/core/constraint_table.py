@@ -11,38 +11,80 @@ Rate bounds
 Along a ray or a move, parametrised by s, every platform joint moves at most at ``V`` (m per
 unit s) and the platform turns at most at ``Ω`` (rad per unit s): along the rays of
 :mod:`~hexapod_workspace.core.search` ``V = ρ`` and ``Ω = 1`` (ρ = max_i |b_i|), along a move
-of :mod:`~hexapod_workspace.core.path_certificate` ``V = |Δp| + ρ·Ω``. With ``ℓ_f`` a lower
-bound of every leg length over the interval considered, the margin of each constraint changes
-at most at
+of :mod:`~hexapod_workspace.core.path_certificate` ``V = |Δp| + ρ·Ω``. The margin of each
+constraint changes at most at
 
-    |dm/ds| ≤ speed·V + turn·V/ℓ_f + spin·Ω
+    |dm/ds| ≤ speed·V + turn·N + spin·Ω + actuate·Q + crank·K + ends·E
 
-with the three coefficients of its row (a minimum of Lipschitz functions keeps the constant;
-the angle between two unit vectors changes at most at the sum of their turning rates):
+with the six coefficients of its row and the rates of the model's leg architecture
+(:mod:`~hexapod_workspace.core.architectures`) over the interval considered:
 
-==================== ===== ===== ===== =======================================================
-constraint           speed turn  spin  why
-==================== ===== ===== ===== =======================================================
-``leg_length``       1     0     0     |dℓ_i/ds| ≤ |dL_i/ds| ≤ V (the base joints A_i are fixed)
-``base_joint``       0     1     0     |dn_i/ds| ≤ |dL_i/ds| / ℓ_i; jA_i is fixed
-``platform_joint``   0     1     1     R·jB_i turns at Ω, n_i at ≤ V / ℓ_f
-``leg_interference`` 2     0     0     each segment A_iB_i moves by ≤ V (Hausdorff), two move
-``singularity``      0     √12   √12   Weyl's inequality, below
-==================== ===== ===== ===== =======================================================
+* N bounds how fast a unit leg direction n_i turns, Q how fast an actuated coordinate q_i
+  changes, K how fast a crank turns (rad), E how fast a leg end moves;
+* 6-UPS (fixed base joints A_i, leg length actuated): with ``ℓ_f`` a lower bound of every leg
+  length, ``N = V/ℓ_f`` (``|dn| ≤ |dL|/ℓ``), ``Q = V`` (``|dℓ| ≤ |dL|``), ``K = 0``, ``E = V``;
+* 6-PUS and 6-RUS (legs of fixed length L_i, base-side end A_i(q) moving): with ``τ_f`` a lower
+  bound of every ``|τ_i|`` (row ``transmission``) over the interval, the base-side end moves at
+  ``W ≤ V/τ_f``: differentiating the leg closure ``|B − A(q)|² = L²`` gives
+  ``n·dB = n·A'(q)·dq``, with ``n·A' = τ`` (pus: A' = u) or ``r·τ`` (rus: A' = w × (C − A0),
+  of norm r), so ``|dq| ≤ V/|τ|`` (pus, m) or ``V/(r·|τ|)`` (rus, rad) and ``|dA| = |A'||dq|
+  ≤ V/|τ|``. Hence ``E = max(V, W) = V/τ_f`` (as ``|τ| ≤ 1``), ``Q = V/τ_f`` (pus) or
+  ``V/(r_min·τ_f)`` (rus), ``K = V/(r_min·τ_f)`` (rus; 0 for pus), and, since
+  ``dn = (dB − dA)/L`` projected, ``N = V(1 + 1/τ_f)/L_min``.
+
+A minimum of Lipschitz functions keeps the constant; the angle between two unit vectors changes
+at most at the sum of their turning rates:
+
+==================== ===== ===== ===== ======= ===== ==== =========================================
+constraint           speed turn  spin  actuate crank ends why
+==================== ===== ===== ===== ======= ===== ==== =========================================
+``leg_length``       1     0     0     0       0     0    6-UPS: |dℓ_i/ds| ≤ |dL_i/ds| ≤ V
+``base_joint``       0     1     0     0       1     0    n_i turns at N; jA_i is fixed (ups), moves
+                                                          with the slide (pus) or turns with the
+                                                          crank at K (rus)
+``platform_joint``   0     1     1     0       0     0    R·jB_i turns at Ω, n_i at ≤ N
+``leg_interference`` 0     0     0     0       0     2    each segment's ends move by ≤ E
+                                                          (Hausdorff), two segments move
+``singularity``      0     √12   √12   0       0     0    Weyl's inequality, below
+``actuator``         0     0     0     1       0     0    pus/rus: |dq_i| ≤ Q
+``ik``               1     0     0     0       0     0    pus/rus: 1-Lipschitz in B_i (below)
+``transmission``     0     1     0     0       1     0    pus: τ = n·u, |dτ| ≤ |dn|; rus: τ = n·t,
+                                                          t the crank end's unit velocity turning
+                                                          at |dq|, |dτ| ≤ N + K
+==================== ===== ===== ===== ======= ===== ==== =========================================
+
+*ik.* pus: ``ik_i = L_i − h_i`` with h_i the distance from B_i to the rail line, a
+1-Lipschitz function of B_i. rus: ``ik_i = min(L − d_min, d_max − L)`` with d_min, d_max the
+smallest and largest distance from B_i to the crank circle, both 1-Lipschitz in B_i. So
+``|d ik/ds| ≤ V`` whether or not the legs have a solution; a violated ``ik`` stays violated for
+``|ik|/V`` (the searches' recovery step where no other margin is defined).
+
+*Transmission floor.* The rates of the pus/rus rows depend on τ_f, which the searches obtain
+like the leg-length floor of 6-UPS: from the rate of ``|τ|`` itself, ``N + K`` with τ_f in it. Along
+a ray from a feasible pose (:func:`~hexapod_workspace.core.search_kernels.certified_step`),
+τ_f = max(τ_lim, τ_now/2) and the step is limited to (τ_now − τ_f)/rate_τ(τ_f): the first
+point where ``|τ|`` fell to τ_f would contradict the rate that holds until then. Over an interval
+[a, b] of a move (:mod:`~hexapod_workspace.core.path_certificate`), any τ_f ≤ min(τ(a), τ(b))
+with ``τ(a) + τ(b) − 2τ_f ≥ rate_τ(τ_f)·w`` holds: the stretches [a, a + (τ(a) − τ_f)/rate] and
+[b − (τ(b) − τ_f)/rate, b], on which ``|τ| ≥ τ_f`` by the same first-point argument, then cover the
+interval. That is a quadratic inequality in τ_f; the certificate takes the largest admissible
+value, and no floor (the rows that need one unbounded) when the interval may contain a pose
+without a solution (ik's lower bound < 0) or none is admissible.
 
 *Singularity.* ``singularity = σ_min(M) − σ_lim`` (σ_lim = ``limits.singularity_min``), M the
 6×6 matrix with rows ``r_i = (n_iᵀ, ((R·b_i) × n_i)ᵀ / ρ)``: the unit leg lines in Plücker
 coordinates, the moment homogenised by ρ = max_i |b_i| (b_i as written in
 ``geometry.platform_joints``). By Weyl's inequality for singular values,
 ``|σ_min(M(s)) − σ_min(M(s'))| ≤ ‖M(s) − M(s')‖₂ ≤ ∫ ‖dM/ds‖_F``, so the rate of σ_min is
-at most ‖dM/ds‖_F. Per row, with ``|dn_i/ds| ≤ V/ℓ_f`` (as for ``base_joint``) and
-``d(R·b_i)/ds = ω × R·b_i`` of norm ≤ Ω·|b_i| ≤ Ω·ρ:
+at most ‖dM/ds‖_F. Per row, with ``|dn_i/ds| ≤ N`` and ``d(R·b_i)/ds = ω × R·b_i`` of norm
+≤ Ω·|b_i| ≤ Ω·ρ:
 
-    |d n_i/ds| ≤ V/ℓ_f,
-    |d((R·b_i) × n_i)/ds| / ρ ≤ (|ω × R·b_i| + |R·b_i|·|dn_i/ds|) / ρ ≤ Ω + V/ℓ_f,
+    |d n_i/ds| ≤ N,
+    |d((R·b_i) × n_i)/ds| / ρ ≤ (|ω × R·b_i| + |R·b_i|·|dn_i/ds|) / ρ ≤ Ω + N,
 
-so ``|dr_i/ds|² ≤ a² + (a + Ω)² ≤ 2(a + Ω)²`` with a = V/ℓ_f, and over the six rows
-``‖dM/ds‖_F ≤ √6·√2·(V/ℓ_f + Ω) = √12·(V/ℓ_f + Ω)``: turn = spin = √12. With σ_lim = 0 the
+so ``|dr_i/ds|² ≤ N² + (N + Ω)² ≤ 2(N + Ω)²`` and over the six rows
+``‖dM/ds‖_F ≤ √6·√2·(N + Ω) = √12·(N + Ω)``: turn = spin = √12 (the same for every
+architecture: M depends on the base-side ends only through n_i). With σ_lim = 0 the
 margin is not evaluated (+inf: free, never limiting) unless a caller asks for it as a report,
 where it is σ_min itself (≥ 0, so it never makes a pose unreachable).
 
@@ -64,17 +106,21 @@ if TYPE_CHECKING:
     from .manipulator import Manipulator
 
 __all__ = [
+    "ACTUATOR",
     "BASE_JOINT",
     "CONSTRAINTS",
     "CONSTRAINT_NAMES",
+    "IK",
     "INDEX",
     "LEG_INTERFERENCE",
     "LEG_LENGTH",
     "N_CONSTRAINTS",
     "PLATFORM_JOINT",
     "SINGULARITY",
+    "TRANSMISSION",
     "Constraint",
     "applicable",
+    "constraint_names",
     "rate_bounds",
     "scales",
 ]
@@ -106,12 +152,17 @@ class Constraint:
     scale_text : str
         What the scale is, in words.
     speed, turn, spin : float
-        Rate coefficients: ``|dm/ds| ≤ speed·V + turn·V/ℓ_f + spin·Ω`` (module documentation).
+        Rate coefficients of V, N (the leg direction's turning rate: V/ℓ_f for ups) and Ω
+        (module documentation).
     applies : callable
         ``applies(manipulator)``: whether the constraint exists for this model (a leg-length
         stroke exists only where legs change length, a collision margin only where bodies are
         declared). Where it does not, the kernels hold +inf in its row (never limiting) and the
         interfaces that list margins by name leave it out (:func:`applicable`).
+    actuate, crank, ends : float
+        Rate coefficients of Q (the actuated coordinate's rate), K (the crank's turning rate,
+        rus) and E (the fastest leg end): the full rate is
+        ``speed·V + turn·N + spin·Ω + actuate·Q + crank·K + ends·E`` (module documentation).
     """
 
     name: str
@@ -127,6 +178,31 @@ class Constraint:
     turn: float
     spin: float
     applies: Callable[[Manipulator], bool] = lambda manipulator: True
+    actuate: float = 0.0
+    crank: float = 0.0
+    ends: float = 0.0
+
+
+def _moving_base(manipulator: Manipulator) -> bool:
+    return manipulator.architecture != "ups"
+
+
+def _fixed_base(manipulator: Manipulator) -> bool:
+    return manipulator.architecture == "ups"
+
+
+def _half_actuator_range(manipulator: Manipulator) -> float:
+    if manipulator.actuator_min is None or manipulator.actuator_max is None:
+        return 1.0
+    return float(np.mean(manipulator.actuator_max - manipulator.actuator_min)) / 2.0
+
+
+def _mean_leg_length(manipulator: Manipulator) -> float:
+    return float(np.mean(manipulator.leg_length_max))
+
+
+def _transmission_scale(manipulator: Manipulator) -> float:
+    return 1.0 - manipulator.transmission_min
 
 
 def _half_stroke(manipulator: Manipulator) -> float:
@@ -168,6 +244,7 @@ CONSTRAINTS: tuple[Constraint, ...] = (
         speed=1.0,
         turn=0.0,
         spin=0.0,
+        applies=_fixed_base,
     ),
     Constraint(
         name="base_joint",
@@ -182,6 +259,7 @@ CONSTRAINTS: tuple[Constraint, ...] = (
         speed=0.0,
         turn=1.0,
         spin=0.0,
+        crank=1.0,
     ),
     Constraint(
         name="platform_joint",
@@ -207,9 +285,10 @@ CONSTRAINTS: tuple[Constraint, ...] = (
         report_factor=1e3,
         scale=_diameter,
         scale_text="the leg diameter D (1 m when the check is disabled)",
-        speed=2.0,
+        speed=0.0,
         turn=0.0,
         spin=0.0,
+        ends=2.0,
     ),
     Constraint(
         name="singularity",
@@ -225,6 +304,53 @@ CONSTRAINTS: tuple[Constraint, ...] = (
         turn=SQRT12,
         spin=SQRT12,
     ),
+    Constraint(
+        name="actuator",
+        unit="m or rad",
+        margin="min_i min(q_i − qmin_i, qmax_i − q_i): slide stroke (pus, m), crank (rus, rad)",
+        label="actuator",
+        column="actuator",
+        report_unit="m or rad",
+        report_factor=1.0,
+        scale=_half_actuator_range,
+        scale_text="half the mean actuator range (qmax − qmin)/2",
+        speed=0.0,
+        turn=0.0,
+        spin=0.0,
+        applies=_moving_base,
+        actuate=1.0,
+    ),
+    Constraint(
+        name="ik",
+        unit="m",
+        margin="min_i: how far L_i lies inside the distances from B_i to its actuator's locus",
+        label="inverse kinematics",
+        column="ik",
+        report_unit="mm",
+        report_factor=1e3,
+        scale=_mean_leg_length,
+        scale_text="the mean leg length L",
+        speed=1.0,
+        turn=0.0,
+        spin=0.0,
+        applies=_moving_base,
+    ),
+    Constraint(
+        name="transmission",
+        unit="1",
+        margin="min_i |τ_i| − τ_lim: τ = n·u (pus), n·(w × (C − A0))/r (rus)",
+        label="transmission",
+        column="transmiss.",
+        report_unit="1",
+        report_factor=1.0,
+        scale=_transmission_scale,
+        scale_text="1 − limits.transmission_min",
+        speed=0.0,
+        turn=1.0,
+        spin=0.0,
+        applies=_moving_base,
+        crank=1.0,
+    ),
 )
 
 #: The constraint names, in table order.
@@ -239,21 +365,40 @@ BASE_JOINT = INDEX["base_joint"]
 PLATFORM_JOINT = INDEX["platform_joint"]
 LEG_INTERFERENCE = INDEX["leg_interference"]
 SINGULARITY = INDEX["singularity"]
+ACTUATOR = INDEX["actuator"]
+IK = INDEX["ik"]
+TRANSMISSION = INDEX["transmission"]
 
 
 def rate_bounds(
-    speed: NDArray[np.float64], turn: NDArray[np.float64], spin: NDArray[np.float64]
+    speed: NDArray[np.float64],
+    turn: NDArray[np.float64],
+    spin: NDArray[np.float64],
+    actuate: NDArray[np.float64] | None = None,
+    crank: NDArray[np.float64] | None = None,
+    ends: NDArray[np.float64] | None = None,
 ) -> NDArray[np.float64]:
-    """Bounds on how much each margin changes, shape (N_CONSTRAINTS, n), from V, V/ℓ_f and Ω
-    (or their integrals over an interval: travel, travel/ℓ_f, turned angle), each shape (n,).
+    """Bounds on how much each margin changes, shape (N_CONSTRAINTS, n), from the rates V, N, Ω,
+    Q, K, E of the module documentation (or their integrals over an interval), each shape (n,).
 
-    ``speed·V + turn·V/ℓ_f + spin·Ω`` per row of the table; a term whose coefficient is 0 is
-    left out (so an infinite V/ℓ_f, no leg floor, only affects the rows that turn with it). The
-    kernels compute the same sum for one pose (``search_kernels._rate``).
+    ``speed·V + turn·N + spin·Ω + actuate·Q + crank·K + ends·E`` per row of the table; a term
+    whose coefficient is 0 is left out (so an infinite N, no leg floor, only affects the rows
+    that turn with it). Left out, Q and E are V (6-UPS: the leg length changes at most at V, the
+    platform joints are the fastest leg ends) and K is 0 (no crank). The kernels compute the
+    same sum for one pose (``search_kernels._rate``).
     """
+    quantities = (
+        speed,
+        turn,
+        spin,
+        speed if actuate is None else actuate,
+        np.zeros_like(speed) if crank is None else crank,
+        speed if ends is None else ends,
+    )
     bounds = np.zeros((N_CONSTRAINTS, np.shape(speed)[0]))
     for k, row in enumerate(CONSTRAINTS):
-        for coefficient, value in ((row.speed, speed), (row.turn, turn), (row.spin, spin)):
+        coefficients = (row.speed, row.turn, row.spin, row.actuate, row.crank, row.ends)
+        for coefficient, value in zip(coefficients, quantities, strict=True):
             if coefficient != 0.0:
                 bounds[k] = bounds[k] + coefficient * value
     return bounds
@@ -262,6 +407,12 @@ def rate_bounds(
 def applicable(manipulator: Manipulator) -> tuple[int, ...]:
     """Rows of the table that exist for this model, in table order (see ``Constraint.applies``)."""
     return tuple(k for k, row in enumerate(CONSTRAINTS) if row.applies(manipulator))
+
+
+def constraint_names(manipulator: Manipulator) -> tuple[str, ...]:
+    """Names of the rows that exist for this model, in table order (the keys of ``check``'s
+    margins, of ``check --json`` and of the messages for this model)."""
+    return tuple(CONSTRAINTS[k].name for k in applicable(manipulator))
 
 
 def scales(manipulator: Manipulator) -> NDArray[np.float64]:

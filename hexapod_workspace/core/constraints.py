@@ -1,7 +1,10 @@
 """Inverse kinematics, exact segment distance and the constraint margins, batched.
 
 Inverse kinematics of leg i (docs/theory.md, *Conventions*): ``L_i = p + R·b_i − a_i``, length
-``ℓ_i = |L_i|``, unit direction ``n_i = L_i / ℓ_i`` (from base joint A_i to platform joint B_i).
+``ℓ_i = |L_i|``, unit direction ``n_i = L_i / ℓ_i`` (from base joint A_i to platform joint B_i);
+:func:`inverse_kinematics` is that of the 6-UPS model. For 6-PUS and 6-RUS models the base-side
+end moves (:mod:`hexapod_workspace.core.architectures`,
+:func:`~hexapod_workspace.core.legs.leg_endpoints`).
 
 Each constraint has a signed margin, ≥ 0 when it holds and < 0 when it is violated; the
 constraints, their units, scales and rate bounds are the rows of
@@ -25,7 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from . import kernels
-from .constraint_table import CONSTRAINT_NAMES, N_CONSTRAINTS, SINGULARITY
+from .constraint_table import CONSTRAINT_NAMES, N_CONSTRAINTS, SINGULARITY, applicable
 from .resolution import MAX_POSITION_NORM, validate_position
 
 if TYPE_CHECKING:
@@ -297,7 +300,10 @@ class CheckResult:
     reachable : ndarray, shape (N,), bool
         Every constraint holds.
     margins : dict of str to ndarray, shape (N,)
-        Signed margin of each constraint (keys :data:`CONSTRAINT_NAMES`), m or rad.
+        Signed margin of each constraint that applies to the model's architecture (keys from
+        :data:`CONSTRAINT_NAMES`, in its order: ``leg_length`` for 6-UPS, ``actuator``, ``ik``
+        and ``transmission`` for pus/rus), m, rad or 1. NaN where undefined (a leg without an
+        inverse-kinematics solution: every margin that needs its actuated coordinate).
     limiting_legs : dict of str to ndarray, shape (N,), int
         1-based leg with the smallest margin of each constraint (``leg_interference``: the lower
         leg of the closest pair; 0 when the check is disabled).
@@ -326,7 +332,11 @@ class CheckResult:
     @property
     def violated(self) -> list[list[str]]:
         """Per pose, the names of the violated constraints (in :data:`CONSTRAINT_NAMES` order)."""
-        return violated_names(np.stack([self.margins[name] for name in CONSTRAINT_NAMES]))
+        count = len(self)
+        absent = np.full(count, np.inf)
+        return violated_names(
+            np.stack([self.margins.get(name, absent) for name in CONSTRAINT_NAMES])
+        )
 
 
 def violated_names(margins: NDArray[np.float64]) -> list[list[str]]:
@@ -420,11 +430,14 @@ def check(
     if not angles.flags.writeable:
         angles = angles.copy()
 
-    margins = np.empty((N_CONSTRAINTS, count))
-    ints = np.empty((N_CONSTRAINTS + 2, count), dtype=np.int64)
+    model = kernels.model_vector(manipulator, report_singularity=singularity)
+    # Only the rows up to the last one that applies (6-UPS: 5 of the table's rows): the others
+    # are +inf for every pose, and allocating them would cost more than the check itself.
+    used = int(model[kernels.ROWS_USED])
+    margins = np.empty((used, count))
+    ints = np.empty((used + 2, count), dtype=np.int64)
     pairs = np.empty((count, 2), dtype=np.int64)
     reachable = np.empty(count, dtype=np.bool_)
-    model = kernels.model_vector(manipulator, report_singularity=singularity)
     outputs = (margins, ints, pairs, reachable)
     workers = _cores() if count >= PARALLEL_POSES else 1
     if workers == 1:
@@ -442,12 +455,15 @@ def check(
     if status == -2:  # not reached: validate_position refused it above
         msg = f"position: expected 3 finite values (x, y, z) in m, got {position.tolist()}"
         raise InputError(msg)
-    legs = ints[:N_CONSTRAINTS]
-    limiting_constraint, limiting_leg = ints[N_CONSTRAINTS], ints[N_CONSTRAINTS + 1]
+    legs = ints[:used]
+    rows = applicable(manipulator)
+    limiting_constraint, limiting_leg = ints[used], ints[used + 1]
     if singularity and manipulator.singularity_min == 0.0:
         # Reported, not enforced: the singularity margin never limits a pose. The limiting
         # constraint is the one with the smallest relative margin among the others.
-        relative = relative_margins(manipulator, margins)
+        full = np.full((N_CONSTRAINTS, count), np.inf)
+        full[:used] = margins
+        relative = relative_margins(manipulator, full)
         relative[SINGULARITY] = np.inf
         relative = np.where(np.isnan(relative), -np.inf, relative)  # NaN is violated
         limiting_constraint = np.argmin(relative, axis=0).astype(np.int64)
@@ -456,8 +472,8 @@ def check(
         position=position,
         angles=angles,
         reachable=reachable,
-        margins={name: margins[k] for k, name in enumerate(CONSTRAINT_NAMES)},
-        limiting_legs={name: legs[k] for k, name in enumerate(CONSTRAINT_NAMES)},
+        margins={CONSTRAINT_NAMES[k]: margins[k] for k in rows},
+        limiting_legs={CONSTRAINT_NAMES[k]: legs[k] for k in rows},
         limiting_pair=pairs,
         limiting_constraint=limiting_constraint,
         limiting_leg=limiting_leg,

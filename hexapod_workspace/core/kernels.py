@@ -28,6 +28,7 @@ from .model_layout import (
     MODEL_SIZE,
     ORDER,
     RHO,
+    ROWS_USED,
     SCALE,
     A,
     B,
@@ -42,6 +43,7 @@ __all__ = [
     "KIND_TT",
     "MAX_STEP",
     "ONE_SIZE",
+    "ROWS_USED",
     "SAFETY",
     "SCALE",
     "cache_is_warm",
@@ -89,6 +91,7 @@ def warm_up() -> float:
     model[A : A + 18] = np.tile([1.0, 0.0, 0.0], 6)
     model[B : B + 18] = np.tile([0.5, 0.0, 0.0], 6)
     model[SCALE : SCALE + N_CONSTRAINTS] = 1.0
+    model[ROWS_USED] = N_CONSTRAINTS
     model[RHO] = 0.5
     model[LENGTH_FLOOR] = model[ESTIMATE_FLOOR] = 1e-3
     model[LMAX : LMAX + 6] = 2.0

@@ -5,9 +5,12 @@ the one place outside them that knows where a leg starts and ends, so that the m
 scene plots and the collision scene follow the model's leg architecture instead of assuming
 fixed base joints.
 
-For the 6-UPS model the base-side end of leg i is the fixed base joint ``A_i = a_i``
-(``geometry.base_joints``) and the platform-side end is ``B_i = p + R·b_i``
-(``geometry.platform_joints`` in the mobile frame).
+The platform-side end is ``B_i = p + R·b_i`` (``geometry.platform_joints`` in the mobile
+frame). The base-side end follows the leg architecture
+(:mod:`hexapod_workspace.core.architectures`): for 6-UPS the fixed base joint ``A_i = a_i``
+(``geometry.base_joints``); for 6-PUS the slide joint ``A_i(q_i) = A0_i + q_i·u_i``; for 6-RUS
+the crank end ``C_i(q_i)``, with q_i from the leg's inverse kinematics at the pose (NaN where
+the leg has no solution).
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
+from .architectures import module as architecture_module
 
 if TYPE_CHECKING:
     from .manipulator import Manipulator
@@ -42,7 +46,8 @@ def leg_endpoints(
     Returns
     -------
     base_ends : ndarray, shape (n, 6, 3)
-        Base-side end of each leg (the base joint), base frame, m.
+        Base-side end of each leg (the base joint, slide joint or crank end), base frame, m;
+        NaN rows for legs without an inverse-kinematics solution (pus, rus).
     platform_ends : ndarray, shape (n, 6, 3)
         Platform-side end B_i = p + R·b_i, base frame, m.
     """
@@ -59,5 +64,7 @@ def leg_endpoints(
         msg = f"positions: expected shape ({r.shape[0]}, 3) or (3,), got {np.shape(positions)}"
         raise InputError(msg)
     platform_ends = p[:, None, :] + np.einsum("nij,kj->nki", r, manipulator.platform_joints)
-    base_ends = np.broadcast_to(manipulator.base_joints, platform_ends.shape).copy()
+    legs = architecture_module(manipulator.architecture)
+    q, _ = legs.inverse_kinematics(manipulator, platform_ends)
+    base_ends: NDArray[np.float64] = legs.base_ends(manipulator, q)
     return base_ends, platform_ends

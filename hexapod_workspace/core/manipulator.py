@@ -1,4 +1,5 @@
-"""The manipulator model: joint positions, joint axes and limits of a 6-UPS hexapod (GPM).
+"""The manipulator model: joint positions, joint axes and limits of a hexapod (6-UPS, 6-PUS or
+6-RUS legs: ``geometry.architecture``, see :mod:`hexapod_workspace.core.architectures`).
 
 Built from a ROS 2 parameters file or a plain mapping (what the node holds), validated as a
 whole. Every error names the parameter, what was expected and what was given.
@@ -17,6 +18,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import ConfigError, GeometryError
+from .architectures import ARCHITECTURES
+from .architectures import module as architecture_module
 from .params import (
     CELL_PARAMETERS,
     NODE_PARAMETERS,
@@ -28,7 +31,13 @@ from .params import (
 from .resolution import MAX_POSITION_NORM
 from .validation import coincident_joints_reason, require_usable, unusable_reason
 
-__all__ = ["PARAMETER_DEFAULTS", "HomePoseWarning", "Manipulator"]
+__all__ = [
+    "ARCHITECTURE_PARAMETERS",
+    "PARAMETER_DEFAULTS",
+    "HomePoseWarning",
+    "Manipulator",
+    "required_parameters",
+]
 
 #: Parameters of the model with their defaults; ``None`` means required.
 PARAMETER_DEFAULTS: dict[str, Any] = {
@@ -45,8 +54,265 @@ PARAMETER_DEFAULTS: dict[str, Any] = {
     "limits.leg_diameter": 0.0,
     "limits.singularity_min": 0.0,
     "pose.position": None,
+    "geometry.architecture": "ups",
+    "geometry.rail_directions": [],
+    "geometry.crank_axes": [],
+    "geometry.crank_zero_directions": [],
+    "geometry.crank_lengths": [],
+    "geometry.leg_lengths": [],
+    "geometry.branch": [],
+    "limits.actuator_min": [],
+    "limits.actuator_max": [],
+    "limits.transmission_min": 0.1,
+}
+#: The parameters only one architecture has (the others refuse them when given), and the
+#: required ones (``None`` in :data:`PARAMETER_DEFAULTS` or listed here) of each.
+ARCHITECTURE_PARAMETERS: dict[str, tuple[str, ...]] = {
+    "ups": ("limits.leg_length_min", "limits.leg_length_max"),
+    "pus": (
+        "geometry.rail_directions",
+        "geometry.leg_lengths",
+        "geometry.branch",
+        "limits.actuator_min",
+        "limits.actuator_max",
+        "limits.transmission_min",
+    ),
+    "rus": (
+        "geometry.crank_axes",
+        "geometry.crank_zero_directions",
+        "geometry.crank_lengths",
+        "geometry.leg_lengths",
+        "geometry.branch",
+        "limits.actuator_min",
+        "limits.actuator_max",
+        "limits.transmission_min",
+    ),
+}
+_REQUIRED: dict[str, tuple[str, ...]] = {
+    "ups": ("limits.leg_length_min", "limits.leg_length_max"),
+    "pus": (
+        "geometry.rail_directions",
+        "geometry.leg_lengths",
+        "limits.actuator_min",
+        "limits.actuator_max",
+    ),
+    "rus": (
+        "geometry.crank_axes",
+        "geometry.crank_zero_directions",
+        "geometry.crank_lengths",
+        "geometry.leg_lengths",
+        "limits.actuator_min",
+        "limits.actuator_max",
+    ),
 }
 _MODEL_GROUPS = ("geometry.", "limits.", "pose.")
+
+
+#: Every parameter that belongs to one architecture only.
+_SPECIFIC = frozenset(name for names in ARCHITECTURE_PARAMETERS.values() for name in names)
+
+
+def required_parameters(architecture: str) -> tuple[str, ...]:
+    """The model parameters a model of this architecture must be given (``pose.position``
+    excluded: it defaults to the home position), in :data:`PARAMETER_DEFAULTS` order."""
+    needed = set(_REQUIRED.get(architecture, ()))
+    return tuple(
+        name
+        for name, default in PARAMETER_DEFAULTS.items()
+        if name != "pose.position"
+        and name.startswith(_MODEL_GROUPS)
+        and (name in needed or (default is None and name not in _SPECIFIC))
+    )
+
+
+def _unset(value: Any) -> bool:
+    """A parameter left out: None, or an empty list (how ROS holds an empty array)."""
+    if value is None:
+        return True
+    if isinstance(value, (str, bytes)):
+        return False
+    return bool(np.ndim(value)) and np.size(value) == 0
+
+
+def _foreign_parameter(architecture: str, flat: Mapping[str, Any]) -> str | None:
+    """Why a parameter of another architecture is refused (given, not empty, not the default),
+    or None."""
+    own = set(ARCHITECTURE_PARAMETERS[architecture])
+    for name in PARAMETER_DEFAULTS:
+        if name not in _SPECIFIC or name in own or name not in flat or _unset(flat[name]):
+            continue
+        default = PARAMETER_DEFAULTS[name]
+        if default is not None and not _unset(default) and flat[name] == default:
+            continue  # a scalar at its default (a node holds every declared parameter)
+        owners = [arch for arch, names in ARCHITECTURE_PARAMETERS.items() if name in names]
+        return (
+            f"{name}: a parameter of geometry.architecture {' or '.join(owners)}, given for "
+            f"{architecture} (value {_describe(flat[name])}); remove it or change the "
+            "architecture"
+        )
+    return None
+
+
+def _stroke(
+    low_name: str, low: Any, high_name: str, high: Any
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A per-leg (min, max) pair of lengths, m, with min < max for every leg."""
+    length_min = _length(low_name, _per_leg(low_name, low))
+    length_max = _length(high_name, _per_leg(high_name, high))
+    bad = np.flatnonzero(length_min >= length_max)
+    if bad.size:
+        i = bad[0]
+        msg = (
+            f"{low_name}: expected < {high_name} for every leg, "
+            f"got {length_min[i]:g} >= {length_max[i]:g} m for leg {i + 1}"
+        )
+        raise GeometryError(msg)
+    return length_min, length_max
+
+
+def _directions(name: str, value: Any, what: str) -> NDArray[np.float64]:
+    """18 numbers as six unit vectors; a zero vector is refused with its leg."""
+    array = _numbers(name, value)
+    if array.size != 18:
+        msg = f"{name}: expected 18 numbers (6 {what}s × x, y, z), got {array.size}"
+        raise GeometryError(msg)
+    rows = array.reshape(6, 3)
+    norms = np.linalg.norm(rows, axis=1)
+    zero = np.flatnonzero(norms < 1e-9)
+    if zero.size:
+        msg = (
+            f"{name}: expected non-zero directions, the {what} of leg {zero[0] + 1} has zero "
+            f"length ({rows[zero[0]].tolist()})"
+        )
+        raise GeometryError(msg)
+    # Rows already of unit length to rounding are kept as given, so that a model written back
+    # by to_parameters reads as the same model.
+    scale = np.where(np.abs(norms - 1.0) <= 4e-16, 1.0, norms)
+    unit: NDArray[np.float64] = rows / scale[:, None]
+    return unit
+
+
+def _positive(name: str, value: Any) -> NDArray[np.float64]:
+    array = _length(name, _per_leg(name, value))
+    bad = np.flatnonzero(array <= 0.0)
+    if bad.size:
+        msg = f"{name}: expected values > 0 m, got {array[bad[0]]:g} for leg {bad[0] + 1}"
+        raise GeometryError(msg)
+    return array
+
+
+def _architecture_parts(architecture: str, values: Mapping[str, Any]) -> dict[str, Any]:
+    """The pus or rus fields of the model from its parameters, validated."""
+    parts: dict[str, Any] = {
+        "leg_lengths": _positive("geometry.leg_lengths", values["geometry.leg_lengths"])
+    }
+    branch_value = values["geometry.branch"]
+    branch = _per_leg("geometry.branch", [1.0] if _unset(branch_value) else branch_value)
+    bad = np.flatnonzero(np.abs(branch) != 1.0)
+    if bad.size:
+        msg = (
+            f"geometry.branch: expected +1 or -1 for every leg, got {branch[bad[0]]:g} for "
+            f"leg {bad[0] + 1}"
+        )
+        raise GeometryError(msg)
+    parts["branch"] = branch
+    if architecture == "pus":
+        parts["rail_directions"] = _directions(
+            "geometry.rail_directions", values["geometry.rail_directions"], "rail"
+        )
+        low, high = _stroke(
+            "limits.actuator_min",
+            values["limits.actuator_min"],
+            "limits.actuator_max",
+            values["limits.actuator_max"],
+        )
+    else:
+        axes = _directions("geometry.crank_axes", values["geometry.crank_axes"], "crank axis")
+        zero = _directions(
+            "geometry.crank_zero_directions",
+            values["geometry.crank_zero_directions"],
+            "crank zero direction",
+        )
+        dots = np.einsum("ij,ij->i", axes, zero)
+        bad = np.flatnonzero(np.abs(dots) > 1e-6)
+        if bad.size:
+            i = bad[0]
+            msg = (
+                f"geometry.crank_zero_directions: expected each perpendicular to its crank axis "
+                f"(geometry.crank_axes), leg {i + 1} has cos(angle) = {dots[i]:.6g} "
+                f"(zero direction {np.round(zero[i], 6).tolist()}, axis "
+                f"{np.round(axes[i], 6).tolist()})"
+            )
+            raise GeometryError(msg)
+        parts["crank_axes"] = axes
+        parts["crank_zero_directions"] = zero
+        parts["crank_lengths"] = _positive(
+            "geometry.crank_lengths", values["geometry.crank_lengths"]
+        )
+        low = _per_leg("limits.actuator_min", values["limits.actuator_min"])
+        high = _per_leg("limits.actuator_max", values["limits.actuator_max"])
+        wide = np.flatnonzero(~((low < high) & (high - low < 2.0 * math.pi)))
+        if wide.size:
+            i = wide[0]
+            msg = (
+                f"limits.actuator_min: expected limits.actuator_min < limits.actuator_max < "
+                f"limits.actuator_min + 2 pi (rad) for every leg, got {low[i]:g} and {high[i]:g} "
+                f"for leg {i + 1}"
+            )
+            raise GeometryError(msg)
+    parts["actuator_min"], parts["actuator_max"] = low, high
+    tau = _numbers("limits.transmission_min", values["limits.transmission_min"])
+    if tau.size != 1 or not 0.0 < tau[0] < 1.0:
+        msg = (
+            f"limits.transmission_min: expected one value in (0, 1), got "
+            f"{_describe(values['limits.transmission_min'])}"
+        )
+        raise GeometryError(msg)
+    parts["transmission_min"] = float(tau[0])
+    return parts
+
+
+def _with_home_axes(manipulator: Manipulator, base: bool, platform: bool) -> Manipulator:
+    """The model with its default joint axes (the leg directions at the home pose: base axes
+    from the base end towards B_i, turned back to crank angle 0 for rus; platform axes
+    reversed), after checking that every leg has a solution and a non-zero length there."""
+    from dataclasses import replace
+
+    legs = architecture_module(manipulator.architecture)
+    home = manipulator.home_position + manipulator.platform_joints
+    q, ik = legs.inverse_kinematics(manipulator, home)
+    unsolved = np.flatnonzero(~(ik >= 0.0))
+    if unsolved.size:
+        i = unsolved[0]
+        msg = (
+            f"geometry.home_position: expected a pose every leg can reach, leg {i + 1} has no "
+            f"inverse-kinematics solution at {manipulator.home_position.tolist()} m (identity "
+            f"orientation; ik margin {ik[i]:.6g} m: its length geometry.leg_lengths does not "
+            "reach its joint)"
+        )
+        raise GeometryError(msg)
+    vectors = home - legs.base_ends(manipulator, q)
+    lengths = np.linalg.norm(vectors, axis=1)
+    degenerate = np.flatnonzero(lengths < 1e-9)
+    if degenerate.size:
+        msg = (
+            f"geometry.home_position: expected non-zero legs at the home pose, "
+            f"leg {degenerate[0] + 1} has zero length there"
+        )
+        raise GeometryError(msg)
+    directions = vectors / lengths[:, None]
+    changes: dict[str, Any] = {}
+    if base:
+        axes = directions
+        if manipulator.architecture == "rus":
+            from .architectures.rus import rotate_about
+
+            assert manipulator.crank_axes is not None
+            axes = rotate_about(manipulator.crank_axes, -q, directions)
+        changes["base_joint_axes"] = _frozen(axes)
+    if platform:
+        changes["platform_joint_axes"] = _frozen(-directions)
+    return replace(manipulator, **changes) if changes else manipulator
 
 
 class HomePoseWarning(UserWarning):
@@ -178,6 +444,24 @@ class Manipulator:
         σ_lim ≥ 0: the smallest singular value of the homogenised Plücker matrix of the legs
         allowed (constraint ``singularity``, see :mod:`~hexapod_workspace.core.constraint_table`);
         0 disables the constraint (dimensionless).
+    architecture : str
+        ``"ups"`` (legs of variable length between fixed joints, the default), ``"pus"``
+        (slides on rails, legs of fixed length) or ``"rus"`` (cranks, rods of fixed length):
+        :mod:`hexapod_workspace.core.architectures`. For pus and rus, ``base_joints`` are the
+        rail origins or crank pivots A0_i, ``leg_length_min`` and ``leg_length_max`` both hold
+        the fixed leg lengths, and the base joint axes of rus are given at crank angle 0.
+    leg_lengths, branch : ndarray, shape (6,), or None
+        pus/rus: fixed leg (rod) lengths L_i, m; assembly branch ±1 of each leg.
+    rail_directions : ndarray, shape (6, 3), or None
+        pus: unit rail directions u_i, base frame.
+    crank_axes, crank_zero_directions : ndarray, shape (6, 3), or None
+        rus: unit crank axes w_i and zero directions e_i ⟂ w_i, base frame.
+    crank_lengths : ndarray, shape (6,), or None
+        rus: crank lengths r_i, m.
+    actuator_min, actuator_max : ndarray, shape (6,), or None
+        pus: slide stroke along the rail, m; rus: crank range, rad (max − min < 2π).
+    transmission_min : float
+        pus/rus: smallest |τ_i| allowed (constraint ``transmission``), in (0, 1).
     """
 
     base_joints: NDArray[np.float64]
@@ -194,6 +478,16 @@ class Manipulator:
     frame_id: str = "base"
     axes_from_home: tuple[bool, bool] = field(default=(True, True))
     singularity_min: float = 0.0
+    architecture: str = "ups"
+    leg_lengths: NDArray[np.float64] | None = None
+    branch: NDArray[np.float64] | None = None
+    rail_directions: NDArray[np.float64] | None = None
+    crank_axes: NDArray[np.float64] | None = None
+    crank_zero_directions: NDArray[np.float64] | None = None
+    crank_lengths: NDArray[np.float64] | None = None
+    actuator_min: NDArray[np.float64] | None = None
+    actuator_max: NDArray[np.float64] | None = None
+    transmission_min: float = 0.1
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -239,7 +533,23 @@ class Manipulator:
         values.update({k: v for k, v in flat.items() if k in PARAMETER_DEFAULTS})
         if values["pose.position"] is None:
             values["pose.position"] = values["geometry.home_position"]
-        missing = [name for name, value in values.items() if value is None]
+        architecture = values["geometry.architecture"]
+        if architecture not in ARCHITECTURES:
+            msg = (
+                f"geometry.architecture: expected one of {', '.join(ARCHITECTURES)}, "
+                f"got {_describe(architecture)}"
+            )
+            raise ConfigError(msg)
+        foreign = _foreign_parameter(architecture, flat)
+        if foreign is not None:
+            raise ConfigError(foreign)
+        needed = set(_REQUIRED[architecture])
+        missing = [
+            name
+            for name, default in PARAMETER_DEFAULTS.items()
+            if (name in needed or (default is None and name not in _SPECIFIC))
+            and _unset(values[name])
+        ]
         if missing:
             msg = f"{missing[0]}: required parameter is missing"
             raise ConfigError(msg)
@@ -262,25 +572,20 @@ class Manipulator:
                 raise GeometryError(coincident)
         home = _vector3("geometry.home_position", values["geometry.home_position"])
         position = _vector3("pose.position", values["pose.position"])
-        length_min = _length(
-            "limits.leg_length_min",
-            _per_leg("limits.leg_length_min", values["limits.leg_length_min"]),
-        )
-        length_max = _length(
-            "limits.leg_length_max",
-            _per_leg("limits.leg_length_max", values["limits.leg_length_max"]),
-        )
-        if np.any(length_min < 0.0):
-            msg = f"limits.leg_length_min: expected values >= 0 m, got {length_min.min():g}"
-            raise GeometryError(msg)
-        bad = np.flatnonzero(length_min >= length_max)
-        if bad.size:
-            i = bad[0]
-            msg = (
-                f"limits.leg_length_min: expected < limits.leg_length_max for every leg, "
-                f"got {length_min[i]:g} >= {length_max[i]:g} m for leg {i + 1}"
+        if architecture == "ups":
+            length_min, length_max = _stroke(
+                "limits.leg_length_min",
+                values["limits.leg_length_min"],
+                "limits.leg_length_max",
+                values["limits.leg_length_max"],
             )
-            raise GeometryError(msg)
+            if np.any(length_min < 0.0):
+                msg = f"limits.leg_length_min: expected values >= 0 m, got {length_min.min():g}"
+                raise GeometryError(msg)
+            legs: dict[str, Any] = {}
+        else:
+            legs = _architecture_parts(architecture, values)
+            length_min = length_max = legs["leg_lengths"]
         angles = {}
         for name in ("limits.base_joint_max_angle", "limits.platform_joint_max_angle"):
             angle = _per_leg(name, values[name])
@@ -302,26 +607,20 @@ class Manipulator:
             msg = f"limits.leg_diameter: expected a value >= 0 m, got {diameter[0]:g}"
             raise GeometryError(msg)
 
-        legs_home = home + platform_joints - base_joints
-        lengths_home = np.linalg.norm(legs_home, axis=1)
-        degenerate = np.flatnonzero(lengths_home < 1e-9)
-        if degenerate.size:
-            msg = (
-                f"geometry.home_position: expected non-zero legs at the home pose, "
-                f"leg {degenerate[0] + 1} has zero length there"
-            )
-            raise GeometryError(msg)
-        directions_home = legs_home / lengths_home[:, None]
         base_axes = _axes("geometry.base_joint_axes", values["geometry.base_joint_axes"])
         platform_axes = _axes(
             "geometry.platform_joint_axes", values["geometry.platform_joint_axes"]
         )
+        frozen_legs: dict[str, Any] = {
+            key: _frozen(value) if isinstance(value, np.ndarray) else value
+            for key, value in legs.items()
+        }
         manipulator = cls(
             base_joints=_frozen(base_joints),
             platform_joints=_frozen(platform_joints),
-            base_joint_axes=_frozen(directions_home if base_axes is None else base_axes),
+            base_joint_axes=_frozen(np.zeros((6, 3)) if base_axes is None else base_axes),
             platform_joint_axes=_frozen(
-                -directions_home if platform_axes is None else platform_axes
+                np.zeros((6, 3)) if platform_axes is None else platform_axes
             ),
             leg_length_min=_frozen(length_min),
             leg_length_max=_frozen(length_max),
@@ -333,7 +632,10 @@ class Manipulator:
             frame_id=frame_id,
             axes_from_home=(base_axes is None, platform_axes is None),
             singularity_min=_singularity_min(values["limits.singularity_min"]),
+            architecture=architecture,
+            **frozen_legs,
         )
+        manipulator = _with_home_axes(manipulator, base_axes is None, platform_axes is None)
         if warn:
             reason = unusable_reason(manipulator)
             if reason is not None:
@@ -412,6 +714,11 @@ class Manipulator:
         def floats(array: NDArray[np.float64]) -> list[float]:
             return [float(v) for v in np.ravel(array)]
 
+        def optional(array: NDArray[np.float64] | None) -> list[float]:
+            return [] if array is None else floats(array)
+
+        ups = self.architecture == "ups"
+
         return {
             "frame_id": self.frame_id,
             "geometry.base_joints": floats(self.base_joints),
@@ -423,13 +730,23 @@ class Manipulator:
             "geometry.platform_joint_axes": []
             if self.axes_from_home[1]
             else floats(self.platform_joint_axes),
-            "limits.leg_length_min": floats(self.leg_length_min),
-            "limits.leg_length_max": floats(self.leg_length_max),
+            "limits.leg_length_min": floats(self.leg_length_min) if ups else [],
+            "limits.leg_length_max": floats(self.leg_length_max) if ups else [],
             "limits.base_joint_max_angle": floats(self.base_joint_max_angle),
             "limits.platform_joint_max_angle": floats(self.platform_joint_max_angle),
             "limits.leg_diameter": float(self.leg_diameter),
             "limits.singularity_min": float(self.singularity_min),
             "pose.position": floats(self.position),
+            "geometry.architecture": self.architecture,
+            "geometry.rail_directions": optional(self.rail_directions),
+            "geometry.crank_axes": optional(self.crank_axes),
+            "geometry.crank_zero_directions": optional(self.crank_zero_directions),
+            "geometry.crank_lengths": optional(self.crank_lengths),
+            "geometry.leg_lengths": optional(self.leg_lengths),
+            "geometry.branch": optional(self.branch),
+            "limits.actuator_min": optional(self.actuator_min),
+            "limits.actuator_max": optional(self.actuator_max),
+            "limits.transmission_min": float(self.transmission_min),
         }
 
     def with_position(self, position: Any) -> Manipulator:
@@ -456,8 +773,29 @@ class Manipulator:
                 "position",
             )
         )
+        optional_equal = all(
+            (getattr(self, name) is None and getattr(other, name) is None)
+            or (
+                getattr(self, name) is not None
+                and getattr(other, name) is not None
+                and np.array_equal(getattr(self, name), getattr(other, name))
+            )
+            for name in (
+                "leg_lengths",
+                "branch",
+                "rail_directions",
+                "crank_axes",
+                "crank_zero_directions",
+                "crank_lengths",
+                "actuator_min",
+                "actuator_max",
+            )
+        )
         return (
             arrays_equal
+            and optional_equal
+            and self.architecture == other.architecture
+            and self.transmission_min == other.transmission_min
             and self.leg_diameter == other.leg_diameter
             and self.singularity_min == other.singularity_min
             and self.frame_id == other.frame_id

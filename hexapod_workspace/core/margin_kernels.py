@@ -21,38 +21,56 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .constraint_table import (
+    ACTUATOR,
     BASE_JOINT,
+    IK,
     LEG_INTERFERENCE,
     LEG_LENGTH,
     N_CONSTRAINTS,
     PLATFORM_JOINT,
     SINGULARITY,
+    TRANSMISSION,
 )
 from .model_layout import (
     ALPHA,
     ALPHA_EQUAL,
+    ARCH,
+    AXIS_ALONG,
+    AXIS_CROSS,
     BETA,
     BETA_EQUAL,
+    BRANCH,
+    CRANK,
+    CROSS,
     DIAMETER,
     INTERFERENCE,
     JA,
     JB,
+    LEG,
+    LENGTH_FLOOR,
     LMAX,
     LMIN,
     ORDER,
     PAIR_I,
     PAIR_J,
+    QCENTRE,
+    QMAX,
+    QMIN,
+    RAIL,
     RHO,
+    ROWS_USED,
     RPAIR,
     RR,
     SCALE,
     SINGULARITY_MIN,
     SINGULARITY_ON,
+    TAU_MIN,
+    ZERO,
     A,
     B,
 )
 
-__all__ = ["ONE_SIZE", "check_angles", "check_one", "margins_rotations"]
+__all__ = ["ONE_SIZE", "SCRATCH_ROWS", "check_angles", "check_one", "margins_rotations"]
 
 # ------------------------------------------------------------------------------ one pose
 # Slots of the per-pose result vector ``out``.
@@ -64,6 +82,9 @@ OUT_SIZE = OUT_SHORTEST + 1
 #: Size of :func:`check_one`'s result: margins, legs, pair (2), limiting constraint and leg,
 #: reachable (1.0 or 0.0).
 ONE_SIZE = 2 * N_CONSTRAINTS + 5
+#: Rows of the per-pose scratch (6 legs each): leg vector planes, squared length, 1/ℓ², and the
+#: base-side ends of pus/rus legs (three planes).
+SCRATCH_ROWS = 8
 
 
 @_helper
@@ -94,8 +115,18 @@ def _pose(
     (test/reference.py, BatchedMargins) operation by operation, so margins agree to rounding:
     the smallest margin of each constraint and its leg (first one on ties; NaN, a zero-length
     leg, wins), the closest pair by Ericson's clamped closest points.
-    ``want_pair`` False skips the interference check (margin +inf).
+    ``want_pair`` False skips the interference check (margin +inf). Models with moving base
+    joints (pus, rus) go to :func:`_pose_moving`.
     """
+    if model[ARCH] != 0.0:
+        _pose_moving(model, r, px, py, pz, scratch, out, want_pair)
+        return
+    out[ACTUATOR] = np.inf
+    out[IK] = np.inf
+    out[TRANSMISSION] = np.inf
+    out[OUT_LEG + ACTUATOR] = 0
+    out[OUT_LEG + IK] = 0
+    out[OUT_LEG + TRANSMISSION] = 0
     lx = scratch[0]
     ly = scratch[1]
     lz = scratch[2]
@@ -169,25 +200,7 @@ def _pose(
     out[OUT_LEG + PLATFORM_JOINT] = leg_b
     out[OUT_SHORTEST] = shortest
     out[OUT_LEG + SINGULARITY] = 0
-    if model[SINGULARITY_ON] != 0.0:
-        rows = np.empty(ROWS_SCRATCH)
-        for k in range(6):
-            bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
-            _plucker_row(
-                rows,
-                k,
-                lx[k],
-                ly[k],
-                lz[k],
-                sq[k],
-                r00 * bx + r01 * by + r02 * bz,
-                r10 * bx + r11 * by + r12 * bz,
-                r20 * bx + r21 * by + r22 * bz,
-                model[RHO],
-            )
-        out[SINGULARITY] = _smallest_singular_value(rows) - model[SINGULARITY_MIN]
-    else:
-        out[SINGULARITY] = np.inf
+    out[SINGULARITY] = _pose_singularity(model, r, scratch)
     if not want_pair or model[INTERFERENCE] == 0.0:
         out[LEG_INTERFERENCE] = np.inf
         out[OUT_LEG + LEG_INTERFERENCE] = 0
@@ -246,6 +259,264 @@ def _pose(
                 best = distance
                 best_pair = pair
             best_squared = min(squared, best_squared)
+    out[LEG_INTERFERENCE] = best - model[DIAMETER]
+    out[OUT_LEG + LEG_INTERFERENCE] = PAIR_I[best_pair]
+    out[OUT_PAIR] = PAIR_I[best_pair]
+    out[OUT_PAIR + 1] = PAIR_J[best_pair]
+
+
+@_helper
+def _pose_singularity(
+    model: NDArray[np.float64], r: NDArray[np.float64], scratch: NDArray[np.float64]
+) -> float:
+    """The singularity margin of one pose from its leg vector planes (scratch rows 0..3) and
+    its rotation ``r`` (9,); +inf when the margin is not evaluated."""
+    if model[SINGULARITY_ON] == 0.0:
+        return np.inf
+    rows = np.empty(ROWS_SCRATCH)
+    for k in range(6):
+        bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
+        _plucker_row(
+            rows,
+            k,
+            scratch[0, k],
+            scratch[1, k],
+            scratch[2, k],
+            scratch[3, k],
+            r[0] * bx + r[1] * by + r[2] * bz,
+            r[3] * bx + r[4] * by + r[5] * bz,
+            r[6] * bx + r[7] * by + r[8] * bz,
+            model[RHO],
+        )
+    value: float = _smallest_singular_value(rows) - model[SINGULARITY_MIN]
+    return value
+
+
+# ------------------------------------------------------------------------------ moving base joints
+@_helper
+def _pose_moving(
+    model: NDArray[np.float64],
+    r: NDArray[np.float64],
+    px: float,
+    py: float,
+    pz: float,
+    scratch: NDArray[np.float64],
+    out: NDArray[np.float64],
+    want_pair: bool,
+) -> None:
+    """Margins of one pose of a pus or rus model into ``out`` (OUT_SIZE,), as :func:`_pose`.
+
+    Per leg, the inverse kinematics of :mod:`hexapod_workspace.core.architectures.pus` or
+    :mod:`~hexapod_workspace.core.architectures.rus` (the same closed forms), the leg vector
+    ``L_k = B_k − A_k(q_k)`` in the scratch planes (lx, ly, lz, sq, 1/ℓ²) and the base-side end
+    A_k in planes 5..7. Where some leg has no solution (``ik`` < 0) every margin that needs its
+    q is NaN (``leg_length`` +inf: it does not apply; ``singularity`` +inf when not evaluated,
+    ``leg_interference`` +inf when disabled).
+    """
+    lx = scratch[0]
+    ly = scratch[1]
+    lz = scratch[2]
+    sq = scratch[3]
+    inverse_sq = scratch[4]
+    ax = scratch[5]
+    ay = scratch[6]
+    az = scratch[7]
+    r00, r01, r02 = r[0], r[1], r[2]
+    r10, r11, r12 = r[3], r[4], r[5]
+    r20, r21, r22 = r[6], r[7], r[8]
+    rus = model[ARCH] == 2.0
+    tau_min = model[TAU_MIN]
+    m_act = np.inf
+    leg_act = 0
+    m_ik = np.inf
+    leg_ik = 0
+    m_tau = np.inf
+    leg_tau = 0
+    m_a = np.inf
+    leg_a = 0
+    m_b = np.inf
+    leg_b = 0
+    solved = True
+    for k in range(6):
+        bx = model[B + 3 * k]
+        by = model[B + 3 * k + 1]
+        bz = model[B + 3 * k + 2]
+        platform_x = (r00 * bx + r01 * by + r02 * bz) + px
+        platform_y = (r10 * bx + r11 * by + r12 * bz) + py
+        platform_z = (r20 * bx + r21 * by + r22 * bz) + pz
+        dx = platform_x - model[A + 3 * k]
+        dy = platform_y - model[A + 3 * k + 1]
+        dz = platform_z - model[A + 3 * k + 2]
+        length = model[LEG + k]
+        branch = model[BRANCH + k]
+        ux = model[RAIL + 3 * k]
+        uy = model[RAIL + 3 * k + 1]
+        uz = model[RAIL + 3 * k + 2]
+        jx = model[JA + 3 * k]
+        jy = model[JA + 3 * k + 1]
+        jz = model[JA + 3 * k + 2]
+        if not rus:
+            # Slide: q = u·d + branch·sqrt(L² − h²), h the distance from B_k to the rail line.
+            along = ux * dx + uy * dy + uz * dz
+            hx = dx - along * ux
+            hy = dy - along * uy
+            hz = dz - along * uz
+            h = math.sqrt(hx * hx + hy * hy + hz * hz)
+            ik = length - h
+            q = along + branch * math.sqrt(max(ik * (length + h), 0.0)) if ik >= 0.0 else np.nan
+            base_x = model[A + 3 * k] + q * ux
+            base_y = model[A + 3 * k + 1] + q * uy
+            base_z = model[A + 3 * k + 2] + q * uz
+            tx, ty, tz = ux, uy, uz
+        else:
+            # Crank: a cos q + b sin q = c; u holds the crank axis w.
+            crank = model[CRANK + k]
+            ex, ey, ez = model[ZERO + 3 * k], model[ZERO + 3 * k + 1], model[ZERO + 3 * k + 2]
+            fx, fy, fz = model[CROSS + 3 * k], model[CROSS + 3 * k + 1], model[CROSS + 3 * k + 2]
+            a = 2.0 * crank * (dx * ex + dy * ey + dz * ez)
+            b = 2.0 * crank * (dx * fx + dy * fy + dz * fz)
+            c = (dx * dx + dy * dy + dz * dz) + crank * crank - length * length
+            along = ux * dx + uy * dy + uz * dz
+            hx = dx - along * ux
+            hy = dy - along * uy
+            hz = dz - along * uz
+            across = math.sqrt(hx * hx + hy * hy + hz * hz)
+            ik = min(
+                length - math.hypot(along, across - crank),
+                math.hypot(along, across + crank) - length,
+            )
+            if ik >= 0.0:
+                norm = math.hypot(a, b)
+                ratio = min(max(c / norm, -1.0), 1.0) if norm > 0.0 else 1.0
+                raw = math.atan2(b, a) + branch * math.acos(ratio)
+                centre = model[QCENTRE + k]
+                shifted = raw - centre + math.pi
+                wrapped = shifted - 2.0 * math.pi * math.floor(shifted / (2.0 * math.pi))
+                q = centre + wrapped - math.pi
+            else:
+                q = np.nan
+            cq = math.cos(q)
+            sq_ = math.sin(q)
+            base_x = model[A + 3 * k] + crank * (cq * ex + sq_ * fx)
+            base_y = model[A + 3 * k + 1] + crank * (cq * ey + sq_ * fy)
+            base_z = model[A + 3 * k + 2] + crank * (cq * ez + sq_ * fz)
+            # The crank end's unit velocity, and the joint axis turned by q about w (Rodrigues).
+            tx, ty, tz = cq * fx - sq_ * ex, cq * fy - sq_ * ey, cq * fz - sq_ * ez
+            jx = cq * jx + sq_ * model[AXIS_CROSS + 3 * k] + (1.0 - cq) * model[AXIS_ALONG + 3 * k]
+            jy = (
+                cq * jy
+                + sq_ * model[AXIS_CROSS + 3 * k + 1]
+                + (1.0 - cq) * model[AXIS_ALONG + 3 * k + 1]
+            )
+            jz = (
+                cq * jz
+                + sq_ * model[AXIS_CROSS + 3 * k + 2]
+                + (1.0 - cq) * model[AXIS_ALONG + 3 * k + 2]
+            )
+        if not ik >= 0.0:
+            solved = False
+        if ik < m_ik or (ik != ik and m_ik == m_ik):
+            m_ik = ik
+            leg_ik = k
+        x = platform_x - base_x
+        y = platform_y - base_y
+        z = platform_z - base_z
+        ax[k] = base_x
+        ay[k] = base_y
+        az[k] = base_z
+        lx[k] = x
+        ly[k] = y
+        lz[k] = z
+        squared = x * x + y * y + z * z
+        sq[k] = squared
+        inverse = 1.0 / math.sqrt(squared)
+        inverse_sq[k] = inverse * inverse
+        value = min(q - model[QMIN + k], model[QMAX + k] - q)
+        if value < m_act or (value != value and m_act == m_act):
+            m_act = value
+            leg_act = k
+        value = abs(tx * x + ty * y + tz * z) * inverse - tau_min
+        if value < m_tau or (value != value and m_tau == m_tau):
+            m_tau = value
+            leg_tau = k
+        cos_a = (jx * x + jy * y + jz * z) * inverse
+        value = model[ALPHA + k] - math.acos(min(max(cos_a, -1.0), 1.0))
+        if value < m_a or (value != value and m_a == m_a):
+            m_a = value
+            leg_a = k
+        kx = model[JB + 3 * k]
+        ky = model[JB + 3 * k + 1]
+        kz = model[JB + 3 * k + 2]
+        cos_b = (
+            (r00 * kx + r01 * ky + r02 * kz) * x
+            + (r10 * kx + r11 * ky + r12 * kz) * y
+            + (r20 * kx + r21 * ky + r22 * kz) * z
+        ) * -inverse
+        value = model[BETA + k] - math.acos(min(max(cos_b, -1.0), 1.0))
+        if value < m_b or (value != value and m_b == m_b):
+            m_b = value
+            leg_b = k
+    out[LEG_LENGTH] = np.inf
+    out[OUT_LEG + LEG_LENGTH] = 0
+    out[ACTUATOR] = m_act
+    out[OUT_LEG + ACTUATOR] = leg_act
+    out[IK] = m_ik
+    out[OUT_LEG + IK] = leg_ik
+    out[TRANSMISSION] = m_tau
+    out[OUT_LEG + TRANSMISSION] = leg_tau
+    out[BASE_JOINT] = m_a
+    out[OUT_LEG + BASE_JOINT] = leg_a
+    out[PLATFORM_JOINT] = m_b
+    out[OUT_LEG + PLATFORM_JOINT] = leg_b
+    out[OUT_SHORTEST] = model[LENGTH_FLOOR]
+    out[OUT_LEG + SINGULARITY] = 0
+    out[OUT_LEG + LEG_INTERFERENCE] = 0
+    out[OUT_PAIR] = 0
+    out[OUT_PAIR + 1] = 0
+    if not solved:
+        # Margins that need the unsolved leg's q are undefined (NaN counts as violated).
+        out[ACTUATOR] = np.nan
+        out[TRANSMISSION] = np.nan
+        out[BASE_JOINT] = np.nan
+        out[PLATFORM_JOINT] = np.nan
+        out[SINGULARITY] = np.nan if model[SINGULARITY_ON] != 0.0 else np.inf
+        out[LEG_INTERFERENCE] = np.nan if want_pair and model[INTERFERENCE] != 0.0 else np.inf
+        return
+    out[SINGULARITY] = _pose_singularity(model, r, scratch)
+    if not want_pair or model[INTERFERENCE] == 0.0:
+        out[LEG_INTERFERENCE] = np.inf
+        return
+    # Every pair in index order (the base-side ends move: no pruning by fixed A_i − A_j),
+    # Ericson's clamped closest points as in _pose; the first pair wins ties.
+    best = np.inf
+    best_pair = 0
+    for pair in range(15):
+        i = PAIR_I[pair]
+        j = PAIR_J[pair]
+        rx = ax[i] - ax[j]
+        ry = ay[i] - ay[j]
+        rz = az[i] - az[j]
+        rr = rx * rx + ry * ry + rz * rz
+        xi, yi, zi = lx[i], ly[i], lz[i]
+        xj, yj, zj = lx[j], ly[j], lz[j]
+        c = xi * rx + yi * ry + zi * rz
+        f = xj * rx + yj * ry + zj * rz
+        a = sq[i]
+        e = sq[j]
+        b = xi * xj + yi * yj + zi * zj
+        denom = a * e - b * b
+        if denom > 1e-14 * a * e:
+            s = min(max((b * f - c * e) / denom, 0.0), 1.0)
+            t = min(max((b * s + f) * inverse_sq[j], 0.0), 1.0)
+            s = min(max((b * t - c) * inverse_sq[i], 0.0), 1.0)
+        else:
+            t = 0.0 if e <= 1e-300 else _clamp01(f / e)
+            s = 0.0 if a <= 1e-300 else _clamp01((b * t - c) / a)
+        squared = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
+        distance = math.sqrt(max(squared, 0.0))
+        if distance < best or (distance != distance and best == best):
+            best = distance
+            best_pair = pair
     out[LEG_INTERFERENCE] = best - model[DIAMETER]
     out[OUT_LEG + LEG_INTERFERENCE] = PAIR_I[best_pair]
     out[OUT_PAIR] = PAIR_I[best_pair]
@@ -401,8 +672,11 @@ def _block_singularity(
     """The singularity margin of the poses of a block that take the vectorised path (the
     others are computed whole by :func:`_pose`) into the _SIGMA row, from the leg and rotation
     planes (before the outputs overwrite the rotation planes)."""
+    moving = model[ARCH] != 0.0  # pus/rus poses with an unsolved leg: NaN, not computed
     for n in range(count):
-        if work[(_MIN + _FIX) * BLOCK + n] != 0.0:
+        if work[(_MIN + _FIX) * BLOCK + n] != 0.0 or (
+            moving and work[(_MOVE + _UNSOLVED) * BLOCK + n] != 0.0
+        ):
             continue
         for k in range(6):
             leg = (_LEGS + 7 * k) * BLOCK + n
@@ -549,10 +823,16 @@ BLOCK = 128
 _CA, _SA, _CB, _SB, _CG, _SG = 0, 1, 2, 3, 4, 5
 _R = 6  # 9 rows: rotation matrix, row-major
 _PHI, _THETA, _PSI = 15, 16, 17
-_MIN = 18  # 9 rows: running minima, see the offsets below
-_LEGS = 27  # 7 rows per leg, see the offsets below
+_MIN = max(18, OUT_SHORTEST)  # 9 rows: running minima (below the outputs' rows), see below
+_LEGS = _MIN + 9  # 7 rows per leg, see the offsets below
 _SIGMA = _LEGS + 6 * 7  # σ_min − σ_lim of each pose (when the singularity margin is on)
-_BLOCK_ROWS = _SIGMA + 1
+# Moving base joints (pus, rus): the base-side end of each leg (3 rows per leg: x, y, z) and the
+# running minima of the architecture's own margins with their legs.
+_BASE = _SIGMA + 1
+_MOVE = _BASE + 18
+# _UNSOLVED: 1.0 when some leg has no inverse-kinematics solution; _UNSOLVED_LEG: the first.
+_M_ACT, _LEG_ACT, _M_IK, _LEG_IK, _M_TAU, _LEG_TAU, _UNSOLVED, _UNSOLVED_LEG = range(8)
+_BLOCK_ROWS = _MOVE + 8
 # Rows of the running minima (offsets from _MIN): margins or cosines and their leg or pair.
 _M_LEN, _LEG_LEN, _M_A, _LEG_A, _M_B, _LEG_B, _BEST, _PAIR, _FIX = range(9)
 # Rows of one leg (offsets from _LEGS + 7·k): vector, squared length, 1/ℓ², joint cosines.
@@ -563,6 +843,27 @@ _LX, _LY, _LZ, _SQ, _INV, _COS_A, _COS_B = range(7)
 def _planes(work: NDArray[np.float64], row: int, rows: int) -> NDArray[np.float64]:
     """The planes [row, row + rows) of a block scratch, as one flat view."""
     return work[row * BLOCK : (row + rows) * BLOCK]
+
+
+@_inline
+def _store_cosines(
+    leg: NDArray[np.float64],
+    minima: NDArray[np.float64],
+    n: int,
+    kf: float,
+    cos_a: float,
+    cos_b: float,
+) -> None:
+    """Pose n of leg planes: both joint cosines, and their running minima with the leg (first
+    leg on ties; one select per statement, so that the loops vectorise)."""
+    leg[_COS_A * BLOCK + n] = cos_a
+    leg[_COS_B * BLOCK + n] = cos_b
+    smallest = minima[_M_A * BLOCK + n]
+    minima[_LEG_A * BLOCK + n] = kf if cos_a < smallest else minima[_LEG_A * BLOCK + n]
+    minima[_M_A * BLOCK + n] = min(cos_a, smallest)
+    smallest = minima[_M_B * BLOCK + n]
+    minima[_LEG_B * BLOCK + n] = kf if cos_b < smallest else minima[_LEG_B * BLOCK + n]
+    minima[_M_B * BLOCK + n] = min(cos_b, smallest)
 
 
 # The leg and pair stages take their planes as separate views with constant row offsets inside:
@@ -612,16 +913,77 @@ def _leg_planes(
             + (r10 * jbx + r11 * jby + r12 * jbz) * y
             + (r20 * jbx + r21 * jby + r22 * jbz) * z
         ) * -inverse
-        leg[_COS_A * BLOCK + n] = cos_a
-        leg[_COS_B * BLOCK + n] = cos_b
-        smallest = minima[_M_A * BLOCK + n]
-        minima[_LEG_A * BLOCK + n] = kf if cos_a < smallest else minima[_LEG_A * BLOCK + n]
-        minima[_M_A * BLOCK + n] = min(cos_a, smallest)
-        smallest = minima[_M_B * BLOCK + n]
-        minima[_LEG_B * BLOCK + n] = kf if cos_b < smallest else minima[_LEG_B * BLOCK + n]
-        minima[_M_B * BLOCK + n] = min(cos_b, smallest)
+        _store_cosines(leg, minima, n, kf, cos_a, cos_b)
         degenerate = 0.0 if squared > 1e-300 else 1.0
         minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], degenerate)
+
+
+@_inline
+def _pair_squared(
+    rx: float,
+    ry: float,
+    rz: float,
+    rr: float,
+    xi: float,
+    yi: float,
+    zi: float,
+    xj: float,
+    yj: float,
+    zj: float,
+    a: float,
+    e: float,
+    inverse_i: float,
+    inverse_j: float,
+) -> tuple[float, float]:
+    """Squared distance of two leg segments A_i + s·L_i, A_j + t·L_j (r = A_i − A_j, rr = |r|²,
+    a = |L_i|², e = |L_j|², inverse_* = 1/|L|²) by Ericson's clamped closest points, and 1.0
+    when the segments are parallel or point-like (for the exact path), else 0.0."""
+    b = xi * xj + yi * yj + zi * zj
+    c = xi * rx + yi * ry + zi * rz
+    f = xj * rx + yj * ry + zj * rz
+    denom = a * e - b * b
+    s = min(max((b * f - c * e) / denom, 0.0), 1.0)
+    t = min(max((b * s + f) * inverse_j, 0.0), 1.0)
+    s = min(max((b * t - c) * inverse_i, 0.0), 1.0)
+    squared = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
+    return squared, (0.0 if denom > 1e-14 * a * e else 1.0)
+
+
+@_inline
+def _pair_at(
+    leg_i: NDArray[np.float64],
+    leg_j: NDArray[np.float64],
+    minima: NDArray[np.float64],
+    n: int,
+    rx: float,
+    ry: float,
+    rz: float,
+    rr: float,
+    pf: float,
+) -> None:
+    """Pose n of a pair plane: the segment distance of legs i and j (r = A_i − A_j) into the
+    running minimum and its pair (first pair on ties), parallel or point-like legs flagged."""
+    squared, regular = _pair_squared(
+        rx,
+        ry,
+        rz,
+        rr,
+        leg_i[_LX * BLOCK + n],
+        leg_i[_LY * BLOCK + n],
+        leg_i[_LZ * BLOCK + n],
+        leg_j[_LX * BLOCK + n],
+        leg_j[_LY * BLOCK + n],
+        leg_j[_LZ * BLOCK + n],
+        leg_i[_SQ * BLOCK + n],
+        leg_j[_SQ * BLOCK + n],
+        leg_i[_INV * BLOCK + n],
+        leg_j[_INV * BLOCK + n],
+    )
+    distance = math.sqrt(max(squared, 0.0))
+    smallest = minima[_BEST * BLOCK + n]
+    minima[_PAIR * BLOCK + n] = pf if distance < smallest else minima[_PAIR * BLOCK + n]
+    minima[_BEST * BLOCK + n] = min(distance, smallest)
+    minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], regular)
 
 
 @_helper
@@ -641,23 +1003,169 @@ def _pair_plane(
     rz = model[RPAIR + 3 * pair + 2]
     rr, pf = model[RR + pair], float(pair)
     for n in range(count):
-        xi, yi, zi = leg_i[_LX * BLOCK + n], leg_i[_LY * BLOCK + n], leg_i[_LZ * BLOCK + n]
-        xj, yj, zj = leg_j[_LX * BLOCK + n], leg_j[_LY * BLOCK + n], leg_j[_LZ * BLOCK + n]
-        a, e = leg_i[_SQ * BLOCK + n], leg_j[_SQ * BLOCK + n]
-        b = xi * xj + yi * yj + zi * zj
-        c = xi * rx + yi * ry + zi * rz
-        f = xj * rx + yj * ry + zj * rz
-        denom = a * e - b * b
-        s = min(max((b * f - c * e) / denom, 0.0), 1.0)
-        t = min(max((b * s + f) * leg_j[_INV * BLOCK + n], 0.0), 1.0)
-        s = min(max((b * t - c) * leg_i[_INV * BLOCK + n], 0.0), 1.0)
-        squared = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
-        distance = math.sqrt(max(squared, 0.0))
-        smallest = minima[_BEST * BLOCK + n]
-        minima[_PAIR * BLOCK + n] = pf if distance < smallest else minima[_PAIR * BLOCK + n]
-        minima[_BEST * BLOCK + n] = min(distance, smallest)
-        regular = 0.0 if denom > 1e-14 * a * e else 1.0
-        minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], regular)
+        _pair_at(leg_i, leg_j, minima, n, rx, ry, rz, rr, pf)
+
+
+@_helper
+def _pair_plane_moving(
+    leg_i: NDArray[np.float64],
+    leg_j: NDArray[np.float64],
+    base_i: NDArray[np.float64],
+    base_j: NDArray[np.float64],
+    minima: NDArray[np.float64],
+    count: int,
+    pair: int,
+) -> None:
+    """:func:`_pair_plane` for moving base joints: r = A_i − A_j per pose, from the base-end
+    planes (x, y, z rows of each leg)."""
+    pf = float(pair)
+    for n in range(count):
+        rx = base_i[n] - base_j[n]
+        ry = base_i[BLOCK + n] - base_j[BLOCK + n]
+        rz = base_i[2 * BLOCK + n] - base_j[2 * BLOCK + n]
+        _pair_at(leg_i, leg_j, minima, n, rx, ry, rz, rx * rx + ry * ry + rz * rz, pf)
+
+
+@_helper
+def _leg_planes_moving(
+    model: NDArray[np.float64],
+    rotation: NDArray[np.float64],
+    leg: NDArray[np.float64],
+    base: NDArray[np.float64],
+    minima: NDArray[np.float64],
+    moves: NDArray[np.float64],
+    count: int,
+    k: int,
+    px: float,
+    py: float,
+    pz: float,
+) -> None:
+    """Leg k of a pus or rus model over a block: the inverse kinematics of
+    :func:`_pose_moving` (the same closed forms), the base-side end into ``base`` (x, y, z
+    rows), the leg vector, squared length, 1/ℓ² and joint cosines into ``leg``, the running
+    minima of both cosines, of ``actuator``, ``ik`` and ``transmission`` with their legs (first
+    leg on ties); a leg without a solution flags the pose for the exact path (NaN margins)."""
+    bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
+    ox, oy, oz = model[A + 3 * k], model[A + 3 * k + 1], model[A + 3 * k + 2]
+    ux, uy, uz = model[RAIL + 3 * k], model[RAIL + 3 * k + 1], model[RAIL + 3 * k + 2]
+    ex, ey, ez = model[ZERO + 3 * k], model[ZERO + 3 * k + 1], model[ZERO + 3 * k + 2]
+    fx, fy, fz = model[CROSS + 3 * k], model[CROSS + 3 * k + 1], model[CROSS + 3 * k + 2]
+    j0x, j0y, j0z = model[JA + 3 * k], model[JA + 3 * k + 1], model[JA + 3 * k + 2]
+    cx, cy, cz = (
+        model[AXIS_CROSS + 3 * k],
+        model[AXIS_CROSS + 3 * k + 1],
+        model[AXIS_CROSS + 3 * k + 2],
+    )
+    gx, gy, gz = (
+        model[AXIS_ALONG + 3 * k],
+        model[AXIS_ALONG + 3 * k + 1],
+        model[AXIS_ALONG + 3 * k + 2],
+    )
+    jbx, jby, jbz = model[JB + 3 * k], model[JB + 3 * k + 1], model[JB + 3 * k + 2]
+    length, branch, crank = model[LEG + k], model[BRANCH + k], model[CRANK + k]
+    qmin, qmax, centre = model[QMIN + k], model[QMAX + k], model[QCENTRE + k]
+    tau_min, kf = model[TAU_MIN], float(k)
+    rus = model[ARCH] == 2.0
+    for n in range(count):
+        r00, r01, r02 = rotation[n], rotation[BLOCK + n], rotation[2 * BLOCK + n]
+        r10, r11, r12 = rotation[3 * BLOCK + n], rotation[4 * BLOCK + n], rotation[5 * BLOCK + n]
+        r20, r21, r22 = rotation[6 * BLOCK + n], rotation[7 * BLOCK + n], rotation[8 * BLOCK + n]
+        platform_x = (r00 * bx + r01 * by + r02 * bz) + px
+        platform_y = (r10 * bx + r11 * by + r12 * bz) + py
+        platform_z = (r20 * bx + r21 * by + r22 * bz) + pz
+        dx, dy, dz = platform_x - ox, platform_y - oy, platform_z - oz
+        along = ux * dx + uy * dy + uz * dz
+        hx, hy, hz = dx - along * ux, dy - along * uy, dz - along * uz
+        h = math.sqrt(hx * hx + hy * hy + hz * hz)
+        if rus:
+            a = 2.0 * crank * (dx * ex + dy * ey + dz * ez)
+            b = 2.0 * crank * (dx * fx + dy * fy + dz * fz)
+            c = (dx * dx + dy * dy + dz * dz) + crank * crank - length * length
+            ik = min(length - math.hypot(along, h - crank), math.hypot(along, h + crank) - length)
+            norm = math.hypot(a, b)
+            ratio = min(max(c / norm, -1.0), 1.0) if norm > 0.0 else 1.0
+            shifted = math.atan2(b, a) + branch * math.acos(ratio) - centre + math.pi
+            q = centre + (shifted - 2.0 * math.pi * math.floor(shifted / (2.0 * math.pi))) - math.pi
+            cq, sq_ = math.cos(q), math.sin(q)
+            base_x = ox + crank * (cq * ex + sq_ * fx)
+            base_y = oy + crank * (cq * ey + sq_ * fy)
+            base_z = oz + crank * (cq * ez + sq_ * fz)
+            tx, ty, tz = cq * fx - sq_ * ex, cq * fy - sq_ * ey, cq * fz - sq_ * ez
+            jx = cq * j0x + sq_ * cx + (1.0 - cq) * gx
+            jy = cq * j0y + sq_ * cy + (1.0 - cq) * gy
+            jz = cq * j0z + sq_ * cz + (1.0 - cq) * gz
+        else:
+            ik = length - h
+            q = along + branch * math.sqrt(max(ik * (length + h), 0.0))
+            base_x, base_y, base_z = ox + q * ux, oy + q * uy, oz + q * uz
+            tx, ty, tz = ux, uy, uz
+            jx, jy, jz = j0x, j0y, j0z
+        x, y, z = platform_x - base_x, platform_y - base_y, platform_z - base_z
+        base[n] = base_x
+        base[BLOCK + n] = base_y
+        base[2 * BLOCK + n] = base_z
+        leg[_LX * BLOCK + n] = x
+        leg[_LY * BLOCK + n] = y
+        leg[_LZ * BLOCK + n] = z
+        squared = x * x + y * y + z * z
+        leg[_SQ * BLOCK + n] = squared
+        inverse = 1.0 / math.sqrt(squared)
+        leg[_INV * BLOCK + n] = inverse * inverse
+        cos_a = (jx * x + jy * y + jz * z) * inverse
+        cos_b = (
+            (r00 * jbx + r01 * jby + r02 * jbz) * x
+            + (r10 * jbx + r11 * jby + r12 * jbz) * y
+            + (r20 * jbx + r21 * jby + r22 * jbz) * z
+        ) * -inverse
+        _store_cosines(leg, minima, n, kf, cos_a, cos_b)
+        value = min(q - qmin, qmax - q)
+        smallest = moves[_M_ACT * BLOCK + n]
+        moves[_LEG_ACT * BLOCK + n] = kf if value < smallest else moves[_LEG_ACT * BLOCK + n]
+        moves[_M_ACT * BLOCK + n] = min(value, smallest)
+        smallest = moves[_M_IK * BLOCK + n]
+        moves[_LEG_IK * BLOCK + n] = kf if ik < smallest else moves[_LEG_IK * BLOCK + n]
+        moves[_M_IK * BLOCK + n] = min(ik, smallest)
+        value = abs(tx * x + ty * y + tz * z) * inverse - tau_min
+        smallest = moves[_M_TAU * BLOCK + n]
+        moves[_LEG_TAU * BLOCK + n] = kf if value < smallest else moves[_LEG_TAU * BLOCK + n]
+        moves[_M_TAU * BLOCK + n] = min(value, smallest)
+        # Unsolved (ik < 0 or NaN), a NaN coordinate or a zero-length leg: the exact path.
+        # A leg without a solution: its margins are NaN (the outputs, below); a NaN coordinate
+        # of a solved leg or a zero-length leg: the exact path.
+        unsolved = 0.0 if ik >= 0.0 else 1.0
+        first = moves[_UNSOLVED * BLOCK + n] == 0.0 and unsolved != 0.0
+        moves[_UNSOLVED_LEG * BLOCK + n] = kf if first else moves[_UNSOLVED_LEG * BLOCK + n]
+        moves[_UNSOLVED * BLOCK + n] = max(moves[_UNSOLVED * BLOCK + n], unsolved)
+        unusable = 0.0 if ((q == q or unsolved != 0.0) and squared > 1e-300) else 1.0
+        minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], unusable)
+
+
+@_helper
+def _unsolved_outputs(
+    work: NDArray[np.float64],
+    moves: NDArray[np.float64],
+    n: int,
+    singular: bool,
+    interference: bool,
+) -> None:
+    """Outputs of pose n of a pus/rus block where some leg has no inverse-kinematics solution,
+    as :func:`_pose_moving` gives them: ``ik`` and its leg; NaN, with the first unsolved leg,
+    for every margin that needs the legs' coordinates; ``leg_length`` +inf; ``singularity`` and
+    ``leg_interference`` NaN when evaluated (+inf otherwise), leg and pair 0."""
+    leg = moves[_UNSOLVED_LEG * BLOCK + n]
+    for c in range(N_CONSTRAINTS):
+        work[c * BLOCK + n] = np.nan
+        work[(OUT_LEG + c) * BLOCK + n] = leg
+    work[LEG_LENGTH * BLOCK + n] = np.inf
+    work[(OUT_LEG + LEG_LENGTH) * BLOCK + n] = 0.0
+    work[IK * BLOCK + n] = moves[_M_IK * BLOCK + n]
+    work[(OUT_LEG + IK) * BLOCK + n] = moves[_LEG_IK * BLOCK + n]
+    work[SINGULARITY * BLOCK + n] = np.nan if singular else np.inf
+    work[(OUT_LEG + SINGULARITY) * BLOCK + n] = 0.0
+    work[LEG_INTERFERENCE * BLOCK + n] = np.nan if interference else np.inf
+    work[(OUT_LEG + LEG_INTERFERENCE) * BLOCK + n] = 0.0
+    work[OUT_PAIR * BLOCK + n] = 0.0
+    work[(OUT_PAIR + 1) * BLOCK + n] = 0.0
 
 
 @_helper
@@ -681,6 +1189,7 @@ def _check_block(
     in 8..9 (as floats).
     """
     px, py, pz = position[0], position[1], position[2]
+    moving = model[ARCH] != 0.0
     for n in range(count):  # strided reads: a loop of its own (it does not vectorise)
         work[_PHI * BLOCK + n] = angles[first + n, 0]
         work[_THETA * BLOCK + n] = angles[first + n, 1]
@@ -717,8 +1226,31 @@ def _check_block(
         work[(_R + 8) * BLOCK + n] = cb
     rotation = _planes(work, _R, 9)
     minima = _planes(work, _MIN, 9)
+    moves = _planes(work, _MOVE, 6)
+    if moving:
+        for n in range(count):
+            for row in (_M_ACT, _M_IK, _M_TAU, _UNSOLVED):
+                moves[row * BLOCK + n] = 0.0 if row == _UNSOLVED else np.inf
+                moves[(row + 1) * BLOCK + n] = 0.0
     for k in range(6):
-        _leg_planes(model, rotation, _planes(work, _LEGS + 7 * k, 7), minima, count, k, px, py, pz)
+        if moving:
+            _leg_planes_moving(
+                model,
+                rotation,
+                _planes(work, _LEGS + 7 * k, 7),
+                _planes(work, _BASE + 3 * k, 3),
+                minima,
+                moves,
+                count,
+                k,
+                px,
+                py,
+                pz,
+            )
+        else:
+            _leg_planes(
+                model, rotation, _planes(work, _LEGS + 7 * k, 7), minima, count, k, px, py, pz
+            )
     interference = model[INTERFERENCE] != 0.0
     if interference:
         pair = 0
@@ -726,7 +1258,18 @@ def _check_block(
             for j in range(i + 1, 6):
                 leg_i = _planes(work, _LEGS + 7 * i, 7)
                 leg_j = _planes(work, _LEGS + 7 * j, 7)
-                _pair_plane(model, leg_i, leg_j, minima, count, pair)
+                if moving:
+                    _pair_plane_moving(
+                        leg_i,
+                        leg_j,
+                        _planes(work, _BASE + 3 * i, 3),
+                        _planes(work, _BASE + 3 * j, 3),
+                        minima,
+                        count,
+                        pair,
+                    )
+                else:
+                    _pair_plane(model, leg_i, leg_j, minima, count, pair)
                 pair += 1
     singular = model[SINGULARITY_ON] != 0.0
     if singular:
@@ -741,8 +1284,15 @@ def _check_block(
             for slot in range(OUT_SHORTEST):
                 work[(slot) * BLOCK + n] = out[slot]
             continue
-        work[LEG_LENGTH * BLOCK + n] = work[(_MIN + _M_LEN) * BLOCK + n]
-        work[(OUT_LEG + LEG_LENGTH) * BLOCK + n] = work[(_MIN + _LEG_LEN) * BLOCK + n]
+        if moving and moves[_UNSOLVED * BLOCK + n] != 0.0:
+            _unsolved_outputs(work, moves, n, singular, interference)
+            continue
+        if moving:
+            work[LEG_LENGTH * BLOCK + n] = np.inf
+            work[(OUT_LEG + LEG_LENGTH) * BLOCK + n] = 0.0
+        else:
+            work[LEG_LENGTH * BLOCK + n] = work[(_MIN + _M_LEN) * BLOCK + n]
+            work[(OUT_LEG + LEG_LENGTH) * BLOCK + n] = work[(_MIN + _LEG_LEN) * BLOCK + n]
         if alpha_equal:
             work[BASE_JOINT * BLOCK + n] = model[ALPHA] - math.acos(
                 min(max(work[(_MIN + _M_A) * BLOCK + n], -1.0), 1.0)
@@ -774,6 +1324,10 @@ def _check_block(
             work[(OUT_PAIR + 1) * BLOCK + n] = 0.0
         work[SINGULARITY * BLOCK + n] = work[_SIGMA * BLOCK + n] if singular else np.inf
         work[(OUT_LEG + SINGULARITY) * BLOCK + n] = 0.0
+        # Rows of the moving-base architectures (+inf where they do not apply).
+        for row, slot in ((ACTUATOR, _M_ACT), (IK, _M_IK), (TRANSMISSION, _M_TAU)):
+            work[row * BLOCK + n] = moves[slot * BLOCK + n] if moving else np.inf
+            work[(OUT_LEG + row) * BLOCK + n] = moves[(slot + 1) * BLOCK + n] if moving else 0.0
 
 
 @_helper
@@ -808,7 +1362,9 @@ def check_angles(
 ) -> int:
     """Check poses ``angles[start:stop]`` (N, 3) of T&T angles (rad) at ``position`` (3,), m.
 
-    Writes, for each pose n in [start, stop): ``margins[:, n]`` (C, N) with C = N_CONSTRAINTS;
+    Writes, for each pose n in [start, stop): ``margins[:, n]`` (C, N) with C the rows in use
+    (``model[ROWS_USED]``: the rows after the last one that applies to the model are +inf for
+    every pose and not written; the arrays may have more rows);
     ``ints[:C, n]`` (C + 2, N), the 1-based leg with the smallest margin of each constraint,
     ``ints[C, n]`` the constraint with the smallest relative margin and ``ints[C + 1, n]`` its
     leg; ``pairs[n]`` (N, 2), the
@@ -832,11 +1388,12 @@ def check_angles(
     for k in range(3):
         if not math.isfinite(position[k]):
             return -2
-    scratch = np.empty((5, 6))
+    scratch = np.empty((SCRATCH_ROWS, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
     work = np.empty(_BLOCK_ROWS * BLOCK)
     enabled = 1 if model[INTERFERENCE] != 0.0 else 0
+    used = int(model[ROWS_USED])
     for first in range(start, stop, BLOCK):
         count = min(BLOCK, stop - first)
         _check_block(model, angles, position, first, count, work, scratch, out, r)
@@ -844,6 +1401,7 @@ def check_angles(
             n = first + m
             for c in range(N_CONSTRAINTS):
                 out[c] = work[c * BLOCK + m]
+            for c in range(used):
                 margins[c, n] = out[c]
                 ints[c, n] = int(work[(OUT_LEG + c) * BLOCK + m]) + 1
             ints[LEG_INTERFERENCE, n] *= enabled
@@ -851,8 +1409,8 @@ def check_angles(
             pairs[n, 0] = (int(work[OUT_PAIR * BLOCK + m]) + 1) * enabled
             pairs[n, 1] = (int(work[(OUT_PAIR + 1) * BLOCK + m]) + 1) * enabled
             worst = _limiting_constraint(model, out)
-            ints[N_CONSTRAINTS, n] = worst
-            ints[N_CONSTRAINTS + 1, n] = ints[worst, n]
+            ints[used, n] = worst
+            ints[used + 1, n] = ints[worst, n] if worst < used else 0
             reachable[n] = _feasible(out)
     return -1
 
@@ -874,7 +1432,7 @@ def check_one(
     (N_CONSTRAINTS; the interference leg 0 when the check is disabled), closest pair (2, 1-based;
     0 when disabled), the limiting constraint and its leg, and 1.0 when reachable (else 0.0).
     """
-    scratch = np.empty((5, 6))
+    scratch = np.empty((SCRATCH_ROWS, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
     _tt_matrix(phi, theta, psi, r)
@@ -909,7 +1467,7 @@ def margins_rotations(
     Writes ``margins`` (C, N), ``legs`` (C, N) (C = N_CONSTRAINTS) and ``pairs`` (N, 2) as
     :func:`check_angles`.
     """
-    scratch = np.empty((5, 6))
+    scratch = np.empty((SCRATCH_ROWS, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
     shared = positions.shape[0] == 1

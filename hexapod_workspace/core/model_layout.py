@@ -12,12 +12,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from .constraint_table import CONSTRAINTS, N_CONSTRAINTS, scales
+from .architectures import CODES
+from .constraint_table import CONSTRAINTS, N_CONSTRAINTS, applicable, scales
 
 if TYPE_CHECKING:
     from .manipulator import Manipulator
 
-__all__ = ["MODEL_SIZE", "PAIR_I", "PAIR_J", "model_vector"]
+__all__ = ["MODEL_SIZE", "PAIR_I", "PAIR_J", "ROWS_USED", "model_vector"]
 
 # ------------------------------------------------------------------------------ model layout
 # Offsets into the model vector. Per-leg 3-vectors are stored leg-major (x, y, z of leg 0, ...).
@@ -48,7 +49,27 @@ RAY_TURN = RAY_CONSTANT + N_CONSTRAINTS  # turn·ρ, m
 ESTIMATE_RATE = RAY_TURN + N_CONSTRAINTS  # the rate with ℓ_f = ESTIMATE_FLOOR
 SINGULARITY_MIN = ESTIMATE_RATE + N_CONSTRAINTS  # σ_lim of the singularity margin
 SINGULARITY_ON = SINGULARITY_MIN + 1  # 1.0 when the singularity margin is evaluated
-MODEL_SIZE = SINGULARITY_ON + 1
+# Leg architecture (core.architectures): 0 ups, 1 pus, 2 rus, and its parameters.
+ARCH = SINGULARITY_ON + 1
+RAIL = ARCH + 1  # rail directions u_i (pus) or crank axes w_i (rus), unit (18)
+ZERO = RAIL + 18  # crank zero directions e_i (rus), unit (18)
+CROSS = ZERO + 18  # f_i = w_i × e_i (rus), unit (18)
+AXIS_CROSS = CROSS + 18  # w_i × jA_i (rus: turning the base joint axes with the crank) (18)
+AXIS_ALONG = AXIS_CROSS + 18  # (w_i·jA_i)·w_i (rus) (18)
+LEG = AXIS_ALONG + 18  # fixed leg lengths L_i, m (6)
+BRANCH = LEG + 6  # assembly branch ±1 (6)
+CRANK = BRANCH + 6  # crank lengths r_i, m (rus) (6)
+QMIN = CRANK + 6  # actuator_min, m or rad (6)
+QMAX = QMIN + 6  # actuator_max (6)
+QCENTRE = QMAX + 6  # centre of the crank range (rus), rad (6)
+TAU_MIN = QCENTRE + 6  # limits.transmission_min
+# Rates along the rays for pus/rus (constraint_table): with τ_f a lower bound of |τ_i|,
+# rate = RAY_CONSTANT + RAY_TURN·(1 + 1/τ_f)/LENGTH_FLOOR + RAY_DRIVE/τ_f.
+RAY_DRIVE = TAU_MIN + 1  # (actuate·g + crank/r_min + ends)·ρ, g = 1 (pus) or 1/r_min (rus)
+# Rows of the table the batch check writes: 1 + the last row that applies to the model (the
+# rows after it are +inf for every pose; check() neither allocates nor fills them).
+ROWS_USED = RAY_DRIVE + N_CONSTRAINTS
+MODEL_SIZE = ROWS_USED + 1
 
 #: Leg pairs (i < j) in the order of numpy.triu_indices(6, 1).
 PAIR_I = np.array([i for i in range(6) for j in range(i + 1, 6)], dtype=np.int64)
@@ -110,13 +131,32 @@ def model_vector(manipulator: Manipulator, report_singularity: bool = False) -> 
         for i, j in zip(PAIR_I, PAIR_J, strict=True)
     ]
     model[ORDER : ORDER + 15] = np.argsort(home_distance, kind="stable")
+    code = CODES[manipulator.architecture]
+    _pack_architecture(model, manipulator, code)
     for c, row in enumerate(CONSTRAINTS):
         rho = model[RHO]
         model[RAY_CONSTANT + c] = row.speed * rho + row.spin
         model[RAY_TURN + c] = row.turn * rho
-        model[ESTIMATE_RATE + c] = model[RAY_CONSTANT + c] + (
-            model[RAY_TURN + c] / model[ESTIMATE_FLOOR] if row.turn != 0.0 else 0.0
-        )
+        if code == 0:
+            # 6-UPS: Q = E = V = ρ along a ray, no crank (constraint_table).
+            if row.actuate + row.ends != 0.0:
+                model[RAY_CONSTANT + c] += (row.actuate + row.ends) * rho
+            model[ESTIMATE_RATE + c] = model[RAY_CONSTANT + c] + (
+                model[RAY_TURN + c] / model[ESTIMATE_FLOOR] if row.turn != 0.0 else 0.0
+            )
+        else:
+            # pus/rus: Q = g·V/τ_f, K = V/(r_min·τ_f) (rus), E = V/τ_f, N = V(1 + 1/τ_f)/L_min.
+            cranks = manipulator.crank_lengths
+            inverse_r = 1.0 / float(np.min(cranks)) if cranks is not None else 0.0
+            gain = inverse_r if code == 2 else 1.0
+            model[RAY_DRIVE + c] = (row.actuate * gain + row.crank * inverse_r + row.ends) * rho
+            tau = model[TAU_MIN]
+            model[ESTIMATE_RATE + c] = (
+                model[RAY_CONSTANT + c]
+                + model[RAY_TURN + c] * (1.0 + 1.0 / tau) / model[LENGTH_FLOOR]
+                + model[RAY_DRIVE + c] / tau
+            )
+    model[ROWS_USED] = max(applicable(manipulator)) + 1
     model[SINGULARITY_MIN] = manipulator.singularity_min
     model[SINGULARITY_ON] = 1.0 if manipulator.singularity_min > 0.0 or report_singularity else 0.0
     model.setflags(write=False)
@@ -126,6 +166,34 @@ def model_vector(manipulator: Manipulator, report_singularity: bool = False) -> 
         models[key] = model
         weakref.finalize(manipulator, models.pop, key, None)
     return model
+
+
+def _pack_architecture(model: NDArray[np.float64], manipulator: Manipulator, code: int) -> None:
+    """The leg architecture's parameters into the model (zeros for 6-UPS)."""
+    model[ARCH] = code
+    if code == 0:
+        return
+    assert manipulator.leg_lengths is not None and manipulator.branch is not None
+    assert manipulator.actuator_min is not None and manipulator.actuator_max is not None
+    model[LEG : LEG + 6] = manipulator.leg_lengths
+    model[BRANCH : BRANCH + 6] = manipulator.branch
+    model[QMIN : QMIN + 6] = manipulator.actuator_min
+    model[QMAX : QMAX + 6] = manipulator.actuator_max
+    model[QCENTRE : QCENTRE + 6] = 0.5 * (manipulator.actuator_min + manipulator.actuator_max)
+    model[TAU_MIN] = manipulator.transmission_min
+    if code == 1:
+        assert manipulator.rail_directions is not None
+        model[RAIL : RAIL + 18] = manipulator.rail_directions.ravel()
+        return
+    w, e = manipulator.crank_axes, manipulator.crank_zero_directions
+    assert w is not None and e is not None and manipulator.crank_lengths is not None
+    axes = manipulator.base_joint_axes
+    model[RAIL : RAIL + 18] = w.ravel()
+    model[ZERO : ZERO + 18] = e.ravel()
+    model[CROSS : CROSS + 18] = np.cross(w, e).ravel()
+    model[AXIS_CROSS : AXIS_CROSS + 18] = np.cross(w, axes).ravel()
+    model[AXIS_ALONG : AXIS_ALONG + 18] = (np.einsum("ij,ij->i", w, axes)[:, None] * w).ravel()
+    model[CRANK : CRANK + 6] = manipulator.crank_lengths
 
 
 def _segment_distance_literal(

@@ -40,6 +40,7 @@ NODE_PARAMETERS = (
     "resolution.projected_method",
     "check.max_poses",
     "check.max_command_age",
+    "check.report_singularity",
     "recording.enabled",
     "recording.directory",
     "recording.max_file_mb",

@@ -15,14 +15,26 @@ The rates are constant along the move and β = θ(s) is linear in [0, π], where
 so the maximum over the move is at an end: ``Ω = max over θ ∈ {θ₀, θ₁} of |ω|``.
 
 *Joint speed.* Platform joint i is at ``B_i(s) = p(s) + R(s)·b_i``, so
-``|dB_i/ds| = |Δp + ω × R b_i| ≤ |Δp| + Ω·ρ =: V`` with ρ = max_i |b_i|. The base joints
-A_i are fixed, so each leg vector ``L_i = B_i − A_i`` moves at most at V.
+``|dB_i/ds| = |Δp + ω × R b_i| ≤ |Δp| + Ω·ρ =: V`` with ρ = max_i |b_i|. For 6-UPS the base
+joints A_i are fixed, so each leg vector ``L_i = B_i − A_i`` moves at most at V; for 6-PUS and
+6-RUS the base-side end moves too, at most at V/τ_f with τ_f a lower bound of the transmission
+``|τ_i|`` over the interval (:mod:`hexapod_workspace.core.constraint_table`).
 
 *Margins.* With ``ℓ_f`` a lower bound on every leg length over the interval considered, each
 margin is Lipschitz in s with the rate of its row of
-:mod:`hexapod_workspace.core.constraint_table`, ``speed·V + turn·V/ℓ_f + spin·Ω`` (V for
-``leg_length``, V / ℓ_f for ``base_joint``, Ω + V / ℓ_f for ``platform_joint``, 2V for
-``leg_interference``; the derivations are written there).
+:mod:`hexapod_workspace.core.constraint_table`, ``speed·V + turn·N + spin·Ω + actuate·Q +
+crank·K + ends·E`` (for 6-UPS: V for ``leg_length``, V / ℓ_f for ``base_joint``, Ω + V / ℓ_f for
+``platform_joint``, 2V for ``leg_interference``; the derivations are written there).
+
+*Moving base joints (pus, rus).* The legs have fixed lengths (ℓ_f = min L_i) and the rates
+need a transmission floor τ_f. On an interval [a, b] of width w, ``|τ|`` changes at most at
+``rate_τ(τ_f) = V/L + V(1/L + c)/τ_f`` (c = 1/r_min for rus, 0 for pus) while ``|τ| ≥ τ_f``;
+any τ_f ≤ min(τ(a), τ(b)) with ``2τ_f ≤ τ(a) + τ(b) − rate_τ(τ_f)·w`` then holds on the whole
+interval (from each end, ``|τ|`` cannot reach τ_f before the two stretches meet). Multiplied by
+τ_f this is ``2τ_f² − S·τ_f + V·w(1/L + c) ≤ 0`` with ``S = τ(a) + τ(b) − V·w/L``: the
+certificate takes the larger root, capped at min(τ(a), τ(b)), when it is admissible and the
+``ik`` bound (rate V, no floor needed) shows every leg solvable on the interval; otherwise the
+bounds that need τ_f are −inf and the interval is split.
 
 *Interval certificate.* On an interval [a, b] of width w = b − a, with margins m(a), m(b) and
 constant L, ``m(s) ≥ max(m(a) − L(s − a), m(b) − L(b − s))`` whose minimum over the interval is
@@ -61,7 +73,7 @@ from typing import TypedDict
 import numpy as np
 from numpy.typing import NDArray
 
-from .constraint_table import LEG_LENGTH, N_CONSTRAINTS, rate_bounds
+from .constraint_table import IK, LEG_LENGTH, N_CONSTRAINTS, TRANSMISSION, rate_bounds
 from .constraints import (
     PoseMargins,
     pose_margins,
@@ -88,6 +100,12 @@ class _Certifier:
         self.manipulator = manipulator
         self.rho = float(np.max(np.linalg.norm(manipulator.platform_joints, axis=1)))
         self.length_min = float(np.min(manipulator.leg_length_min))
+        self.moving = manipulator.architecture != "ups"
+        self.crank_inverse = (
+            1.0 / float(np.min(manipulator.crank_lengths))
+            if manipulator.crank_lengths is not None
+            else 0.0
+        )
 
     def margins(
         self, rotations: NDArray[np.float64], positions: NDArray[np.float64]
@@ -106,6 +124,8 @@ class _Certifier:
         """Certified lower bounds (C, n) of the margins over intervals of ``width`` (n,) in s,
         from the margins (C, n) at both ends and the move's V and Ω (n,); the rates are those
         of the constraint table (:func:`~hexapod_workspace.core.constraint_table.rate_bounds`)."""
+        if self.moving:
+            return self._lower_bounds_moving(start, end, width, speed, omega)
         travel = speed * width
         length_start, length_end = start[LEG_LENGTH], end[LEG_LENGTH]
         with np.errstate(invalid="ignore", over="ignore"):
@@ -120,6 +140,55 @@ class _Certifier:
                 np.minimum(start, end), 0.5 * (start + end - lipschitz_travel)
             )
         low[LEG_LENGTH] = low_length
+        return low
+
+    def _lower_bounds_moving(
+        self,
+        start: NDArray[np.float64],
+        end: NDArray[np.float64],
+        width: NDArray[np.float64],
+        speed: NDArray[np.float64],
+        omega: NDArray[np.float64],
+    ) -> NDArray[np.float64]:
+        """:meth:`lower_bounds` for pus/rus (the transmission floor τ_f of the module
+        documentation); where no floor can be certified (a leg may lose its solution, or |τ|
+        may reach 0) the bounds of the rows that need it are −inf."""
+        travel = speed * width
+        tau_min = self.manipulator.transmission_min
+        length = self.length_min
+        crank = self.crank_inverse
+        with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+            ik_low = np.minimum(
+                np.minimum(start[IK], end[IK]), 0.5 * (start[IK] + end[IK] - travel)
+            )
+            tau_a, tau_b = start[TRANSMISSION] + tau_min, end[TRANSMISSION] + tau_min
+            total = tau_a + tau_b - travel / length
+            product = travel * (1.0 / length + crank)
+            discriminant = total * total - 8.0 * product
+            root = np.sqrt(np.maximum(discriminant, 0.0))
+            tau_f = np.minimum(np.minimum((total + root) / 4.0, tau_a), tau_b)
+            valid = (
+                (discriminant >= 0.0)
+                & (tau_f >= (total - root) / 4.0)
+                & (tau_f > 0.0)
+                & (ik_low >= 0.0)
+            )
+            inverse = np.where(valid, 1.0 / np.where(valid, tau_f, 1.0), np.inf)
+            gain = crank if self.manipulator.architecture == "rus" else 1.0
+            lipschitz_travel = rate_bounds(
+                travel,
+                travel * (1.0 + inverse) / length,
+                omega * width,
+                actuate=travel * gain * inverse,
+                crank=travel * crank * inverse,
+                ends=travel * inverse,
+            )
+            low: NDArray[np.float64] = np.minimum(
+                np.minimum(start, end), 0.5 * (start + end - lipschitz_travel)
+            )
+        never = np.isposinf(start) & np.isposinf(end)  # rows that do not apply or are off
+        low[never] = np.inf
+        low[IK] = ik_low
         return low
 
     def relative(self, margins: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ResolutionError
+from .constraint_table import applicable
 from .constraints import CONSTRAINT_NAMES, PoseMargins, relative_margins
 from .manipulator import Manipulator
 from .path_certificate import (
@@ -47,7 +48,7 @@ def _waypoint_checks(
         positions=positions,
         angles=matrix_to_tt(rotations),
         reachable=found.reachable,
-        margins={name: found.margins[k] for k, name in enumerate(CONSTRAINT_NAMES)},
+        margins={CONSTRAINT_NAMES[k]: found.margins[k] for k in applicable(certifier.manipulator)},
         relative=certifier.relative(found.margins),
         limiting_constraint=limiting,
         limiting_leg=found.limiting_legs[limiting, columns] + 1,

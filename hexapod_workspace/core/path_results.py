@@ -62,7 +62,8 @@ class WaypointChecks:
     def margin_array(self) -> NDArray[np.float64]:
         """The margins as one array, shape (C, N), rows in the order of
         :data:`~hexapod_workspace.core.constraint_table.CONSTRAINT_NAMES`."""
-        return np.stack([self.margins[name] for name in CONSTRAINT_NAMES])
+        absent = np.full(len(self), np.inf)  # rows that do not apply to the architecture
+        return np.stack([self.margins.get(name, absent) for name in CONSTRAINT_NAMES])
 
     @property
     def violated(self) -> list[list[str]]:

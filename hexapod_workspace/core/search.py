@@ -126,6 +126,7 @@ class RaySearch:
             angles = angles.copy()
         count = angles.shape[0]
         margins = np.empty((N_CONSTRAINTS, count))
+        margins[int(self.model[kernels.ROWS_USED]) :] = np.inf  # rows the kernel leaves out
         kernels.check_angles(
             self.model,
             angles,

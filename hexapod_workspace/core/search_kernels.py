@@ -17,19 +17,29 @@ from .jit import jit as _jit
 import numpy as np
 from numpy.typing import NDArray
 
-from .constraint_table import LEG_LENGTH, N_CONSTRAINTS
+from .constraint_table import IK, LEG_LENGTH, N_CONSTRAINTS, TRANSMISSION
 from .margin_kernels import (
     _BLOCK_ROWS,
     BLOCK,
     OUT_SHORTEST,
     OUT_SIZE,
+    SCRATCH_ROWS,
     _check_block,
     _feasible,
     _limiting_constraint,
     _pose,
     _tt_matrix,
 )
-from .model_layout import ESTIMATE_RATE, LENGTH_FLOOR, RAY_CONSTANT, RAY_TURN, RHO
+from .model_layout import (
+    ARCH,
+    ESTIMATE_RATE,
+    LENGTH_FLOOR,
+    RAY_CONSTANT,
+    RAY_DRIVE,
+    RAY_TURN,
+    RHO,
+    TAU_MIN,
+)
 
 __all__ = ["KIND_CYLINDRICAL", "KIND_TT", "MAX_STEP", "SAFETY", "search_rays", "torsion_scan"]
 
@@ -78,6 +88,80 @@ def _rate(model: NDArray[np.float64], c: int, floor: float) -> float:
 
 
 @_helper
+def _rate_moving(model: NDArray[np.float64], c: int, tau: float) -> float:
+    """Lipschitz rate of margin ``c`` along a ray for a pus or rus model with |τ_i| ≥ ``tau`` > 0
+    on the stretch considered: RAY_CONSTANT + RAY_TURN·(1 + 1/τ)/L_min + RAY_DRIVE/τ (the
+    constraint table's speed·V + turn·N + spin·Ω + actuate·Q + crank·K + ends·E with V = ρ,
+    Ω = 1, N = V(1 + 1/τ)/L_min, Q = V/τ (pus) or V/(r_min·τ) (rus), K = V/(r_min·τ) (rus),
+    E = V/τ); terms with a zero coefficient left out."""
+    rate: float = model[RAY_CONSTANT + c]
+    turn = model[RAY_TURN + c]
+    if turn != 0.0:
+        rate += turn * (1.0 + 1.0 / tau) / model[LENGTH_FLOOR]
+    drive = model[RAY_DRIVE + c]
+    if drive != 0.0:
+        rate += drive / tau
+    return rate
+
+
+@_helper
+def _certified_step_moving(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
+    """certified_step for pus/rus (feasible margins, so every leg has its q and
+    |τ_i| ≥ τ_lim > 0). With τ_now = min |τ_i| and τ_f = max(τ_lim, τ_now/2), the rates with
+    floor τ_f hold as long as |τ| ≥ τ_f; the step is also limited to (τ_now − τ_f)/rate_τ(τ_f),
+    within which |τ| cannot fall to τ_f (the first such point would contradict the rate), and
+    ``ik`` (rate V, independent of τ) keeps every leg solvable over any step it allows."""
+    tau_now = out[TRANSMISSION] + model[TAU_MIN]
+    tau_f = max(model[TAU_MIN], 0.5 * tau_now)
+    step = (tau_now - tau_f) / _rate_moving(model, TRANSMISSION, tau_f)
+    for c in range(N_CONSTRAINTS):
+        step = _fmin(step, out[c] / _rate_moving(model, c, tau_f))
+    step = _fmin(step, MAX_STEP)
+    if not step > 0.0:
+        step = 0.0
+    return step * SAFETY
+
+
+@_helper
+def _recovery_step_moving(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
+    """recovery_step for pus/rus, the largest of three valid bounds:
+
+    * a violated ``ik`` stays violated for |ik|/ρ (1-Lipschitz in each B_i, which moves at ≤ ρ);
+    * a violated ``transmission`` (every leg solved, τ_now = min |τ_i| < τ_lim): to climb back
+      to τ_lim, |τ| must cross [τ_now, τ_lim] on a stretch where it stays ≥ τ_now, so the legs
+      stay solved (a leg loses its solution only through τ = 0: at ik = 0 the leg is tangent
+      to its actuator's locus) and its rate is at most rate_τ(τ_now): it stays violated for
+      (τ_lim − τ_now)/rate_τ(τ_now);
+    * another violated margin (every leg solved, τ_now > 0): with τ_f = τ_now/2 and the step
+      kept within (τ_now − τ_f)/rate_τ(τ_f), |τ| stays above τ_f (the legs stay solved, q is
+      continuous) and the margin cannot climb back to zero within |m_c|/rate_c(τ_f).
+
+    NaN margins (a leg without a solution) give no bound but ik's."""
+    rho: float = model[RHO]
+    recover = 0.0
+    if out[IK] < 0.0:
+        recover = -out[IK] / rho
+    tau_now = out[TRANSMISSION] + model[TAU_MIN]
+    if out[IK] >= 0.0 and tau_now > 0.0:
+        if out[TRANSMISSION] < 0.0:
+            climb = -out[TRANSMISSION] / _rate_moving(model, TRANSMISSION, tau_now)
+            if climb > recover:
+                recover = climb
+        tau_f = 0.5 * tau_now
+        other = 0.0
+        for c in range(N_CONSTRAINTS):
+            if c == IK or c == TRANSMISSION:  # noqa: SIM109 - plain comparisons for numba
+                continue
+            value = -out[c] / _rate_moving(model, c, tau_f) if out[c] < 0.0 else 0.0
+            if value > other:
+                other = value
+        other = min(other, (tau_now - tau_f) / _rate_moving(model, TRANSMISSION, tau_f))
+        if other > recover:
+            recover = other
+    return recover * SAFETY
+
+
+@_helper
 def _estimate(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
     """Signed distance estimate min_c m_c / L_c with fixed Lipschitz constants, rad (NaN wins).
 
@@ -105,6 +189,8 @@ def _fmin(a: float, b: float) -> float:
 @_helper
 def certified_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
     """Length over which no margin can reach zero, from feasible margins (core.search)."""
+    if model[ARCH] != 0.0:
+        return _certified_step_moving(model, out)
     rho = model[RHO]
     length_min = model[LENGTH_FLOOR]
     length_now = length_min + max(out[LEG_LENGTH], 0.0)
@@ -124,6 +210,8 @@ def recovery_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> float
     """Length over which a violated pose stays violated: the most violated constraint, in
     Lipschitz units, cannot climb back to zero within |m_c| / L_c; joint-angle bounds use half
     the current shortest leg, and the step keeps every leg at least that long."""
+    if model[ARCH] != 0.0:
+        return _recovery_step_moving(model, out)
     rho: float = model[RHO]
     floor: float = 0.5 * out[OUT_SHORTEST]
     recover = 0.0
@@ -202,7 +290,7 @@ def search_rays(
     rays = np.empty(count, dtype=np.int64)
     angles = np.empty((count, 3))
     work = np.empty(_BLOCK_ROWS * BLOCK)
-    scratch = np.empty((5, 6))
+    scratch = np.empty((SCRATCH_ROWS, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
     half = 0.25 * tolerance
@@ -323,7 +411,7 @@ def torsion_scan(
     start_ok : bool
         Whether ψ = −π is feasible.
     """
-    scratch = np.empty((5, 6))
+    scratch = np.empty((SCRATCH_ROWS, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
     capacity = edges.shape[0]

@@ -79,7 +79,10 @@ def home_conditioning(manipulator: Manipulator) -> float:
     identity orientation, b_i the platform joint (mobile frame = base frame orientation there),
     ρ = max |b_i| (1 m when every b_i is 0). Dimensionless; 0 for a singular platform.
     """
-    legs = manipulator.home_position + manipulator.platform_joints - manipulator.base_joints
+    from .legs import leg_endpoints
+
+    base, platform = leg_endpoints(manipulator, np.eye(3), manipulator.home_position)
+    legs = platform[0] - base[0]
     directions = legs / np.linalg.norm(legs, axis=1)[:, None]
     radius = float(np.max(np.linalg.norm(manipulator.platform_joints, axis=1))) or 1.0
     moments = np.cross(manipulator.platform_joints, directions) / radius
@@ -89,6 +92,11 @@ def home_conditioning(manipulator: Manipulator) -> float:
 
 def _unit_hint(manipulator: Manipulator) -> str:
     """Which lengths look like millimetres, from the home leg lengths against the limits."""
+    if manipulator.architecture != "ups":
+        return (
+            "parameters are in metres and radians (a unit mistake, millimetres or degrees, is "
+            "the usual cause)"
+        )
     legs = manipulator.home_position + manipulator.platform_joints - manipulator.base_joints
     lengths = np.linalg.norm(legs, axis=1)
     low, high = manipulator.leg_length_min, manipulator.leg_length_max

@@ -151,7 +151,12 @@ class CommandStream:
     ) -> None:
         """One check for the commands ``members`` at ``position``; one by one if it fails."""
         try:
-            result = check(state.manipulator, angles[members], position)
+            result = check(
+                state.manipulator,
+                angles[members],
+                position,
+                singularity=state.settings.report_singularity,
+            )
         except InputError as error:
             if members.size > 1:  # find the invalid one(s)
                 for k in members:

@@ -4,9 +4,10 @@ The nested ``~/check_poses`` builds and (de)serialises one ``PoseCheck`` message
 10 µs a pose in rclpy, a hundred times the compiled check itself. This form carries the same
 verdicts in a handful of arrays: the request's angles as one ``float64[]`` (N × 3, row-major),
 the answer's margins as one ``float64[]`` (N × K, row-major) with the K constraint names once
-(``constraint_names``, read from :data:`hexapod_workspace.core.constraints.CONSTRAINT_NAMES`,
-never counted here), ``reachable`` and ``limiting_leg`` one value per pose. The arrays go in and
-out of the messages as numpy buffers (``array.array`` for rclpy), with no Python loop per pose.
+(``constraint_names``: the rows of :data:`hexapod_workspace.core.constraints.CONSTRAINT_NAMES`
+that apply to the model, never counted here), ``reachable`` and ``limiting_leg`` one value per
+pose. The arrays go in and out of the messages as numpy buffers (``array.array`` for rclpy),
+with no Python loop per pose.
 Requests and answers are recorded like the other services' (``<service>/request`` and
 ``/response``, as the message twins ``CheckPosesFlatRequest``/``CheckPosesFlatResponse``).
 The position and angles are in the frame ``header.frame_id`` names (base or work,
@@ -16,12 +17,14 @@ The position and angles are in the frame ``header.frame_id`` names (base or work
 from __future__ import annotations
 
 import array
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 from hexapod_workspace_msgs.srv import CheckPosesFlat
 from numpy.typing import NDArray
 
+from hexapod_workspace.core.constraint_table import constraint_names
 from hexapod_workspace.core.constraints import CONSTRAINT_NAMES, CheckResult, check
 from hexapod_workspace.errors import InputError
 
@@ -65,8 +68,9 @@ def angles_from_flat(values: Any, max_poses: int) -> NDArray[np.float64]:
 
 
 def flat_margins(result: CheckResult) -> NDArray[np.float64]:
-    """Margins of ``result``, shape (N, K): column k is constraint ``CONSTRAINT_NAMES[k]``."""
-    return np.column_stack([np.asarray(result.margins[name]) for name in CONSTRAINT_NAMES])
+    """Margins of ``result``, shape (N, K): column k is constraint ``list(result.margins)[k]``
+    (the constraints of the model's leg architecture, in table order)."""
+    return np.column_stack([np.asarray(values) for values in result.margins.values()])
 
 
 def _doubles(values: NDArray[Any]) -> array.array:
@@ -82,11 +86,16 @@ def _int32s(values: NDArray[Any]) -> array.array:
 
 
 def flat_response(
-    result: CheckResult | None, *, message: str | None = None
+    result: CheckResult | None,
+    *,
+    message: str | None = None,
+    names: Sequence[str] = CONSTRAINT_NAMES,
 ) -> CheckPosesFlat.Response:
     """The answer to a flat request: the verdicts of ``result``, or a refusal (``result`` None,
-    ``message`` the reason; every array empty, ``constraint_names`` still given)."""
-    response = CheckPosesFlat.Response(constraint_names=list(CONSTRAINT_NAMES))
+    ``message`` the reason; every array empty, ``constraint_names`` still given: ``names``, the
+    model's)."""
+    names = list(result.margins) if result is not None else list(names)
+    response = CheckPosesFlat.Response(constraint_names=names)
     if result is None:
         response.success = False
         response.message = message or "request failed"
@@ -109,6 +118,7 @@ def attach(node: Any, name: str) -> Any:
     ) -> CheckPosesFlat.Response:
         node.stats.check_calls += 1
         state = node.state
+        names = constraint_names(state.manipulator)
         try:
             angles, position = angles_to_base(
                 state,
@@ -116,11 +126,18 @@ def attach(node: Any, name: str) -> Any:
                 angles_from_flat(request.angles, state.settings.max_poses),
                 position_from_point(request.position),
             )
-            answer = flat_response(check(state.manipulator, angles, position))
+            answer = flat_response(
+                check(
+                    state.manipulator,
+                    angles,
+                    position,
+                    singularity=state.settings.report_singularity,
+                )
+            )
         except InputError as error:
-            answer = flat_response(None, message=str(error))
+            answer = flat_response(None, message=str(error), names=names)
         except Exception as error:  # a bug: answered, never silence
-            answer = flat_response(None, message=node.internal_error(error))
+            answer = flat_response(None, message=node.internal_error(error), names=names)
         if not answer.success:
             node.stats.check_refused += 1
         if state is not None:

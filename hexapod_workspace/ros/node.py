@@ -380,7 +380,10 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         if unknown is not None:
             raise ConfigError(f"unknown parameter given to the node: {unknown}")
         given = model_given(names)
-        missing = missing_model_parameters(given) if given else None
+        overrides = getattr(self, "_parameter_overrides", {})
+        chosen = overrides.get("geometry.architecture")
+        architecture = str(chosen.value) if chosen is not None else "ups"
+        missing = missing_model_parameters(given, architecture) if given else None
         if missing is not None:
             raise ConfigError(missing)
         declared: dict[str, Any] = {}
@@ -531,7 +534,12 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
                     angles_from_orientations(request.orientations),
                     position_from_point(request.position),
                 )
-                result = check(state.manipulator, angles, position)
+                result = check(
+                    state.manipulator,
+                    angles,
+                    position,
+                    singularity=state.settings.report_singularity,
+                )
                 return messages.check_poses_response_fields(result)
             except InputError as error:
                 reason = str(error)

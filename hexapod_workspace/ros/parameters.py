@@ -33,8 +33,14 @@ from rclpy.parameter import Parameter
 
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import resolution
+from hexapod_workspace.core.architectures import ARCHITECTURES
 from hexapod_workspace.core.frames import CELL_DEFAULTS, CellFrames, cell_from_mapping, tool_model
-from hexapod_workspace.core.manipulator import PARAMETER_DEFAULTS, Manipulator
+from hexapod_workspace.core.manipulator import (
+    ARCHITECTURE_PARAMETERS,
+    PARAMETER_DEFAULTS,
+    Manipulator,
+    required_parameters,
+)
 from hexapod_workspace.core.validation import require_usable
 from hexapod_workspace.errors import ConfigError
 
@@ -80,8 +86,8 @@ MODEL_DESCRIPTIONS = {
         "Axes of symmetry of the platform joints, mobile frame, pointing into the legs: 18 "
         "floats, or empty/unset = reversed leg directions at the home pose."
     ),
-    "limits.leg_length_min": "Minimum leg length |A_iB_i|, m: 1 value (all legs) or 6.",
-    "limits.leg_length_max": "Maximum leg length |A_iB_i|, m: 1 value (all legs) or 6.",
+    "limits.leg_length_min": "ups: minimum leg length |A_iB_i|, m: 1 value (all legs) or 6.",
+    "limits.leg_length_max": "ups: maximum leg length |A_iB_i|, m: 1 value (all legs) or 6.",
     "limits.base_joint_max_angle": (
         "Maximum angle between a base joint axis and its leg, rad, in (0, pi): 1 or 6 values."
     ),
@@ -98,11 +104,54 @@ MODEL_DESCRIPTIONS = {
     "pose.position": (
         "Default tool-tip position OC, base frame, m (3 floats): used by the Trigger services."
     ),
+    "geometry.architecture": (
+        "Leg architecture: ups (legs of variable length between fixed joints), pus (slides on "
+        "rails, legs of fixed length) or rus (cranks, rods of fixed length)."
+    ),
+    "geometry.rail_directions": (
+        "pus: direction u_i of each rail, base frame, 18 floats (normalised); "
+        "A_i(q) = A0_i + q u_i with A0_i = geometry.base_joints. Empty for ups and rus."
+    ),
+    "geometry.crank_axes": (
+        "rus: crank (motor) axis w_i through A0_i = geometry.base_joints, base frame, 18 floats "
+        "(normalised). Empty for ups and pus."
+    ),
+    "geometry.crank_zero_directions": (
+        "rus: crank direction e_i at q = 0, perpendicular to w_i, 18 floats (normalised). "
+        "Empty for ups and pus."
+    ),
+    "geometry.crank_lengths": "rus: crank length r_i, m: 1 value (all legs) or 6.",
+    "geometry.leg_lengths": "pus, rus: fixed leg (rod) length L_i, m: 1 value or 6.",
+    "geometry.branch": (
+        "pus, rus: assembly branch of each leg, +1 or -1: 1 value or 6 (empty = +1)."
+    ),
+    "limits.actuator_min": (
+        "pus: slide stroke minimum along the rail, m; rus: crank angle minimum, rad: 1 or 6."
+    ),
+    "limits.actuator_max": (
+        "pus: slide stroke maximum, m; rus: crank angle maximum, rad (max - min < 2 pi): 1 or 6."
+    ),
+    "limits.transmission_min": (
+        "pus, rus: smallest |tau_i| allowed (tau: the leg direction against the actuator's "
+        "motion), in (0, 1)."
+    ),
 }
 #: Ranges of the model's scalar parameters (the model validation says the same).
-_FLOAT_RANGES = {"limits.leg_diameter": (0.0, 10.0), "limits.singularity_min": (0.0, 1.0)}
+_FLOAT_RANGES = {
+    "limits.leg_diameter": (0.0, 10.0),
+    "limits.singularity_min": (0.0, 1.0),
+    "limits.transmission_min": (0.0, 1.0),
+}
 #: Axes that may be empty: an empty YAML list arrives as an unset parameter of any type.
 _OPTIONAL_AXES = ("geometry.base_joint_axes", "geometry.platform_joint_axes")
+#: Arrays that are empty for some architecture (the model refuses non-numbers): typed at run
+#: time, like the optional axes.
+_ARCHITECTURE_ARRAYS = tuple(
+    name
+    for names in ARCHITECTURE_PARAMETERS.values()
+    for name in names
+    if isinstance(PARAMETER_DEFAULTS[name], list) or PARAMETER_DEFAULTS[name] is None
+)
 
 
 @dataclass(frozen=True)
@@ -152,8 +201,12 @@ def parameter_specs() -> dict[str, Spec]:
             [] if name in _OPTIONAL_AXES else default,
             MODEL_DESCRIPTIONS[name],
             read_only=name == "frame_id",
-            dynamic_typing=name in _OPTIONAL_AXES,  # the model validation refuses non-numbers
+            # the model validation refuses non-numbers
+            dynamic_typing=name in _OPTIONAL_AXES or name in _ARCHITECTURE_ARRAYS,
             float_range=_FLOAT_RANGES.get(name),
+            constraints=(
+                f"one of: {', '.join(ARCHITECTURES)}" if name == "geometry.architecture" else ""
+            ),
         )
         for name, default in example.items()
     ]
@@ -203,6 +256,14 @@ def parameter_specs() -> dict[str, Spec]:
             "clock) is answered success=false 'overloaded' instead of checked; 0 = never. "
             "Commands with a zero stamp are always checked.",
             float_range=(0.0, 3600.0),
+        ),
+        Spec(
+            "check.report_singularity",
+            False,
+            "Report the singularity margin (sigma_min of the legs' Pluecker matrix) in the "
+            "answers of check_poses, check_poses_flat and the command stream even when "
+            "limits.singularity_min is 0 (then it never changes a verdict); false: null/+inf "
+            "there, at no cost.",
         ),
         Spec(
             "recording.enabled",
@@ -345,6 +406,7 @@ class Settings:
     projected_method: str
     max_poses: int
     max_command_age: float
+    report_singularity: bool
     recording_enabled: bool
     recording_directory: Path
     recording_rotation: Rotation
@@ -487,6 +549,7 @@ def state_from(values: dict[str, Any]) -> State:
         projected_method=method,
         max_poses=int(values["check.max_poses"]),
         max_command_age=age,
+        report_singularity=bool(values["check.report_singularity"]),
         recording_enabled=bool(values["recording.enabled"]),
         recording_directory=folder,
         recording_rotation=Rotation(
@@ -513,18 +576,15 @@ def model_given(names: Iterable[str]) -> list[str]:
     )
 
 
-def missing_model_parameters(given: Iterable[str]) -> str | None:
+def missing_model_parameters(given: Iterable[str], architecture: str = "ups") -> str | None:
     """Why a start with model parameters ``given`` (non-empty) is refused, or None.
 
-    A node given any model parameter must be given every required one: the packaged example
-    never fills in the rest of a user's machine.
+    A node given any model parameter must be given every required one of its architecture
+    (``geometry.architecture`` as given, else ups): the packaged example never fills in the
+    rest of a user's machine.
     """
     given = set(given)
-    required = [
-        name
-        for name, default in PARAMETER_DEFAULTS.items()
-        if default is None and name.startswith(MODEL_GROUPS) and name != "pose.position"
-    ]
+    required = list(required_parameters(architecture))
     missing = [name for name in required if name not in given]
     if not missing:
         return None
@@ -544,6 +604,8 @@ def model_default(name: str, declared: dict[str, Any]) -> Any:
         return list(declared["geometry.home_position"])
     if name in CELL_DEFAULTS:  # limits.actuator_speed_max: the cell's own default
         return CELL_DEFAULTS[name]
+    if name in _ARCHITECTURE_ARRAYS:
+        return []  # not this architecture's: left empty
     return PARAMETER_DEFAULTS[name]
 
 

@@ -17,7 +17,7 @@ require_ros()
 from hexapod_workspace_msgs.srv import CheckPoses, CheckPosesFlat  # noqa: E402
 from test_ros_node import check_request, sample_angles  # noqa: E402
 
-from hexapod_workspace import CONSTRAINT_NAMES, check, logs  # noqa: E402
+from hexapod_workspace import check, logs  # noqa: E402
 from hexapod_workspace.errors import InputError  # noqa: E402
 from hexapod_workspace.logs.summary import summarize_log  # noqa: E402
 from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402
@@ -26,6 +26,10 @@ from hexapod_workspace.ros.flat import angles_from_flat, flat_margins  # noqa: E
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # test/recording_support.py
 from recording_support import read_with_foxglove, read_with_rosbags_documented  # noqa: E402
 from test_node_recording import NAMESPACES, node_args  # noqa: E402
+
+#: The constraints of a 6-UPS model: the names the node gives for the example (the rows of the
+#: constraint table that apply to it), as before the leg architectures.
+CONSTRAINT_NAMES = ("leg_length", "base_joint", "platform_joint", "leg_interference", "singularity")
 
 NAMESPACES.setdefault("flat", "/flat_log")  # node_args puts the node there
 

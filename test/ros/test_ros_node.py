@@ -26,12 +26,15 @@ from rcl_interfaces.srv import (  # noqa: E402
 )
 
 from hexapod_workspace import (  # noqa: E402
-    CONSTRAINT_NAMES,
     Manipulator,
     check,
     logs,
 )
 from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402
+
+#: The constraints of a 6-UPS model: the names the node gives for the example (the rows of the
+#: constraint table that apply to it), as before the leg architectures.
+CONSTRAINT_NAMES = ("leg_length", "base_joint", "platform_joint", "leg_interference", "singularity")
 
 NODE = "/hexapod_workspace"
 #: Small resolutions keep the workspace computations of the tests short.
