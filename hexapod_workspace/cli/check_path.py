@@ -168,7 +168,9 @@ def path_to_json(
     waypoints, segments = path.waypoints, path.segments
     angles_deg = np.degrees(waypoints.angles) if degrees is None else degrees
     violated = waypoints.violated
-    margins = {name: waypoints.margins[name].tolist() for name in CONSTRAINT_NAMES}
+    scene = len(waypoints.collision_pair) > 0
+    names = [name for name in CONSTRAINT_NAMES if name != "collision" or scene]
+    margins = {name: waypoints.margins[name].tolist() for name in names}
     document: dict[str, Any] = {
         "ok": bool(path.ok and (plan is None or plan.ok)),
         "planned_torsion": plan is not None,
@@ -183,9 +185,10 @@ def path_to_json(
                 "psi_deg": float(angles_deg[k, 2]),
                 "reachable": bool(waypoints.reachable[k]),
                 "violated": violated[k],
-                "margins": {name: _number(margins[name][k]) for name in CONSTRAINT_NAMES},
+                "margins": {name: _number(margins[name][k]) for name in names},
                 "limiting_leg": int(waypoints.limiting_leg[k]),
                 "relative_margin": _number(waypoints.relative[k]),
+                **({"collision_pair": waypoints.collision_pair[k]} if scene else {}),
             }
             for k in range(len(waypoints))
         ],
@@ -231,10 +234,21 @@ def _segment_json(segments: Any, k: int) -> dict[str, Any]:
         "min_relative_margin": _number(segments.min_relative_margin[k]),
         "min_at_s": float(segments.min_at_s[k]),
         "min_relative_margin_bound": _number(segments.min_relative_margin_bound[k]),
+        **(
+            {"collision_pair": None if ok else segments.collision_pair[k]}
+            if len(segments.collision_pair)
+            else {}
+        ),
     }
 
 
 # ---------------------------------------------------------------------------- text
+def _pair_text(entry: dict[str, Any]) -> str:
+    """ ", tool vs leg 4" when the entry's collision margin is violated, else ""."""
+    pair = entry.get("collision_pair")
+    return f", {pair}" if pair and "collision" in entry["violated"] else ""
+
+
 def _text(result: PathCheck | TorsionPlan, document: dict[str, Any], out: IO[str]) -> None:
     plan = result if isinstance(result, TorsionPlan) else None
     waypoints, segments = document["waypoints"], document["segments"]
@@ -270,14 +284,14 @@ def _text(result: PathCheck | TorsionPlan, document: dict[str, Any], out: IO[str
     for w in failing_w[:10]:
         out.write(
             f"  waypoint {w['index']}: unreachable ({', '.join(w['violated'])}, "
-            f"leg {w['limiting_leg']})\n"
+            f"leg {w['limiting_leg']}{_pair_text(w)})\n"
         )
     for s in failing_s[:10]:
         phi, theta, psi = s["first_violation_pose_deg"]
         out.write(
             f"  move {s['index']}: leaves the workspace at s = {s['first_violation_s']:.5f} "
             f"(phi {phi:.2f}, theta {theta:.2f}, psi {psi:.2f} deg): "
-            f"{', '.join(s['violated'])}, leg {s['limiting_leg']}\n"
+            f"{', '.join(s['violated'])}, leg {s['limiting_leg']}{_pair_text(s)}\n"
         )
     baseline = document["psi_zero_baseline"]
     out.write(

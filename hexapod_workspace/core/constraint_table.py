@@ -28,7 +28,18 @@ constraint           speed turn  spin  why
 ``platform_joint``   0     1     1     R·jB_i turns at Ω, n_i at ≤ V / ℓ_f
 ``leg_interference`` 2     0     0     each segment A_iB_i moves by ≤ V (Hausdorff), two move
 ``singularity``      0     √12   √12   Weyl's inequality, below
+``collision``        1     0     ρ_c   a body point moves at ≤ |ṗ| + Ω·r, below
 ==================== ===== ===== ===== =======================================================
+
+*Collision.* ``collision = min over the checked pairs of sd − collision.clearance`` (signed
+distances of the scene's bodies, :mod:`hexapod_workspace.core.collision.scene`), present only
+when the model declares a scene with at least one pair (``Constraint.applies``; +inf
+otherwise). :func:`hexapod_workspace.core.collision.scene.rate_bound` derives
+``|dm/ds| ≤ |ṗ| + ρ_c·Ω`` with ρ_c the model's largest moving-body radius about the tool centre
+point; since ``V = |Δp| + ρ·Ω ≥ |ṗ|``, speed 1 and spin ρ_c bound it: the ``spin`` coefficient
+of this row depends on the model (:meth:`Constraint.coefficients`). The derivation holds for
+base joints A_i that stand still (6-UPS); where a leg architecture moves A_i, each leg body's
+rate must add that joint's speed.
 
 *Singularity.* ``singularity = σ_min(M) − σ_lim`` (σ_lim = ``limits.singularity_min``), M the
 6×6 matrix with rows ``r_i = (n_iᵀ, ((R·b_i) × n_i)ᵀ / ρ)``: the unit leg lines in Plücker
@@ -65,6 +76,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BASE_JOINT",
+    "COLLISION",
     "CONSTRAINTS",
     "CONSTRAINT_NAMES",
     "INDEX",
@@ -105,8 +117,10 @@ class Constraint:
         margin / scale is its relative margin (dimensionless).
     scale_text : str
         What the scale is, in words.
-    speed, turn, spin : float
-        Rate coefficients: ``|dm/ds| ≤ speed·V + turn·V/ℓ_f + spin·Ω`` (module documentation).
+    speed, turn, spin : float or callable
+        Rate coefficients: ``|dm/ds| ≤ speed·V + turn·V/ℓ_f + spin·Ω`` (module documentation);
+        a callable ``coefficient(manipulator)`` where it depends on the model (read them through
+        :meth:`coefficients`).
     applies : callable
         ``applies(manipulator)``: whether the constraint exists for this model (a leg-length
         stroke exists only where legs change length, a collision margin only where bodies are
@@ -123,10 +137,22 @@ class Constraint:
     report_factor: float
     scale: Callable[[Manipulator], float]
     scale_text: str
-    speed: float
-    turn: float
-    spin: float
+    speed: float | Callable[[Manipulator], float]
+    turn: float | Callable[[Manipulator], float]
+    spin: float | Callable[[Manipulator], float]
     applies: Callable[[Manipulator], bool] = lambda manipulator: True
+
+    def coefficients(self, manipulator: Manipulator) -> tuple[float, float, float]:
+        """(speed, turn, spin) of this row for ``manipulator`` (a constant row ignores it)."""
+        return (
+            _value(self.speed, manipulator),
+            _value(self.turn, manipulator),
+            _value(self.spin, manipulator),
+        )
+
+
+def _value(coefficient: float | Callable[[Manipulator], float], manipulator: Manipulator) -> float:
+    return float(coefficient(manipulator) if callable(coefficient) else coefficient)
 
 
 def _half_stroke(manipulator: Manipulator) -> float:
@@ -151,6 +177,28 @@ SQRT12 = float(np.sqrt(12.0))
 
 def _diameter(manipulator: Manipulator) -> float:
     return manipulator.leg_diameter if manipulator.leg_diameter > 0.0 else 1.0
+
+
+def _has_scene(manipulator: Manipulator) -> bool:
+    scene = getattr(manipulator, "collision", None)
+    return scene is not None and scene.pair_count > 0
+
+
+def _collision_spin(manipulator: Manipulator) -> float:
+    """ρ_c of :func:`hexapod_workspace.core.collision.scene.rate_bound` (0 without a scene)."""
+    if not _has_scene(manipulator):
+        return 0.0
+    from .collision.scene import rate_bound
+
+    return rate_bound(manipulator, manipulator.collision).rotation  # type: ignore[arg-type]
+
+
+def _collision_scale(manipulator: Manipulator) -> float:
+    """The clearance, or the leg diameter, or 1 cm: a length at which a collision matters."""
+    scene = getattr(manipulator, "collision", None)
+    if scene is not None and scene.clearance > 0.0:
+        return float(scene.clearance)
+    return manipulator.leg_diameter if manipulator.leg_diameter > 0.0 else 0.01
 
 
 #: The table, in the order of every margin array (rows of shape (N_CONSTRAINTS, N) arrays).
@@ -225,6 +273,21 @@ CONSTRAINTS: tuple[Constraint, ...] = (
         turn=SQRT12,
         spin=SQRT12,
     ),
+    Constraint(
+        name="collision",
+        unit="m",
+        margin="min over the scene's pairs of sd − collision.clearance; +inf without a scene",
+        label="collision",
+        column="collision",
+        report_unit="mm",
+        report_factor=1e3,
+        scale=_collision_scale,
+        scale_text="collision.clearance (else the leg diameter D, else 1 cm)",
+        speed=1.0,
+        turn=0.0,
+        spin=_collision_spin,
+        applies=_has_scene,
+    ),
 )
 
 #: The constraint names, in table order.
@@ -239,13 +302,18 @@ BASE_JOINT = INDEX["base_joint"]
 PLATFORM_JOINT = INDEX["platform_joint"]
 LEG_INTERFERENCE = INDEX["leg_interference"]
 SINGULARITY = INDEX["singularity"]
+COLLISION = INDEX["collision"]
 
 
 def rate_bounds(
-    speed: NDArray[np.float64], turn: NDArray[np.float64], spin: NDArray[np.float64]
+    manipulator: Manipulator,
+    speed: NDArray[np.float64],
+    turn: NDArray[np.float64],
+    spin: NDArray[np.float64],
 ) -> NDArray[np.float64]:
     """Bounds on how much each margin changes, shape (N_CONSTRAINTS, n), from V, V/ℓ_f and Ω
-    (or their integrals over an interval: travel, travel/ℓ_f, turned angle), each shape (n,).
+    (or their integrals over an interval: travel, travel/ℓ_f, turned angle), each shape (n,),
+    with the coefficients of ``manipulator``'s rows (:meth:`Constraint.coefficients`).
 
     ``speed·V + turn·V/ℓ_f + spin·Ω`` per row of the table; a term whose coefficient is 0 is
     left out (so an infinite V/ℓ_f, no leg floor, only affects the rows that turn with it). The
@@ -253,7 +321,8 @@ def rate_bounds(
     """
     bounds = np.zeros((N_CONSTRAINTS, np.shape(speed)[0]))
     for k, row in enumerate(CONSTRAINTS):
-        for coefficient, value in ((row.speed, speed), (row.turn, turn), (row.spin, spin)):
+        coefficients = row.coefficients(manipulator)
+        for coefficient, value in zip(coefficients, (speed, turn, spin), strict=True):
             if coefficient != 0.0:
                 bounds[k] = bounds[k] + coefficient * value
     return bounds

@@ -305,8 +305,16 @@ def tool_model(manipulator: Manipulator, tool: Tool) -> Manipulator:
         at P's home pose, ``home + t`` (used only to order leg pairs); ``position`` (the
         default pose position) is the tool centre point's.
     """
-    if tool.is_identity:
+    if tool.is_identity and manipulator.collision is None:
         return manipulator
+    scene = manipulator.collision
+    if scene is not None:
+        transform = np.eye(4)
+        transform[:3, :3] = tool.rotation
+        transform[:3, 3] = tool.offset
+        scene = scene.in_tool_frame(transform)
+    if tool.is_identity:
+        return replace(manipulator, collision=scene)
     rotation_t = tool.rotation.T
     joints = (manipulator.platform_joints - tool.offset) @ rotation_t.T
     axes = manipulator.platform_joint_axes @ rotation_t.T
@@ -316,6 +324,7 @@ def tool_model(manipulator: Manipulator, tool: Tool) -> Manipulator:
         platform_joint_axes=_frozen(axes),
         home_position=_frozen(manipulator.home_position + tool.offset),
         axes_from_home=(manipulator.axes_from_home[0], False),
+        collision=scene,
     )
 
 

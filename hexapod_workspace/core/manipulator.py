@@ -11,7 +11,7 @@ import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 from ..errors import ConfigError, GeometryError
 from .params import (
     CELL_PARAMETERS,
+    COLLISION_PARAMETERS,
     NODE_PARAMETERS,
     ROS_PARAMETERS,
     flatten,
@@ -27,6 +28,9 @@ from .params import (
 )
 from .resolution import MAX_POSITION_NORM
 from .validation import coincident_joints_reason, require_usable, unusable_reason
+
+if TYPE_CHECKING:
+    from .collision.params import CollisionScene
 
 __all__ = ["PARAMETER_DEFAULTS", "HomePoseWarning", "Manipulator"]
 
@@ -178,6 +182,10 @@ class Manipulator:
         σ_lim ≥ 0: the smallest singular value of the homogenised Plücker matrix of the legs
         allowed (constraint ``singularity``, see :mod:`~hexapod_workspace.core.constraint_table`);
         0 disables the constraint (dimensionless).
+    collision : CollisionScene or None
+        The collision scene (``collision.*``: platform and tool bodies, obstacles), with its
+        moving bodies in this model's mobile frame; None when no scene is declared (then the
+        ``collision`` constraint does not exist: +inf, left out of the interfaces).
     """
 
     base_joints: NDArray[np.float64]
@@ -194,6 +202,7 @@ class Manipulator:
     frame_id: str = "base"
     axes_from_home: tuple[bool, bool] = field(default=(True, True))
     singularity_min: float = 0.0
+    collision: CollisionScene | None = None
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -334,6 +343,8 @@ class Manipulator:
             axes_from_home=(base_axes is None, platform_axes is None),
             singularity_min=_singularity_min(values["limits.singularity_min"]),
         )
+        if any(name.startswith(COLLISION_PARAMETERS) for name in flat):
+            manipulator = _with_scene(manipulator, flat)
         if warn:
             reason = unusable_reason(manipulator)
             if reason is not None:
@@ -372,7 +383,14 @@ class Manipulator:
         """
         parameters = load_params_file(path)
         unknown = unknown_parameter(
-            parameters, (*PARAMETER_DEFAULTS, *NODE_PARAMETERS, *CELL_PARAMETERS, *ROS_PARAMETERS)
+            parameters,
+            (
+                *PARAMETER_DEFAULTS,
+                *NODE_PARAMETERS,
+                *CELL_PARAMETERS,
+                *COLLISION_PARAMETERS,
+                *ROS_PARAMETERS,
+            ),
         )
         if unknown is not None:
             msg = f"parameters file {path}: {unknown}"
@@ -412,7 +430,9 @@ class Manipulator:
         def floats(array: NDArray[np.float64]) -> list[float]:
             return [float(v) for v in np.ravel(array)]
 
+        scene = dict(self.collision.parameters) if self.collision is not None else {}
         return {
+            **scene,
             "frame_id": self.frame_id,
             "geometry.base_joints": floats(self.base_joints),
             "geometry.platform_joints": floats(self.platform_joints),
@@ -462,9 +482,36 @@ class Manipulator:
             and self.singularity_min == other.singularity_min
             and self.frame_id == other.frame_id
             and self.axes_from_home == other.axes_from_home
+            and self.collision == other.collision
         )
 
     __hash__ = None  # type: ignore[assignment]
+
+
+def _with_scene(manipulator: Manipulator, flat: Mapping[str, Any]) -> Manipulator:
+    """The model with its collision scene (``collision.*``), built in the platform frame P.
+
+    Obstacles given in the work frame are placed with ``work.*``; the tool body starts at the
+    tool centre point of ``tool.*`` (the cell's tool frame). A scene with no pair to check
+    (no tool and no obstacle) leaves the model without one. Refuses, naming the pair, an
+    obstacle or body in collision at the home pose.
+    """
+    from dataclasses import replace
+
+    from .collision.params import collision_scene
+    from .frames import cell_from_mapping
+
+    cell = cell_from_mapping(flat)
+    work = np.eye(4)
+    work[:3, :3] = cell.work.rotation
+    work[:3, 3] = cell.work.origin
+    tool = np.eye(4)
+    tool[:3, :3] = cell.tool.rotation
+    tool[:3, 3] = cell.tool.offset
+    scene = collision_scene(flat, work_transform=work, tool_transform=tool, manipulator=manipulator)
+    if scene.pair_count == 0:
+        return manipulator
+    return replace(manipulator, collision=scene)
 
 
 def _model_names() -> str:

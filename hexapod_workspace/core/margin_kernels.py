@@ -20,8 +20,10 @@ from .jit import jit as _jit
 import numpy as np
 from numpy.typing import NDArray
 
+from .collision_kernels import SCRATCH_FLOATS, collision_margin
 from .constraint_table import (
     BASE_JOINT,
+    COLLISION,
     LEG_INTERFERENCE,
     LEG_LENGTH,
     N_CONSTRAINTS,
@@ -33,12 +35,14 @@ from .model_layout import (
     ALPHA_EQUAL,
     BETA,
     BETA_EQUAL,
+    COLLISION_ON,
     DIAMETER,
     INTERFERENCE,
     JA,
     JB,
     LMAX,
     LMIN,
+    MODEL_SIZE,
     ORDER,
     PAIR_I,
     PAIR_J,
@@ -52,7 +56,7 @@ from .model_layout import (
     B,
 )
 
-__all__ = ["ONE_SIZE", "check_angles", "check_one", "margins_rotations"]
+__all__ = ["ONE_SIZE", "SCRATCH_ROWS", "check_angles", "check_one", "margins_rotations"]
 
 # ------------------------------------------------------------------------------ one pose
 # Slots of the per-pose result vector ``out``.
@@ -60,7 +64,11 @@ __all__ = ["ONE_SIZE", "check_angles", "check_one", "margins_rotations"]
 OUT_LEG = N_CONSTRAINTS  # limiting leg of each margin (N_CONSTRAINTS slots, as float)
 OUT_PAIR = 2 * N_CONSTRAINTS  # closest pair (2 slots)
 OUT_SHORTEST = OUT_PAIR + 2  # shortest leg length, m
-OUT_SIZE = OUT_SHORTEST + 1
+OUT_GAP = OUT_SHORTEST + 1  # the collision margin's gap to its upper bound, m (collision_kernels)
+OUT_SIZE = OUT_GAP + 1
+#: Rows of the per-call scratch of :func:`_pose` (shape (SCRATCH_ROWS, 6)): 5 leg planes, then
+#: the working memory of the collision margin.
+SCRATCH_ROWS = 5 + (SCRATCH_FLOATS + 5) // 6
 #: Size of :func:`check_one`'s result: margins, legs, pair (2), limiting constraint and leg,
 #: reachable (1.0 or 0.0).
 ONE_SIZE = 2 * N_CONSTRAINTS + 5
@@ -90,7 +98,8 @@ def _pose(
     """Margins of one pose into ``out`` (OUT_SIZE,).
 
     ``r`` (9,) is the rotation matrix row-major, (px, py, pz) the position (m), ``scratch``
-    (5, 6) working memory (leg vector planes and squared lengths). Follows the numpy reference
+    (SCRATCH_ROWS, 6) working memory (leg vector planes and squared lengths, then the
+    collision margin's). Follows the numpy reference
     (test/reference.py, BatchedMargins) operation by operation, so margins agree to rounding:
     the smallest margin of each constraint and its leg (first one on ties; NaN, a zero-length
     leg, wins), the closest pair by Ericson's clamped closest points.
@@ -168,6 +177,7 @@ def _pose(
     out[OUT_LEG + BASE_JOINT] = leg_a
     out[OUT_LEG + PLATFORM_JOINT] = leg_b
     out[OUT_SHORTEST] = shortest
+    _pose_collision(model, r, px, py, pz, scratch, out)
     out[OUT_LEG + SINGULARITY] = 0
     if model[SINGULARITY_ON] != 0.0:
         rows = np.empty(ROWS_SCRATCH)
@@ -250,6 +260,30 @@ def _pose(
     out[OUT_LEG + LEG_INTERFERENCE] = PAIR_I[best_pair]
     out[OUT_PAIR] = PAIR_I[best_pair]
     out[OUT_PAIR + 1] = PAIR_J[best_pair]
+
+
+@_helper
+def _pose_collision(
+    model: NDArray[np.float64],
+    r: NDArray[np.float64],
+    px: float,
+    py: float,
+    pz: float,
+    scratch: NDArray[np.float64],
+    out: NDArray[np.float64],
+) -> None:
+    """The collision margin, its pair (as the constraint's "leg") and gap into ``out``, from the
+    leg planes of ``scratch`` (+inf, −1, 0 without a scene)."""
+    if model[COLLISION_ON] != 0.0:
+        memory = scratch[5:].reshape(-1)
+        value, pair, gap = collision_margin(
+            model, MODEL_SIZE, r, px, py, pz, scratch[0], scratch[1], scratch[2], memory
+        )
+    else:
+        value, pair, gap = np.inf, -1.0, 0.0
+    out[COLLISION] = value
+    out[OUT_LEG + COLLISION] = pair
+    out[OUT_GAP] = gap
 
 
 # ------------------------------------------------------------------------------ singularity
@@ -437,6 +471,38 @@ def _block_singularity(
         work[_SIGMA * BLOCK + n] = _smallest_singular_value(rows) - model[SINGULARITY_MIN]
 
 
+@_helper
+def _block_collision(
+    model: NDArray[np.float64],
+    work: NDArray[np.float64],
+    count: int,
+    px: float,
+    py: float,
+    pz: float,
+    scratch: NDArray[np.float64],
+    r: NDArray[np.float64],
+) -> None:
+    """The collision margin and its pair of the poses of a block that take the vectorised path
+    (the others are computed whole by :func:`_pose`) into the _COLLIDE rows, from the leg and
+    rotation planes (before the outputs overwrite the rotation planes)."""
+    memory = scratch[5:].reshape(-1)
+    for n in range(count):
+        if work[(_MIN + _FIX) * BLOCK + n] != 0.0:
+            continue
+        for i in range(9):
+            r[i] = work[(_R + i) * BLOCK + n]
+        for k in range(6):
+            leg = (_LEGS + 7 * k) * BLOCK + n
+            scratch[0, k] = work[leg + _LX * BLOCK]
+            scratch[1, k] = work[leg + _LY * BLOCK]
+            scratch[2, k] = work[leg + _LZ * BLOCK]
+        value, pair, _ = collision_margin(
+            model, MODEL_SIZE, r, px, py, pz, scratch[0], scratch[1], scratch[2], memory
+        )
+        work[_COLLIDE * BLOCK + n] = value
+        work[(_COLLIDE + 1) * BLOCK + n] = pair
+
+
 # ------------------------------------------------------------------------------ sin and cos
 # Cody–Waite reduction by π/2 in three parts of 33 bits (exact products for |k| < 2**20) and the
 # Cephes polynomials on [−π/4, π/4]: within 1 ulp of libm, and branch-free, so that loops over a
@@ -552,7 +618,8 @@ _PHI, _THETA, _PSI = 15, 16, 17
 _MIN = 18  # 9 rows: running minima, see the offsets below
 _LEGS = 27  # 7 rows per leg, see the offsets below
 _SIGMA = _LEGS + 6 * 7  # σ_min − σ_lim of each pose (when the singularity margin is on)
-_BLOCK_ROWS = _SIGMA + 1
+_COLLIDE = _SIGMA + 1  # 2 rows: collision margin and its pair (when a scene is declared)
+_BLOCK_ROWS = _COLLIDE + 2
 # Rows of the running minima (offsets from _MIN): margins or cosines and their leg or pair.
 _M_LEN, _LEG_LEN, _M_A, _LEG_A, _M_B, _LEG_B, _BEST, _PAIR, _FIX = range(9)
 # Rows of one leg (offsets from _LEGS + 7·k): vector, squared length, 1/ℓ², joint cosines.
@@ -731,6 +798,9 @@ def _check_block(
     singular = model[SINGULARITY_ON] != 0.0
     if singular:
         _block_singularity(model, work, count, np.empty(ROWS_SCRATCH))
+    collide = model[COLLISION_ON] != 0.0
+    if collide:
+        _block_collision(model, work, count, px, py, pz, scratch, r)
     # Per pose: the joint-angle margins (arccos), the rare poses that need care, the outputs.
     alpha_equal = model[ALPHA_EQUAL] != 0.0
     beta_equal = model[BETA_EQUAL] != 0.0
@@ -774,6 +844,10 @@ def _check_block(
             work[(OUT_PAIR + 1) * BLOCK + n] = 0.0
         work[SINGULARITY * BLOCK + n] = work[_SIGMA * BLOCK + n] if singular else np.inf
         work[(OUT_LEG + SINGULARITY) * BLOCK + n] = 0.0
+        work[COLLISION * BLOCK + n] = work[_COLLIDE * BLOCK + n] if collide else np.inf
+        work[(OUT_LEG + COLLISION) * BLOCK + n] = (
+            work[(_COLLIDE + 1) * BLOCK + n] if collide else -1.0
+        )
 
 
 @_helper
@@ -832,7 +906,7 @@ def check_angles(
     for k in range(3):
         if not math.isfinite(position[k]):
             return -2
-    scratch = np.empty((5, 6))
+    scratch = np.empty((SCRATCH_ROWS, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
     work = np.empty(_BLOCK_ROWS * BLOCK)
@@ -874,7 +948,7 @@ def check_one(
     (N_CONSTRAINTS; the interference leg 0 when the check is disabled), closest pair (2, 1-based;
     0 when disabled), the limiting constraint and its leg, and 1.0 when reachable (else 0.0).
     """
-    scratch = np.empty((5, 6))
+    scratch = np.empty((SCRATCH_ROWS, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
     _tt_matrix(phi, theta, psi, r)
@@ -909,7 +983,7 @@ def margins_rotations(
     Writes ``margins`` (C, N), ``legs`` (C, N) (C = N_CONSTRAINTS) and ``pairs`` (N, 2) as
     :func:`check_angles`.
     """
-    scratch = np.empty((5, 6))
+    scratch = np.empty((SCRATCH_ROWS, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
     shared = positions.shape[0] == 1

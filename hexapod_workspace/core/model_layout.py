@@ -1,7 +1,9 @@
 """Model layout of the compiled kernels: a manipulator packed into one float64 vector.
 
 The kernels take a handful of arrays, which keeps numba's dispatch cheap (a few microseconds per
-call): :func:`model_vector` packs the model once per manipulator at the offsets below.
+call): :func:`model_vector` packs the model once per manipulator at the offsets below. A model
+with a collision scene has its scene appended after ``MODEL_SIZE``
+(:func:`hexapod_workspace.core.collision_kernels.pack_scene`; ``COLLISION_ON`` says so).
 """
 
 from __future__ import annotations
@@ -48,7 +50,8 @@ RAY_TURN = RAY_CONSTANT + N_CONSTRAINTS  # turn·ρ, m
 ESTIMATE_RATE = RAY_TURN + N_CONSTRAINTS  # the rate with ℓ_f = ESTIMATE_FLOOR
 SINGULARITY_MIN = ESTIMATE_RATE + N_CONSTRAINTS  # σ_lim of the singularity margin
 SINGULARITY_ON = SINGULARITY_MIN + 1  # 1.0 when the singularity margin is evaluated
-MODEL_SIZE = SINGULARITY_ON + 1
+COLLISION_ON = SINGULARITY_ON + 1  # 1.0 when a collision block follows MODEL_SIZE
+MODEL_SIZE = COLLISION_ON + 1
 
 #: Leg pairs (i < j) in the order of numpy.triu_indices(6, 1).
 PAIR_I = np.array([i for i in range(6) for j in range(i + 1, 6)], dtype=np.int64)
@@ -73,15 +76,16 @@ def model_vector(manipulator: Manipulator, report_singularity: bool = False) -> 
 
     Returns
     -------
-    ndarray, shape (MODEL_SIZE,)
-        Read-only; layout given by the offsets of this module.
+    ndarray, shape (MODEL_SIZE + K,)
+        Read-only; layout given by the offsets of this module, then the collision block (K = 0
+        without a scene).
     """
     key = id(manipulator)  # one dictionary per kind: the per-call lookup stays an int's
     models = _REPORT_MODELS if report_singularity else _MODELS
     cached = models.get(key)
     if cached is not None:
         return cached
-    model = np.zeros(MODEL_SIZE)
+    model: NDArray[np.float64] = np.zeros(MODEL_SIZE)
     model[A : A + 18] = manipulator.base_joints.ravel()
     model[B : B + 18] = manipulator.platform_joints.ravel()
     model[JA : JA + 18] = manipulator.base_joint_axes.ravel()
@@ -112,13 +116,20 @@ def model_vector(manipulator: Manipulator, report_singularity: bool = False) -> 
     model[ORDER : ORDER + 15] = np.argsort(home_distance, kind="stable")
     for c, row in enumerate(CONSTRAINTS):
         rho = model[RHO]
-        model[RAY_CONSTANT + c] = row.speed * rho + row.spin
-        model[RAY_TURN + c] = row.turn * rho
+        speed, turn, spin = row.coefficients(manipulator)
+        model[RAY_CONSTANT + c] = speed * rho + spin
+        model[RAY_TURN + c] = turn * rho
         model[ESTIMATE_RATE + c] = model[RAY_CONSTANT + c] + (
-            model[RAY_TURN + c] / model[ESTIMATE_FLOOR] if row.turn != 0.0 else 0.0
+            model[RAY_TURN + c] / model[ESTIMATE_FLOOR] if turn != 0.0 else 0.0
         )
     model[SINGULARITY_MIN] = manipulator.singularity_min
     model[SINGULARITY_ON] = 1.0 if manipulator.singularity_min > 0.0 or report_singularity else 0.0
+    from .collision_kernels import pack_scene
+
+    scene = pack_scene(manipulator)
+    if scene.size:
+        model[COLLISION_ON] = 1.0
+        model = np.concatenate([model, scene])
     model.setflags(write=False)
     # The manipulator is frozen: nothing is written into it. The entry lives as long as the
     # object (its id is not reused before the finalizer has removed the entry).

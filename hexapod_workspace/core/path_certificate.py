@@ -115,7 +115,7 @@ class _Certifier:
             floor = 0.5 * (2.0 * self.length_min + length_start + length_end - travel)
             floor = np.where(low_length >= 0.0, np.maximum(floor, self.length_min), floor)
             turn = np.where(floor > 0.0, travel / np.where(floor > 0.0, floor, 1.0), np.inf)
-            lipschitz_travel = rate_bounds(travel, turn, omega * width)
+            lipschitz_travel = rate_bounds(self.manipulator, travel, turn, omega * width)
             low: NDArray[np.float64] = np.minimum(
                 np.minimum(start, end), 0.5 * (start + end - lipschitz_travel)
             )

@@ -17,12 +17,14 @@ from .jit import jit as _jit
 import numpy as np
 from numpy.typing import NDArray
 
-from .constraint_table import LEG_LENGTH, N_CONSTRAINTS
+from .constraint_table import COLLISION, LEG_LENGTH, N_CONSTRAINTS
 from .margin_kernels import (
     _BLOCK_ROWS,
     BLOCK,
+    OUT_GAP,
     OUT_SHORTEST,
     OUT_SIZE,
+    SCRATCH_ROWS,
     _check_block,
     _feasible,
     _limiting_constraint,
@@ -123,12 +125,15 @@ def certified_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> floa
 def recovery_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
     """Length over which a violated pose stays violated: the most violated constraint, in
     Lipschitz units, cannot climb back to zero within |m_c| / L_c; joint-angle bounds use half
-    the current shortest leg, and the step keeps every leg at least that long."""
+    the current shortest leg, and the step keeps every leg at least that long. The collision
+    margin is a lower bound within its gap of the true one (exact except in deep contact with a
+    box or cylinder): its recovery starts from value + gap, an upper bound."""
     rho: float = model[RHO]
     floor: float = 0.5 * out[OUT_SHORTEST]
     recover = 0.0
     for c in range(N_CONSTRAINTS):
-        value = -out[c] / _rate(model, c, floor) if out[c] < 0.0 else 0.0
+        margin = out[c] + out[OUT_GAP] if c == COLLISION else out[c]
+        value = -margin / _rate(model, c, floor) if margin < 0.0 else 0.0
         if value > recover or value != value:
             recover = value
     return min(recover, floor / rho) * SAFETY
@@ -202,7 +207,7 @@ def search_rays(
     rays = np.empty(count, dtype=np.int64)
     angles = np.empty((count, 3))
     work = np.empty(_BLOCK_ROWS * BLOCK)
-    scratch = np.empty((5, 6))
+    scratch = np.empty((SCRATCH_ROWS, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
     half = 0.25 * tolerance
@@ -323,7 +328,7 @@ def torsion_scan(
     start_ok : bool
         Whether ψ = −π is feasible.
     """
-    scratch = np.empty((5, 6))
+    scratch = np.empty((SCRATCH_ROWS, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
     capacity = edges.shape[0]

@@ -60,7 +60,7 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import kernels
+from ..jit import CACHE_DIRECTORY
 
 __all__ = [
     "BOX",
@@ -87,10 +87,13 @@ _KIND, _C, _R, _P, _INFLATION = 0, 1, 4, 13, 16
 GJK_TOLERANCE = 1e-9
 #: Largest gap (upper − lower bound, m) the tests accept from GJK, stagnation included.
 GJK_GAP_BOUND = 1e-8
+#: Rows of the (WORK_ROWS, 3) working memory of :func:`_pair` (simplex, support points, the
+#: tetrahedron's face): callers allocate it once per batch.
+WORK_ROWS = 17
 #: Iteration cap of GJK (reached only in degenerate numerics; the lower bound stays valid).
 GJK_MAX_ITERATIONS = 64
 
-_CACHE = kernels.CACHE_DIRECTORY is not None
+_CACHE = CACHE_DIRECTORY is not None
 
 
 # numba ships no type information: the decorators are typed as returning the function they
@@ -384,10 +387,16 @@ def _closest_triangle(simplex: NDArray[np.float64], v: NDArray[np.float64]) -> i
 
 @_helper
 def _closest_simplex(
-    simplex: NDArray[np.float64], count: int, v: NDArray[np.float64], tmp: NDArray[np.float64]
+    simplex: NDArray[np.float64],
+    count: int,
+    v: NDArray[np.float64],
+    tmp: NDArray[np.float64],
+    face: NDArray[np.float64],
+    candidate: NDArray[np.float64],
 ) -> int:
     """Closest point v of the simplex (count vertices) to the origin; reduces the simplex to
-    the vertices that support v and returns their count (0: the origin is inside)."""
+    the vertices that support v and returns their count (0: the origin is inside). ``face``
+    (3, 3) and ``candidate`` (3,) are working memory (no allocation per call)."""
     if count == 1:
         v[:] = simplex[0]
         return 1
@@ -419,8 +428,6 @@ def _closest_simplex(
     best = np.inf
     best_mask = 0
     best_face = -1
-    face = np.empty((3, 3))
-    candidate = np.empty(3)
     for opposite in range(4):
         k = 0
         for m in range(4):
@@ -465,10 +472,16 @@ def _closest_simplex(
 
 @_helper
 def _gjk(
-    a: NDArray[np.float64], b: NDArray[np.float64], work: NDArray[np.float64]
+    a: NDArray[np.float64],
+    b: NDArray[np.float64],
+    work: NDArray[np.float64],
+    tolerance: float = GJK_TOLERANCE,
+    cutoff: float = np.inf,
 ) -> tuple[float, float]:
-    """(lower, upper) bounds of sd(core A, core B), m; upper − lower ≤ GJK_TOLERANCE unless the
-    iteration cap or the numerics stopped it (lower stays a certified bound)."""
+    """(lower, upper) bounds of sd(core A, core B), m; upper − lower ≤ ``tolerance`` unless the
+    iteration cap or the numerics stopped it (lower stays a certified bound), or as soon as
+    lower > ``cutoff`` (a caller that looks for a minimum below it needs no more). ``work`` is
+    (WORK_ROWS, 3) working memory."""
     simplex = work[0:4]
     tmp = work[4:8]
     v = work[8]
@@ -500,7 +513,7 @@ def _gjk(
         w = sa - sb
         bound = (v[0] * w[0] + v[1] * w[1] + v[2] * w[2]) / vn
         lower = max(lower, bound)
-        if upper - lower <= GJK_TOLERANCE:
+        if upper - lower <= tolerance or lower > cutoff:
             break
         duplicate = False
         for k in range(count):
@@ -509,7 +522,7 @@ def _gjk(
         if duplicate:
             break
         simplex[count] = w
-        count = _closest_simplex(simplex, count + 1, v, tmp)
+        count = _closest_simplex(simplex, count + 1, v, tmp, work[13:16], work[16])
         if count == 0:
             overlap = True
             break
@@ -554,9 +567,15 @@ def _gjk(
 
 @_helper
 def _pair(
-    a: NDArray[np.float64], b: NDArray[np.float64], work: NDArray[np.float64]
+    a: NDArray[np.float64],
+    b: NDArray[np.float64],
+    work: NDArray[np.float64],
+    tolerance: float = GJK_TOLERANCE,
+    cutoff: float = np.inf,
 ) -> tuple[float, float]:
-    """(signed distance lower bound, gap to the upper bound) of two bodies, m."""
+    """(signed distance lower bound, gap to the upper bound) of two bodies, m; GJK's
+    ``tolerance`` and ``cutoff`` (on the cores' distance: stop once it cannot be below it) as
+    in :func:`_gjk`."""
     ka = int(a[_KIND])
     kb = int(b[_KIND])
     inflation = a[_INFLATION] + b[_INFLATION]
@@ -569,7 +588,7 @@ def _pair(
         return _point_solid(a, b) - inflation, 0.0
     if kb == POINT:
         return _point_solid(b, a) - inflation, 0.0
-    lower, upper = _gjk(a, b, work)
+    lower, upper = _gjk(a, b, work, tolerance, cutoff + inflation)
     # Both are lower bounds of sd; in contact the enclosing capsules' can be the better one
     # (and the scene's pair skipping relies on the value never being below it).
     value = max(lower - inflation, _capsule_bound(a, b))
@@ -583,7 +602,7 @@ def _pair_batch(
     distance: NDArray[np.float64],
     gap: NDArray[np.float64],
 ) -> None:
-    work = np.empty((13, 3))
+    work = np.empty((WORK_ROWS, 3))
     for k in range(first.shape[0]):
         distance[k], gap[k] = _pair(first[k], second[k], work)
 
