@@ -68,7 +68,7 @@ def test_kernels_agree_with_scene_kernel_and_coal(plain: Manipulator) -> None:
         scenes += 1
         assert model.collision is not None
         rotations, positions = random_poses(rng, 100)
-        reference = scene_distances(model, model.collision, rotations, positions)
+        reference = scene_distances(model, model.collision, rotations, positions, all_pairs=True)
         found = constraints.pose_margins(model, rotations, positions)
         # Apart, every value is exact (GJK to 1e-7 m in the kernels, 1e-9 m standalone); in
         # contact both are certified lower bounds of the depth (the kernels stop GJK as soon as
@@ -78,8 +78,12 @@ def test_kernels_agree_with_scene_kernel_and_coal(plain: Manipulator) -> None:
             found.margins[COLLISION][apart], reference.margin[apart], rtol=0, atol=1e-6
         )
         assert np.all(found.margins[COLLISION][~apart] < 0.0)
-        same = apart & (np.abs(found.margins[COLLISION] - reference.margin) < 1e-12)
-        assert np.all(found.limiting_legs[COLLISION][same] == reference.pair[same])
+        # The pair named holds the margin (near-ties may name either of two pairs).
+        assert reference.distances is not None
+        named = reference.distances[np.arange(100), found.limiting_legs[COLLISION]]
+        np.testing.assert_allclose(
+            named[apart] - model.collision.clearance, reference.margin[apart], atol=1e-6
+        )
         for pose in range(0, 100, 10):
             one = model.collision
             values = coal_scene(model, one, rotations[pose], positions[pose])
@@ -117,8 +121,10 @@ def test_batch_and_single_pose_paths_agree(cell: Manipulator) -> None:
 
 
 def test_worked_example_psi_zero_hits_a_leg(cell: Manipulator) -> None:
-    """At (104°, 37°, 0) the spindle meets leg 3 and nothing else is violated."""
-    result = constraints.check(cell, np.radians([[104.0, 37.0, 0.0]]), HOME)
+    """At (90°, 30°, 0) the spindle meets leg 3 and nothing else is violated; at ψ = 20° it
+    clears."""
+    result = constraints.check(cell, np.radians([[90.0, 30.0, 0.0], [90.0, 30.0, 20.0]]), HOME)
+    assert result.reachable[1]
     assert result.violated[0] == ["collision"]
     assert result.collision_pair[0] == "tool vs leg 3"
     assert result.limiting_leg[0] == 0
@@ -132,10 +138,10 @@ def axes_of(angles: np.ndarray) -> np.ndarray:
 
 
 def test_planner_turns_the_tool_clear_of_the_leg(cell: Manipulator) -> None:
-    """Tilting to 37° towards φ = 104°: with ψ ≡ 0 the move and its end hit leg 3; the torsion
+    """Tilting to 30° towards φ = 90°: with ψ ≡ 0 the last waypoint hits leg 3; the torsion
     planner finds a plan whose certified moves are all clear."""
-    theta = np.radians(np.linspace(0.0, 37.0, 6))
-    angles = np.column_stack([np.full(6, math.radians(104.0)), theta, np.zeros(6)])
+    theta = np.radians(np.linspace(0.0, 30.0, 6))
+    angles = np.column_stack([np.full(6, math.radians(90.0)), theta, np.zeros(6)])
     positions = np.tile(HOME, (6, 1))
     baseline = check_path(cell, positions, angles=angles)
     assert not baseline.ok
@@ -161,13 +167,12 @@ def sphere_scene(centre: list[float], radius: float) -> dict:
 def test_a_move_that_clips_an_obstacle_between_waypoints_is_caught(plain: Manipulator) -> None:
     """A ball next to leg 1's path: both ends of a translation clear it, the middle passes
     through it (dense sampling says so); the certificate reports the move, the pair is named.
-    Moved 5 cm further away the same move is certified clear."""
+    Moved 13 cm down, below the platform joints' path, the same move is certified clear."""
     start, end = HOME + np.array([-0.08, -0.25, 0.0]), HOME + np.array([-0.08, 0.25, 0.0])
-    # Leg 1's platform joint at the middle of the move, shifted outwards: the ball sits there.
+    # Just above leg 1's platform joint at the middle of the move: the ball sits there.
     middle = 0.5 * (start + end) + plain.platform_joints[0]
-    outward = np.array([middle[0], middle[1], 0.0]) / np.hypot(middle[0], middle[1])
     radius = 0.03
-    centre = middle + outward * 0.0 + [0.0, 0.0, 0.05]
+    centre = middle + np.array([0.0, 0.0, 0.05])
     model = with_scene(plain, sphere_scene(centre.tolist(), radius))
     positions = np.array([start, end])
     angles = np.zeros((2, 3))
@@ -184,7 +189,7 @@ def test_a_move_that_clips_an_obstacle_between_waypoints_is_caught(plain: Manipu
     s = result.segments.first_violation_s[0]
     first_dense = samples[np.flatnonzero(dense.margins[COLLISION] < 0)[0]]
     assert abs(s - first_dense) < 2e-3
-    clear = with_scene(plain, sphere_scene((centre + outward * 0.08).tolist(), radius))
+    clear = with_scene(plain, sphere_scene((centre - np.array([0.0, 0.0, 0.13])).tolist(), radius))
     dense = constraints.pose_margins(
         clear, np.tile(np.eye(3), (2001, 1, 1)), start + samples[:, None] * (end - start)
     )
@@ -195,7 +200,7 @@ def test_a_move_that_clips_an_obstacle_between_waypoints_is_caught(plain: Manipu
 def test_torsion_range_boundaries_against_dense_sampling(cell: Manipulator) -> None:
     """The certified torsion scan with the scene: its feasible set equals dense sampling's,
     away from the boundaries (within the tolerance)."""
-    for phi, theta in ((104.0, 37.0), (-165.0, 28.0), (30.0, 33.0)):
+    for phi, theta in ((90.0, 30.0), (100.0, 30.0), (-165.0, 28.0)):
         found = torsion_range(cell, math.radians(phi), math.radians(theta), HOME, tolerance=1e-4)
         psi = np.linspace(-math.pi, math.pi, 20_001)
         angles = np.column_stack(
@@ -214,14 +219,14 @@ def test_torsion_range_boundaries_against_dense_sampling(cell: Manipulator) -> N
 def test_cli_check_json_names_the_pair() -> None:
     from cli_support import run_main
 
-    code, out, _ = run_main("check", "--config", str(EXAMPLE), "--json", "104", "37", "0")
+    code, out, _ = run_main("check", "--config", str(EXAMPLE), "--json", "--pose", "90", "30", "0")
     assert code == 1  # unreachable
     document = json.loads(out)
     pose = document["poses"][0]
     assert pose["collision_pair"] == "tool vs leg 3"
     assert pose["margins"]["collision"] < 0
     assert pose["violated"] == ["collision"]
-    _, out, _ = run_main("check", "--json", "10", "20", "0")
+    _, out, _ = run_main("check", "--json", "--pose", "10", "20", "0")
     pose = json.loads(out)["poses"][0]
     assert "collision" not in pose["margins"] and "collision_pair" not in pose
 

@@ -243,10 +243,13 @@ def _segment_json(segments: Any, k: int) -> dict[str, Any]:
 
 
 # ---------------------------------------------------------------------------- text
-def _pair_text(entry: dict[str, Any]) -> str:
-    """ ", tool vs leg 4" when the entry's collision margin is violated, else ""."""
+def _limited_by(entry: dict[str, Any]) -> str:
+    """What limits a waypoint or move: "leg 3", the collision pair ("tool vs leg 4") when
+    collision limits (no leg then), or both when collision is violated besides the leg."""
     pair = entry.get("collision_pair")
-    return f", {pair}" if pair and "collision" in entry["violated"] else ""
+    leg = f"leg {entry['limiting_leg']}" if entry["limiting_leg"] else ""
+    named = pair if pair and "collision" in entry["violated"] else ""
+    return ", ".join(part for part in (leg, named) if part) or f"leg {entry['limiting_leg']}"
 
 
 def _text(result: PathCheck | TorsionPlan, document: dict[str, Any], out: IO[str]) -> None:
@@ -283,15 +286,14 @@ def _text(result: PathCheck | TorsionPlan, document: dict[str, Any], out: IO[str
     )
     for w in failing_w[:10]:
         out.write(
-            f"  waypoint {w['index']}: unreachable ({', '.join(w['violated'])}, "
-            f"leg {w['limiting_leg']}{_pair_text(w)})\n"
+            f"  waypoint {w['index']}: unreachable ({', '.join(w['violated'])}, {_limited_by(w)})\n"
         )
     for s in failing_s[:10]:
         phi, theta, psi = s["first_violation_pose_deg"]
         out.write(
             f"  move {s['index']}: leaves the workspace at s = {s['first_violation_s']:.5f} "
             f"(phi {phi:.2f}, theta {theta:.2f}, psi {psi:.2f} deg): "
-            f"{', '.join(s['violated'])}, leg {s['limiting_leg']}{_pair_text(s)}\n"
+            f"{', '.join(s['violated'])}, {_limited_by(s)}\n"
         )
     baseline = document["psi_zero_baseline"]
     out.write(

@@ -25,9 +25,10 @@ body's rate bound must add that joint's speed (the leg point moves at
 Cost
 ----
 Per pose: the tool–leg pairs by the closed form of two segments (exact); every body–obstacle
-pair first by a lower bound (the distance from the body's segment, or the platform's
-bounding sphere, to the obstacle's bounding sphere, minus both radii: ≤ sd by inclusion), and
-exactly (closed form or GJK) only when that bound can still beat the smallest distance found.
+pair first by a lower bound (the signed distance of two capsules that hold the bodies, a
+closed form: ≤ sd by inclusion), and exactly (closed form or GJK) only when that bound can
+still beat the smallest distance found; GJK itself stops as soon as its lower bound shows the
+pair cannot be the smallest.
 The pair that was closest at the previous pose of the same call is evaluated first (rays and
 moves are continuous), so that usually one or two obstacle pairs are evaluated exactly. The
 result does not depend on that order: the smallest value wins, the lower pair index on ties.
@@ -61,12 +62,11 @@ from .collision.distance import (
     _INFLATION,
     _P,
     _R,
-    BOX,
     CYLINDER,
-    POINT,
     RECORD_SIZE,
     SEGMENT,
     WORK_ROWS,
+    _capsule_bound,
     _pair,
 )
 from .model_layout import B
@@ -87,9 +87,8 @@ TOOL_RADIUS = 5
 TOOL_ENDS = 6  # q0, q1 in the mobile frame (6)
 PLATFORM_ON = 12
 PLATFORM_RECORD = 13  # the platform cylinder in the mobile frame (RECORD_SIZE)
-PLATFORM_SPHERE = PLATFORM_RECORD + RECORD_SIZE  # bounding sphere: centre (3), radius
-OBSTACLES = PLATFORM_SPHERE + 4
-OBSTACLE_STRIDE = RECORD_SIZE + 4  # record (base frame), bounding sphere centre (3), radius
+OBSTACLES = PLATFORM_RECORD + RECORD_SIZE
+OBSTACLE_STRIDE = RECORD_SIZE  # the obstacle's record, base frame
 # Then the pairs: (moving body, other body) per pair, bodies numbered as in collision.scene
 # (0-5 legs, 6 platform, 7 tool, 8 + k obstacle k).
 _PLATFORM, _TOOL, _FIRST_OBSTACLE = 6, 7, 8
@@ -105,18 +104,6 @@ _WORK = 9 * RECORD_SIZE  # GJK working memory (WORK_ROWS, 3)
 _HINT = _WORK + 3 * WORK_ROWS  # the closest pair at the previous pose (−1 or garbage: checked)
 #: Floats of working memory :func:`collision_margin` needs.
 SCRATCH_FLOATS = _HINT + 1
-
-
-def _bounding_radius(record: NDArray[np.float64]) -> float:
-    """Radius of a sphere about the record's centre that holds the body, m."""
-    kind = int(record[0])
-    if kind == BOX:
-        return float(np.linalg.norm(record[_P : _P + 3]))
-    if kind == CYLINDER:
-        return math.hypot(record[_P], record[_P + 1])
-    if kind == SEGMENT:
-        return float(record[_P] + record[_INFLATION])
-    return float(record[_INFLATION])
 
 
 def pack_scene(manipulator: Manipulator) -> NDArray[np.float64]:
@@ -147,13 +134,9 @@ def pack_scene(manipulator: Manipulator) -> NDArray[np.float64]:
         record = platform_record(scene)
         block[PLATFORM_ON] = 1.0
         block[PLATFORM_RECORD : PLATFORM_RECORD + RECORD_SIZE] = record
-        block[PLATFORM_SPHERE : PLATFORM_SPHERE + 3] = record[_C : _C + 3]
-        block[PLATFORM_SPHERE + 3] = _bounding_radius(record)
     for k, obstacle in enumerate(scene.obstacles):
         start = OBSTACLES + OBSTACLE_STRIDE * k
         block[start : start + RECORD_SIZE] = obstacle.record
-        block[start + RECORD_SIZE : start + RECORD_SIZE + 3] = obstacle.record[_C : _C + 3]
-        block[start + RECORD_SIZE + 3] = _bounding_radius(obstacle.record)
     block[OBSTACLES + OBSTACLE_STRIDE * count :] = pairs.ravel()
     return block
 
@@ -183,20 +166,6 @@ def _segment_body(
     row[_R + 8] = dz * inverse
     row[_P] = 0.5 * length
     row[_INFLATION] = radius
-
-
-@_helper
-def _segment_sphere_bound(row: NDArray[np.float64], sx: float, sy: float, sz: float) -> float:
-    """Distance from the core of a segment or point record to the point s, m."""
-    cx, cy, cz = row[_C], row[_C + 1], row[_C + 2]
-    wx, wy, wz = sx - cx, sy - cy, sz - cz
-    if int(row[0]) == POINT:
-        return math.sqrt(wx * wx + wy * wy + wz * wz)
-    h = row[_P]
-    ux, uy, uz = row[_R + 2], row[_R + 5], row[_R + 8]
-    t = min(max(wx * ux + wy * uy + wz * uz, -h), h)
-    x, y, z = wx - t * ux, wy - t * uy, wz - t * uz
-    return math.sqrt(x * x + y * y + z * z)
 
 
 @_helper
@@ -258,11 +227,8 @@ def collision_margin(
         y1 = r10 * model[t + 3] + r11 * model[t + 4] + r12 * model[t + 5] + py
         z1 = r20 * model[t + 3] + r21 * model[t + 4] + r22 * model[t + 5] + pz
         _segment_body(bodies[_TOOL], x0, y0, z0, x1, y1, z1, model[block + TOOL_RADIUS])
-    platform_filled = False
-    sphere = block + PLATFORM_SPHERE
-    psx = r00 * model[sphere] + r01 * model[sphere + 1] + r02 * model[sphere + 2] + px
-    psy = r10 * model[sphere] + r11 * model[sphere + 1] + r12 * model[sphere + 2] + py
-    psz = r20 * model[sphere] + r21 * model[sphere + 1] + r22 * model[sphere + 2] + pz
+    if model[block + PLATFORM_ON] != 0.0:
+        _platform_body(model, block, r, px, py, pz, bodies[_PLATFORM])
     n_obstacles = int(model[block + N_OBSTACLES])
     n_pairs = int(model[block + N_PAIRS])
     pairs_at = block + OBSTACLES + OBSTACLE_STRIDE * n_obstacles
@@ -277,32 +243,18 @@ def collision_margin(
             continue
         moving = int(model[pairs_at + 2 * k])
         other = int(model[pairs_at + 2 * k + 1])
+        first = bodies[moving]
         second = bodies[other if other < _FIRST_OBSTACLE else 8]
         if other >= _FIRST_OBSTACLE:
             at = block + OBSTACLES + OBSTACLE_STRIDE * (other - _FIRST_OBSTACLE)
-            if visit >= 0:
-                # Lower bound by the obstacle's bounding sphere (≤ sd: inclusion).
-                sx = model[at + RECORD_SIZE]
-                sy = model[at + RECORD_SIZE + 1]
-                sz = model[at + RECORD_SIZE + 2]
-                if moving == _PLATFORM:
-                    dx, dy, dz = sx - psx, sy - psy, sz - psz
-                    bound = math.sqrt(dx * dx + dy * dy + dz * dz) - model[sphere + 3]
-                else:
-                    row = bodies[moving]
-                    bound = _segment_sphere_bound(row, sx, sy, sz) - row[_INFLATION]
-                bound -= model[at + RECORD_SIZE + 3]
-                if bound > best or (bound == best and k > chosen):
-                    continue
             for i in range(RECORD_SIZE):
                 second[i] = model[at + i]
-        if moving == _PLATFORM:
-            if not platform_filled:
-                _platform_body(model, block, r, px, py, pz, bodies[_PLATFORM])
-                platform_filled = True
-            first = bodies[_PLATFORM]
-        else:
-            first = bodies[moving]
+            if visit >= 0:
+                # Lower bound: the signed distance of capsules that hold the two bodies (≤ sd
+                # by inclusion; exact for capsules and spheres, tight for long cylinders).
+                bound = _capsule_bound(first, second)
+                if bound > best or (bound == best and k > chosen):
+                    continue
         value, gap = _pair(first, second, work, GJK_KERNEL_TOLERANCE, best)
         if value < best or (value == best and k < chosen) or value != value:
             best = value

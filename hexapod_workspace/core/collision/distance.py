@@ -32,7 +32,9 @@ points), and inflations add: ``sd(A ⊕ r_A, B ⊕ r_B) = sd(A, B) − r_A − r
 * Closed forms (exact to rounding): point and segment cores against each other (Ericson's
   closest points of two segments, degenerate cases included; the Minkowski difference of two
   segments is flat, so their signed distance is their distance), a point against a box and
-  against a cylinder (signed: inside, minus the distance to the nearest face).
+  against a cylinder (signed: inside, minus the distance to the nearest face), a segment
+  against a cylinder whose curved surface holds the closest point (``_segment_cylinder``:
+  the distance to the axis minus the radius, exact there).
 * GJK (Gilbert–Johnson–Keerthi) for every other pair (segment, box or cylinder against box or
   cylinder). Each iteration has the upper bound ``|v|`` (a point of ``M``) and, by (1) with
   ``d = v/|v|``, the lower bound ``v·w/|v|`` (``w`` the support point of ``M`` in ``−v``).
@@ -212,6 +214,31 @@ def _axis_bound(
 
 
 @_helper
+def _segment_cylinder(segment: NDArray[np.float64], cylinder: NDArray[np.float64]) -> float:
+    """Distance from a point or segment core to a cylinder core, in closed form where it is
+    exact, else NaN.
+
+    The cylinder lies inside the capsule of its radius r around its axis segment, so
+    ``sd ≥ d − r`` with d the distance from the segment to the axis segment. When the closest
+    axis point q* is interior (parameter strictly inside (0, 1)), p* − q* is perpendicular to
+    the axis (first-order optimality), so ``q* + r (p* − q*)/d`` lies on the curved surface,
+    at d − r from p*: then, for d ≥ r, ``sd = d − r`` exactly. Otherwise (an end disc or rim is
+    closest, or the cores overlap) NaN, and the caller runs GJK.
+    """
+    p0x, p0y, p0z, d1x, d1y, d1z = _ends(segment)
+    h = cylinder[_P + 1]
+    ax, ay, az = cylinder[_R + 2] * h, cylinder[_R + 5] * h, cylinder[_R + 8] * h
+    q0x, q0y, q0z = cylinder[_C] - ax, cylinder[_C + 1] - ay, cylinder[_C + 2] - az
+    distance, t = _segment_segment_t(
+        p0x, p0y, p0z, d1x, d1y, d1z, q0x, q0y, q0z, 2.0 * ax, 2.0 * ay, 2.0 * az
+    )
+    radius = float(cylinder[_P])
+    if 0.0 < t < 1.0 and distance >= radius:
+        return float(distance - radius)
+    return math.nan
+
+
+@_helper
 def _segment_segment(
     p0x: float,
     p0y: float,
@@ -227,6 +254,27 @@ def _segment_segment(
     d2z: float,
 ) -> float:
     """Distance between segments p0 + s·d1 and q0 + t·d2, s, t in [0, 1] (Ericson 5.1.9)."""
+    distance, _ = _segment_segment_t(p0x, p0y, p0z, d1x, d1y, d1z, q0x, q0y, q0z, d2x, d2y, d2z)
+    return distance
+
+
+@_helper
+def _segment_segment_t(
+    p0x: float,
+    p0y: float,
+    p0z: float,
+    d1x: float,
+    d1y: float,
+    d1z: float,
+    q0x: float,
+    q0y: float,
+    q0z: float,
+    d2x: float,
+    d2y: float,
+    d2z: float,
+) -> tuple[float, float]:
+    """(distance, t) of segments p0 + s·d1 and q0 + t·d2, s, t in [0, 1] (Ericson 5.1.9), t
+    the second segment's parameter of the closest points."""
     rx, ry, rz = p0x - q0x, p0y - q0y, p0z - q0z
     a = d1x * d1x + d1y * d1y + d1z * d1z
     e = d2x * d2x + d2y * d2y + d2z * d2z
@@ -256,7 +304,7 @@ def _segment_segment(
     x = rx + s * d1x - t * d2x
     y = ry + s * d1y - t * d2y
     z = rz + s * d1z - t * d2z
-    return math.sqrt(x * x + y * y + z * z)
+    return math.sqrt(x * x + y * y + z * z), t
 
 
 @_helper
@@ -588,6 +636,14 @@ def _pair(
         return _point_solid(a, b) - inflation, 0.0
     if kb == POINT:
         return _point_solid(b, a) - inflation, 0.0
+    if ka == SEGMENT and kb == CYLINDER:
+        value = _segment_cylinder(a, b)
+        if value == value:
+            return value - inflation, 0.0
+    if kb == SEGMENT and ka == CYLINDER:
+        value = _segment_cylinder(b, a)
+        if value == value:
+            return value - inflation, 0.0
     lower, upper = _gjk(a, b, work, tolerance, cutoff + inflation)
     # Both are lower bounds of sd; in contact the enclosing capsules' can be the better one
     # (and the scene's pair skipping relies on the value never being below it).
