@@ -260,7 +260,10 @@ def _write(tmp_path, parameters: dict, extra: str = "") -> object:
 @pytest.mark.parametrize(
     ("name", "reason"),
     [
-        ("limitz.leg_length_min", "limitz: unknown section (expected one of check, frame_id, "),
+        (
+            "limitz.leg_length_min",
+            "limitz: unknown section (expected one of check, collision, frame_id, ",
+        ),
         ("limits.leg_lenght_min", "limits.leg_lenght_min: unknown parameter (expected one of "),
         ("resolution.n_phy", "resolution.n_phy: unknown parameter (expected one of resolution."),
         ("frame_id.x", "frame_id: expected a value, got a section"),

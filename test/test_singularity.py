@@ -22,6 +22,7 @@ from hexapod_workspace import (
     projected_workspace,
     torsion_range,
 )
+from hexapod_workspace.core.constraint_table import SINGULARITY
 from hexapod_workspace.core.constraints import check_pose, inverse_kinematics, pose_margins
 from hexapod_workspace.core.rotations import tt_to_matrix
 
@@ -94,7 +95,7 @@ def test_rate_bound_holds_along_rays_and_moves(limited, rng):
         angles = a0 + s[:, None] * (a1 - a0)
         positions = p0 + s[:, None] * (p1 - p0)
         rotations = tt_to_matrix(angles)
-        margins = pose_margins(limited, rotations, positions).margins[-1]
+        margins = pose_margins(limited, rotations, positions).margins[SINGULARITY]
         lengths = inverse_kinematics(limited, rotations, positions).lengths
         # Angular rate from consecutive rotations, an upper estimate of Ω over each step.
         relative = np.einsum("nji,njk->nik", rotations[:-1], rotations[1:])

@@ -69,7 +69,6 @@ from .collision.distance import (
     _capsule_bound,
     _pair,
 )
-from .model_layout import B
 
 if TYPE_CHECKING:
     from .manipulator import Manipulator
@@ -172,6 +171,7 @@ def _segment_body(
 def collision_margin(
     model: NDArray[np.float64],
     block: int,
+    joints: int,
     r: NDArray[np.float64],
     px: float,
     py: float,
@@ -186,7 +186,8 @@ def collision_margin(
     Parameters
     ----------
     model : ndarray
-        The packed model; its collision block starts at ``block``.
+        The packed model; its collision block starts at ``block``, the platform joints b_k
+        (mobile frame, leg-major) at ``joints`` (``model_layout.B``).
     r : ndarray, shape (9,)
         Rotation (mobile -> base frame), row-major.
     px, py, pz : float
@@ -212,7 +213,7 @@ def collision_margin(
     r20, r21, r22 = r[6], r[7], r[8]
     leg_radius = model[block + LEG_RADIUS]
     for k in range(6):
-        bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
+        bx, by, bz = model[joints + 3 * k], model[joints + 3 * k + 1], model[joints + 3 * k + 2]
         qx = r00 * bx + r01 * by + r02 * bz + px
         qy = r10 * bx + r11 * by + r12 * bz + py
         qz = r20 * bx + r21 * by + r22 * bz + pz

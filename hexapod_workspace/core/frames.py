@@ -45,7 +45,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ConfigError, InputError
-from .manipulator import Manipulator, _describe, _frozen, _numbers, _vector3
+from .manipulator import Manipulator, _angles3, _describe, _frozen, _numbers, _vector3
 from .params import flatten, load_params_file
 from .rotations import tt_to_matrix
 
@@ -78,17 +78,6 @@ _TOOL_KEY = re.compile(r"^tools\.T([1-9][0-9]*)\.(offset|orientation)$")
 def _rotation(angles: NDArray[np.float64]) -> NDArray[np.float64]:
     matrix: NDArray[np.float64] = tt_to_matrix(angles)
     return matrix
-
-
-def _angles3(name: str, value: Any) -> NDArray[np.float64]:
-    array = _numbers(name, value)
-    if array.size != 3:
-        msg = f"{name}: expected 3 numbers (phi, theta, psi) in rad, got {array.size}"
-        raise ConfigError(msg)
-    if float(np.max(np.abs(array))) > 1e6:
-        msg = f"{name}: expected angles within ±1e6 rad, got {_describe(array.tolist())}"
-        raise ConfigError(msg)
-    return array
 
 
 @dataclass(frozen=True, eq=False)

@@ -129,6 +129,31 @@ def _axes(name: str, value: Any) -> NDArray[np.float64] | None:
     return unit
 
 
+def _angles3(name: str, value: Any) -> NDArray[np.float64]:
+    """Three angles (φ, θ, ψ) in rad, within ±1e6 (the cell's frame orientations)."""
+    array = _numbers(name, value)
+    if array.size != 3:
+        msg = f"{name}: expected 3 numbers (phi, theta, psi) in rad, got {array.size}"
+        raise ConfigError(msg)
+    if float(np.max(np.abs(array))) > 1e6:
+        msg = f"{name}: expected angles within ±1e6 rad, got {_describe(array.tolist())}"
+        raise ConfigError(msg)
+    return array
+
+
+def _cell_transform(flat: Mapping[str, Any], group: str, offset: str) -> NDArray[np.float64]:
+    """The 4×4 transform of the cell's ``tool`` (P <- C: ``offset``, ``orientation``) or
+    ``work`` (O <- W: ``origin``, ``orientation``) frame, from its parameters (default zero),
+    as :mod:`hexapod_workspace.core.frames` reads them."""
+    from .rotations import tt_to_matrix
+
+    transform = np.eye(4)
+    transform[:3, 3] = _vector3(f"{group}.{offset}", flat.get(f"{group}.{offset}", [0.0] * 3))
+    angles = _angles3(f"{group}.orientation", flat.get(f"{group}.orientation", [0.0] * 3))
+    transform[:3, :3] = tt_to_matrix(angles)
+    return transform
+
+
 def _singularity_min(value: Any) -> float:
     """``limits.singularity_min``: one finite number in [0, 1] (σ_min of a matrix of unit
     rows is at most √6, but a limit above 1 leaves no practical workspace)."""
@@ -499,15 +524,9 @@ def _with_scene(manipulator: Manipulator, flat: Mapping[str, Any]) -> Manipulato
     from dataclasses import replace
 
     from .collision.params import collision_scene
-    from .frames import cell_from_mapping
 
-    cell = cell_from_mapping(flat)
-    work = np.eye(4)
-    work[:3, :3] = cell.work.rotation
-    work[:3, 3] = cell.work.origin
-    tool = np.eye(4)
-    tool[:3, :3] = cell.tool.rotation
-    tool[:3, 3] = cell.tool.offset
+    work = _cell_transform(flat, "work", "origin")
+    tool = _cell_transform(flat, "tool", "offset")
     scene = collision_scene(flat, work_transform=work, tool_transform=tool, manipulator=manipulator)
     if scene.pair_count == 0:
         return manipulator

@@ -277,7 +277,7 @@ def _pose_collision(
     if model[COLLISION_ON] != 0.0:
         memory = scratch[5:].reshape(-1)
         value, pair, gap = collision_margin(
-            model, MODEL_SIZE, r, px, py, pz, scratch[0], scratch[1], scratch[2], memory
+            model, MODEL_SIZE, B, r, px, py, pz, scratch[0], scratch[1], scratch[2], memory
         )
     else:
         value, pair, gap = np.inf, -1.0, 0.0
@@ -497,7 +497,7 @@ def _block_collision(
             scratch[1, k] = work[leg + _LY * BLOCK]
             scratch[2, k] = work[leg + _LZ * BLOCK]
         value, pair, _ = collision_margin(
-            model, MODEL_SIZE, r, px, py, pz, scratch[0], scratch[1], scratch[2], memory
+            model, MODEL_SIZE, B, r, px, py, pz, scratch[0], scratch[1], scratch[2], memory
         )
         work[_COLLIDE * BLOCK + n] = value
         work[(_COLLIDE + 1) * BLOCK + n] = pair

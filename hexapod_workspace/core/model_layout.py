@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from .collision_kernels import pack_scene
 from .constraint_table import CONSTRAINTS, N_CONSTRAINTS, scales
 
 if TYPE_CHECKING:
@@ -124,8 +125,6 @@ def model_vector(manipulator: Manipulator, report_singularity: bool = False) -> 
         )
     model[SINGULARITY_MIN] = manipulator.singularity_min
     model[SINGULARITY_ON] = 1.0 if manipulator.singularity_min > 0.0 or report_singularity else 0.0
-    from .collision_kernels import pack_scene
-
     scene = pack_scene(manipulator)
     if scene.size:
         model[COLLISION_ON] = 1.0

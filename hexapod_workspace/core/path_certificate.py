@@ -22,7 +22,8 @@ A_i are fixed, so each leg vector ``L_i = B_i − A_i`` moves at most at V.
 margin is Lipschitz in s with the rate of its row of
 :mod:`hexapod_workspace.core.constraint_table`, ``speed·V + turn·V/ℓ_f + spin·Ω`` (V for
 ``leg_length``, V / ℓ_f for ``base_joint``, Ω + V / ℓ_f for ``platform_joint``, 2V for
-``leg_interference``; the derivations are written there).
+``leg_interference``, V + ρ_c·Ω for ``collision``, ρ_c from the model's scene, bounding the
+derived |Δp| + ρ_c·Ω since V ≥ |Δp|; the derivations are written there).
 
 *Interval certificate.* On an interval [a, b] of width w = b − a, with margins m(a), m(b) and
 constant L, ``m(s) ≥ max(m(a) − L(s − a), m(b) − L(b − s))`` whose minimum over the interval is
