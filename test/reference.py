@@ -174,7 +174,19 @@ def pose_margins_literal(
         "singularity": singularity_literal(manipulator, rotation, legs)
         if manipulator.singularity_min > 0.0
         else math.inf,
+        "collision": collision_literal(manipulator, rotation, position),
     }
+
+
+def collision_literal(manipulator: Manipulator, rotation: NDArray, position: NDArray) -> float:
+    """The collision margin by the standalone scene kernel (checked against coal and dense
+    surface sampling in test_collision.py); +inf without a scene."""
+    scene = manipulator.collision
+    if scene is None or scene.pair_count == 0:
+        return math.inf
+    from hexapod_workspace.core.collision import scene_distances
+
+    return float(scene_distances(manipulator, scene, rotation, position).margin[0])
 
 
 def singularity_literal(manipulator: Manipulator, rotation: NDArray, legs: list[NDArray]) -> float:

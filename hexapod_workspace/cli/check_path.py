@@ -169,6 +169,7 @@ def path_to_json(
     angles_deg = np.degrees(waypoints.angles) if degrees is None else degrees
     violated = waypoints.violated
     names = list(waypoints.margins)  # the constraints of the model's architecture
+    scene = "collision" in waypoints.margins  # a collision scene is declared
     margins = {name: waypoints.margins[name].tolist() for name in names}
     document: dict[str, Any] = {
         "ok": bool(path.ok and (plan is None or plan.ok)),
@@ -187,6 +188,7 @@ def path_to_json(
                 "margins": {name: _number(margins[name][k]) for name in names},
                 "limiting_leg": int(waypoints.limiting_leg[k]),
                 "relative_margin": _number(waypoints.relative[k]),
+                **({"collision_pair": waypoints.collision_pair[k]} if scene else {}),
             }
             for k in range(len(waypoints))
         ],
@@ -232,10 +234,24 @@ def _segment_json(segments: Any, k: int) -> dict[str, Any]:
         "min_relative_margin": _number(segments.min_relative_margin[k]),
         "min_at_s": float(segments.min_at_s[k]),
         "min_relative_margin_bound": _number(segments.min_relative_margin_bound[k]),
+        **(
+            {"collision_pair": None if ok else segments.collision_pair[k]}
+            if len(segments.collision_pair)
+            else {}
+        ),
     }
 
 
 # ---------------------------------------------------------------------------- text
+def _limited_by(entry: dict[str, Any]) -> str:
+    """What limits a waypoint or move: "leg 3", the collision pair ("tool vs leg 4") when
+    collision limits (no leg then), or both when collision is violated besides the leg."""
+    pair = entry.get("collision_pair")
+    leg = f"leg {entry['limiting_leg']}" if entry["limiting_leg"] else ""
+    named = pair if pair and "collision" in entry["violated"] else ""
+    return ", ".join(part for part in (leg, named) if part) or f"leg {entry['limiting_leg']}"
+
+
 def _text(result: PathCheck | TorsionPlan, document: dict[str, Any], out: IO[str]) -> None:
     plan = result if isinstance(result, TorsionPlan) else None
     waypoints, segments = document["waypoints"], document["segments"]
@@ -270,15 +286,14 @@ def _text(result: PathCheck | TorsionPlan, document: dict[str, Any], out: IO[str
     )
     for w in failing_w[:10]:
         out.write(
-            f"  waypoint {w['index']}: unreachable ({', '.join(w['violated'])}, "
-            f"leg {w['limiting_leg']})\n"
+            f"  waypoint {w['index']}: unreachable ({', '.join(w['violated'])}, {_limited_by(w)})\n"
         )
     for s in failing_s[:10]:
         phi, theta, psi = s["first_violation_pose_deg"]
         out.write(
             f"  move {s['index']}: leaves the workspace at s = {s['first_violation_s']:.5f} "
             f"(phi {phi:.2f}, theta {theta:.2f}, psi {psi:.2f} deg): "
-            f"{', '.join(s['violated'])}, leg {s['limiting_leg']}\n"
+            f"{', '.join(s['violated'])}, {_limited_by(s)}\n"
         )
     baseline = document["psi_zero_baseline"]
     out.write(

@@ -62,6 +62,12 @@ def write_json(document: Any, out: IO[str]) -> None:
 
 
 # ---------------------------------------------------------------------------- check
+def reported_names(result: CheckResult) -> tuple[str, ...]:
+    """The constraints a report lists: those of the model (its architecture's rows, ``collision``
+    only where a scene is declared), in table order."""
+    return tuple(result.margins)
+
+
 def _write_rows(out: IO[str], template: str, columns: Sequence[Sequence[Any]], sep: str) -> None:
     """Write ``template % row`` for the rows of ``columns`` joined by ``sep``, in blocks."""
     block = 65536
@@ -88,7 +94,7 @@ def check_json(result: CheckResult, out: IO[str], degrees: NDArray[np.float64]) 
     """
     texts: dict[tuple[str, ...], str] = {}
     violated = [texts.setdefault(tuple(v), json.dumps(v)) for v in result.violated]
-    names = list(result.margins)  # the constraints of the model's architecture, table order
+    names = reported_names(result)
     finite = {name: bool(np.all(np.isfinite(result.margins[name]))) for name in names}
     margins = [
         result.margins[name].tolist()
@@ -98,9 +104,10 @@ def check_json(result: CheckResult, out: IO[str], degrees: NDArray[np.float64]) 
     ]
     # 12 significant digits: exact to 1e-12 relative, and twice as fast to format as repr().
     margin_fields = ", ".join(f'"{name}": {"%.12g" if finite[name] else "%s"}' for name in names)
+    pair = ', "collision_pair": %s' if result.collision_pairs else ""
     template = (
         '{"phi_deg": %.12g, "theta_deg": %.12g, "psi_deg": %.12g, "reachable": %s, "violated": %s, '
-        f'"margins": {{{margin_fields}}}, "limiting_leg": %d}}'
+        f'"margins": {{{margin_fields}}}, "limiting_leg": %d{pair}}}'
     )
     columns = [
         *np.asarray(degrees).T.tolist(),
@@ -109,6 +116,9 @@ def check_json(result: CheckResult, out: IO[str], degrees: NDArray[np.float64]) 
         *margins,
         result.limiting_leg.tolist(),
     ]
+    if result.collision_pairs:
+        quoted = {name: json.dumps(name) for name in ("", *result.collision_pairs)}
+        columns.append([quoted[name] for name in result.collision_pair])
     out.write(f'{{"position": {json.dumps(result.position.tolist())}, "poses": [\n')
     _write_rows(out, template, columns, ",\n")
     out.write("]}\n")
@@ -123,11 +133,13 @@ def check_table(result: CheckResult, out: IO[str], degrees: NDArray[np.float64])
     x, y, z = result.position
     out.write(f"position: ({x:.4f}, {y:.4f}, {z:.4f}) m\n")
     # The singularity margin is a column only where it was evaluated (enforced by
-    # limits.singularity_min > 0 or asked for with --singularity); otherwise it is +inf.
+    # limits.singularity_min > 0 or asked for with --singularity); otherwise it is +inf. The
+    # collision margin is one only where the model declares a scene.
+    reported = reported_names(result)
     shown = [
         row
         for row in CONSTRAINTS
-        if row.name in result.margins
+        if row.name in reported
         and (
             row is not CONSTRAINTS[SINGULARITY] or not np.all(np.isposinf(result.margins[row.name]))
         )
@@ -136,7 +148,8 @@ def check_table(result: CheckResult, out: IO[str], degrees: NDArray[np.float64])
     units = " ".join(f"{'[' + row.report_unit + ']':>11}" for row in shown)
     header = (
         f"{'':>9} {'':>9} {'':>9}  {'':<9}  {'margin to each limit (>= 0 holds, < 0 violated)'}",
-        f"{'phi':>9} {'theta':>9} {'psi':>9}  {'reachable':<9}  {names}  {'limiting':>8}  violated",
+        f"{'phi':>9} {'theta':>9} {'psi':>9}  {'reachable':<9}  {names}  {'limiting':>8}  violated"
+        + ("  closest pair" if result.collision_pairs else ""),
         f"{'[deg]':>9} {'[deg]':>9} {'[deg]':>9}  {'':<9}  {units}  {'leg':>8}",
     )
     out.write("".join(line.rstrip() + "\n" for line in header))
@@ -156,6 +169,9 @@ def check_table(result: CheckResult, out: IO[str], degrees: NDArray[np.float64])
         [",".join(v) or "-" for v in result.violated],
     ]
     template = angle_format + "  %-9s  " + " ".join(["%11.3f"] * len(shown)) + "  %8d  %s"
+    if result.collision_pairs:
+        template += "  %s"
+        columns.append(result.collision_pair)
     _write_rows(out, template, columns, "\n")
     reachable = int(np.count_nonzero(result.reachable))
     out.write(f"\n{reachable}/{len(result)} poses reachable\n")

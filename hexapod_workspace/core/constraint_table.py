@@ -51,6 +51,8 @@ constraint           speed turn  spin  actuate crank ends why
 ``transmission``     0     1     0     0       1     0    pus: τ = n·u, |dτ| ≤ |dn|; rus: τ = n·t,
                                                           t the crank end's unit velocity turning
                                                           at |dq|, |dτ| ≤ N + K
+``collision``        1     0     ρ_c   0       0     0/1  a body point moves at ≤ |ṗ| + Ω·r, below;
+                                                          ends 1 where base joints move (pus/rus)
 ==================== ===== ===== ===== ======= ===== ==== =========================================
 
 *ik.* pus: ``ik_i = L_i − h_i`` with h_i the distance from B_i to the rail line, a
@@ -70,6 +72,20 @@ with ``τ(a) + τ(b) − 2τ_f ≥ rate_τ(τ_f)·w`` holds: the stretches [a, a
 interval. That is a quadratic inequality in τ_f; the certificate takes the largest admissible
 value, and no floor (the rows that need one unbounded) when the interval may contain a pose
 without a solution (ik's lower bound < 0) or none is admissible.
+
+*Collision.* ``collision = min over the checked pairs of sd − collision.clearance`` (signed
+distances of the scene's bodies, :mod:`hexapod_workspace.core.collision.scene`), present only
+when the model declares a scene with at least one pair (``Constraint.applies``; +inf
+otherwise). :func:`hexapod_workspace.core.collision.scene.rate_bound` derives
+``|dm/ds| ≤ |ṗ| + ρ_c·Ω`` with ρ_c the model's largest moving-body radius about the tool centre
+point, for base joints A_i that stand still (6-UPS); since ``V = |Δp| + ρ·Ω ≥ |ṗ|``, speed 1
+and spin ρ_c bound it: the ``spin`` coefficient of this row depends on the model
+(:meth:`Constraint.coefficients`). Where a leg architecture moves A_i (6-PUS, 6-RUS), a point
+``A_i + λ(B_i − A_i)`` of leg i moves at ``(1 − λ)|dA_i| + λ|dB_i|``, so by at most ``E`` more
+than the derivation's bound for a fixed A_i (``|dA_i| ≤ E``, the leg end rate above): the row
+adds ``ends·E`` with ends = 1 for those architectures (0 for 6-UPS, whose bound is unchanged).
+The tool–leg bound of ``rate_bound`` grows the same way (the leg points move by at most E
+more; the tool's do not change).
 
 *Singularity.* ``singularity = σ_min(M) − σ_lim`` (σ_lim = ``limits.singularity_min``), M the
 6×6 matrix with rows ``r_i = (n_iᵀ, ((R·b_i) × n_i)ᵀ / ρ)``: the unit leg lines in Plücker
@@ -108,6 +124,7 @@ if TYPE_CHECKING:
 __all__ = [
     "ACTUATOR",
     "BASE_JOINT",
+    "COLLISION",
     "CONSTRAINTS",
     "CONSTRAINT_NAMES",
     "IK",
@@ -151,9 +168,10 @@ class Constraint:
         margin / scale is its relative margin (dimensionless).
     scale_text : str
         What the scale is, in words.
-    speed, turn, spin : float
+    speed, turn, spin : float or callable
         Rate coefficients of V, N (the leg direction's turning rate: V/ℓ_f for ups) and Ω
-        (module documentation).
+        (module documentation); a callable ``coefficient(manipulator)`` where it depends on the
+        model (read every coefficient through :meth:`coefficients`).
     applies : callable
         ``applies(manipulator)``: whether the constraint exists for this model (a leg-length
         stroke exists only where legs change length, a collision margin only where bodies are
@@ -174,13 +192,58 @@ class Constraint:
     report_factor: float
     scale: Callable[[Manipulator], float]
     scale_text: str
-    speed: float
-    turn: float
-    spin: float
+    speed: float | Callable[[Manipulator], float]
+    turn: float | Callable[[Manipulator], float]
+    spin: float | Callable[[Manipulator], float]
     applies: Callable[[Manipulator], bool] = lambda manipulator: True
     actuate: float = 0.0
     crank: float = 0.0
-    ends: float = 0.0
+    ends: float | Callable[[Manipulator], float] = 0.0
+
+    def coefficients(
+        self, manipulator: Manipulator
+    ) -> tuple[float, float, float, float, float, float]:
+        """(speed, turn, spin, actuate, crank, ends) of this row for ``manipulator`` (a
+        constant coefficient ignores it; a callable one is evaluated)."""
+        return (
+            _value(self.speed, manipulator),
+            _value(self.turn, manipulator),
+            _value(self.spin, manipulator),
+            _value(self.actuate, manipulator),
+            _value(self.crank, manipulator),
+            _value(self.ends, manipulator),
+        )
+
+
+def _value(coefficient: float | Callable[[Manipulator], float], manipulator: Manipulator) -> float:
+    return float(coefficient(manipulator) if callable(coefficient) else coefficient)
+
+
+def _has_scene(manipulator: Manipulator) -> bool:
+    scene = getattr(manipulator, "collision", None)
+    return scene is not None and scene.pair_count > 0
+
+
+def _collision_spin(manipulator: Manipulator) -> float:
+    """ρ_c of :func:`hexapod_workspace.core.collision.scene.rate_bound` (0 without a scene)."""
+    if not _has_scene(manipulator):
+        return 0.0
+    from .collision.scene import rate_bound
+
+    return rate_bound(manipulator, manipulator.collision).rotation  # type: ignore[arg-type]
+
+
+def _collision_ends(manipulator: Manipulator) -> float:
+    """1 where the leg architecture moves the base joints (module documentation), else 0."""
+    return 1.0 if _has_scene(manipulator) and manipulator.architecture != "ups" else 0.0
+
+
+def _collision_scale(manipulator: Manipulator) -> float:
+    """The clearance, or the leg diameter, or 1 cm: a length at which a collision matters."""
+    scene = getattr(manipulator, "collision", None)
+    if scene is not None and scene.clearance > 0.0:
+        return float(scene.clearance)
+    return manipulator.leg_diameter if manipulator.leg_diameter > 0.0 else 0.01
 
 
 def _moving_base(manipulator: Manipulator) -> bool:
@@ -351,6 +414,22 @@ CONSTRAINTS: tuple[Constraint, ...] = (
         applies=_moving_base,
         crank=1.0,
     ),
+    Constraint(
+        name="collision",
+        unit="m",
+        margin="min over the scene's pairs of sd − collision.clearance; +inf without a scene",
+        label="collision",
+        column="collision",
+        report_unit="mm",
+        report_factor=1e3,
+        scale=_collision_scale,
+        scale_text="collision.clearance (else the leg diameter D, else 1 cm)",
+        speed=1.0,
+        turn=0.0,
+        spin=_collision_spin,
+        applies=_has_scene,
+        ends=_collision_ends,
+    ),
 )
 
 #: The constraint names, in table order.
@@ -368,9 +447,11 @@ SINGULARITY = INDEX["singularity"]
 ACTUATOR = INDEX["actuator"]
 IK = INDEX["ik"]
 TRANSMISSION = INDEX["transmission"]
+COLLISION = INDEX["collision"]
 
 
 def rate_bounds(
+    manipulator: Manipulator,
     speed: NDArray[np.float64],
     turn: NDArray[np.float64],
     spin: NDArray[np.float64],
@@ -397,8 +478,7 @@ def rate_bounds(
     )
     bounds = np.zeros((N_CONSTRAINTS, np.shape(speed)[0]))
     for k, row in enumerate(CONSTRAINTS):
-        coefficients = (row.speed, row.turn, row.spin, row.actuate, row.crank, row.ends)
-        for coefficient, value in zip(coefficients, quantities, strict=True):
+        for coefficient, value in zip(row.coefficients(manipulator), quantities, strict=True):
             if coefficient != 0.0:
                 bounds[k] = bounds[k] + coefficient * value
     return bounds

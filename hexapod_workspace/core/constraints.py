@@ -28,7 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from . import kernels
-from .constraint_table import CONSTRAINT_NAMES, N_CONSTRAINTS, SINGULARITY, applicable
+from .constraint_table import COLLISION, CONSTRAINT_NAMES, N_CONSTRAINTS, SINGULARITY, applicable
 from .resolution import MAX_POSITION_NORM, validate_position
 
 if TYPE_CHECKING:
@@ -42,6 +42,7 @@ __all__ = [
     "PoseMargins",
     "check",
     "check_pose",
+    "collision_pair_names",
     "home_pose_violations",
     "inverse_kinematics",
     "pose_margins",
@@ -230,7 +231,8 @@ class PoseMargins:
         the constraint table).
     limiting_legs : ndarray, shape (C, N), int
         0-based leg with the smallest margin of each constraint (for ``leg_interference`` the
-        lower leg of the closest pair; 0 when the check is disabled).
+        lower leg of the closest pair; 0 when the check is disabled; for ``collision`` the
+        0-based index of the closest pair in :func:`collision_pair_names`, −1 without a scene).
     limiting_pairs : ndarray, shape (N, 2), int
         0-based legs (i < j) of the closest pair.
     """
@@ -314,7 +316,12 @@ class CheckResult:
         margin: leg length over half the stroke (ℓmax − ℓmin)/2, joint angles over their maximum
         angle, interference over D. For an unreachable pose it is the most violated one.
     limiting_leg : ndarray, shape (N,), int
-        1-based leg of the limiting constraint.
+        1-based leg of the limiting constraint (0 when it is ``collision``: a pair of bodies,
+        see :attr:`collision_pair`).
+    collision_pairs : tuple of str
+        Names of the pairs the model's collision scene checks (``"tool vs leg 4"``, moving
+        body first); empty without a scene (then ``collision`` is +inf and not reported).
+        ``limiting_legs["collision"]`` is the 1-based index into it of each pose's closest pair.
     """
 
     position: NDArray[np.float64]
@@ -325,9 +332,18 @@ class CheckResult:
     limiting_pair: NDArray[np.int64]
     limiting_constraint: NDArray[np.int64]
     limiting_leg: NDArray[np.int64]
+    collision_pairs: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return int(self.reachable.shape[0])
+
+    @property
+    def collision_pair(self) -> list[str]:
+        """Per pose, the closest pair of the collision scene ("" without a scene)."""
+        if "collision" not in self.limiting_legs:  # no scene: the row does not apply
+            return [""] * len(self)
+        names = ("", *self.collision_pairs)
+        return [names[k] for k in self.limiting_legs["collision"].tolist()]
 
     @property
     def violated(self) -> list[list[str]]:
@@ -468,6 +484,7 @@ def check(
         relative = np.where(np.isnan(relative), -np.inf, relative)  # NaN is violated
         limiting_constraint = np.argmin(relative, axis=0).astype(np.int64)
         limiting_leg = legs[limiting_constraint, np.arange(count)]
+    limiting_leg = np.where(limiting_constraint == COLLISION, 0, limiting_leg)
     return CheckResult(
         position=position,
         angles=angles,
@@ -477,7 +494,19 @@ def check(
         limiting_pair=pairs,
         limiting_constraint=limiting_constraint,
         limiting_leg=limiting_leg,
+        collision_pairs=collision_pair_names(manipulator),
     )
+
+
+def collision_pair_names(manipulator: Manipulator) -> tuple[str, ...]:
+    """Names of the pairs the model's collision scene checks, in the kernels' pair order
+    (``"tool vs leg 4"``, ``"leg 2 vs vise"``: moving body first); empty without a scene."""
+    scene = manipulator.collision
+    if scene is None or scene.pair_count == 0:
+        return ()
+    from .collision.scene import pair_table
+
+    return pair_table(scene)[1]
 
 
 def home_pose_violations(manipulator: Manipulator) -> list[str]:
@@ -498,7 +527,8 @@ class PoseCheck(NamedTuple):
         Signed margins in :data:`CONSTRAINT_NAMES` order (units of the constraint table).
     limiting_legs : tuple of int
         1-based leg with the smallest margin of each constraint (``leg_interference``: the
-        lower leg of the closest pair; 0 when the check is disabled).
+        lower leg of the closest pair; 0 when the check is disabled; ``collision``: the 1-based
+        index of the closest pair in :func:`collision_pair_names`, 0 without a scene).
     limiting_pair : tuple of 2 int
         1-based closest pair (0, 0 when the check is disabled).
     limiting_constraint : int

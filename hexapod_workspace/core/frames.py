@@ -47,7 +47,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ConfigError, InputError
-from .manipulator import Manipulator, _describe, _frozen, _numbers, _vector3
+from .manipulator import Manipulator, _angles3, _describe, _frozen, _numbers, _vector3
 from .params import flatten, load_params_file
 from .rotations import tt_to_matrix
 
@@ -81,17 +81,6 @@ _TOOL_KEY = re.compile(r"^tools\.T([1-9][0-9]*)\.(offset|orientation)$")
 def _rotation(angles: NDArray[np.float64]) -> NDArray[np.float64]:
     matrix: NDArray[np.float64] = tt_to_matrix(angles)
     return matrix
-
-
-def _angles3(name: str, value: Any) -> NDArray[np.float64]:
-    array = _numbers(name, value)
-    if array.size != 3:
-        msg = f"{name}: expected 3 numbers (phi, theta, psi) in rad, got {array.size}"
-        raise ConfigError(msg)
-    if float(np.max(np.abs(array))) > 1e6:
-        msg = f"{name}: expected angles within ±1e6 rad, got {_describe(array.tolist())}"
-        raise ConfigError(msg)
-    return array
 
 
 @dataclass(frozen=True, eq=False)
@@ -328,8 +317,16 @@ def tool_model(manipulator: Manipulator, tool: Tool) -> Manipulator:
         at P's home pose, ``home + t`` (used only to order leg pairs); ``position`` (the
         default pose position) is the tool centre point's.
     """
-    if tool.is_identity:
+    if tool.is_identity and manipulator.collision is None:
         return manipulator
+    scene = manipulator.collision
+    if scene is not None:
+        transform = np.eye(4)
+        transform[:3, :3] = tool.rotation
+        transform[:3, 3] = tool.offset
+        scene = scene.in_tool_frame(transform)
+    if tool.is_identity:
+        return replace(manipulator, collision=scene)
     rotation_t = tool.rotation.T
     joints = (manipulator.platform_joints - tool.offset) @ rotation_t.T
     axes = manipulator.platform_joint_axes @ rotation_t.T
@@ -339,6 +336,7 @@ def tool_model(manipulator: Manipulator, tool: Tool) -> Manipulator:
         platform_joint_axes=_frozen(axes),
         home_position=_frozen(manipulator.home_position + tool.offset),
         axes_from_home=(manipulator.axes_from_home[0], False),
+        collision=scene,
     )
 
 

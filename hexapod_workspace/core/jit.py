@@ -74,6 +74,8 @@ KERNEL_SOURCES = tuple(
         "jit.py",
         "constraint_table.py",
         "model_layout.py",
+        "collision_kernels.py",
+        "collision/distance.py",
         "margin_kernels.py",
         "search_kernels.py",
         "planner_kernels.py",

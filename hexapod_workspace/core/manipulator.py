@@ -12,7 +12,7 @@ import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -22,6 +22,7 @@ from .architectures import ARCHITECTURES
 from .architectures import module as architecture_module
 from .params import (
     CELL_PARAMETERS,
+    COLLISION_PARAMETERS,
     NODE_PARAMETERS,
     ROS_PARAMETERS,
     flatten,
@@ -30,6 +31,9 @@ from .params import (
 )
 from .resolution import MAX_POSITION_NORM
 from .validation import coincident_joints_reason, require_usable, unusable_reason
+
+if TYPE_CHECKING:
+    from .collision.params import CollisionScene
 
 __all__ = [
     "ARCHITECTURE_PARAMETERS",
@@ -391,6 +395,31 @@ def _axes(name: str, value: Any) -> NDArray[np.float64] | None:
     return unit
 
 
+def _angles3(name: str, value: Any) -> NDArray[np.float64]:
+    """Three angles (φ, θ, ψ) in rad, within ±1e6 (the cell's frame orientations)."""
+    array = _numbers(name, value)
+    if array.size != 3:
+        msg = f"{name}: expected 3 numbers (phi, theta, psi) in rad, got {array.size}"
+        raise ConfigError(msg)
+    if float(np.max(np.abs(array))) > 1e6:
+        msg = f"{name}: expected angles within ±1e6 rad, got {_describe(array.tolist())}"
+        raise ConfigError(msg)
+    return array
+
+
+def _cell_transform(flat: Mapping[str, Any], group: str, offset: str) -> NDArray[np.float64]:
+    """The 4×4 transform of the cell's ``tool`` (P <- C: ``offset``, ``orientation``) or
+    ``work`` (O <- W: ``origin``, ``orientation``) frame, from its parameters (default zero),
+    as :mod:`hexapod_workspace.core.frames` reads them."""
+    from .rotations import tt_to_matrix
+
+    transform = np.eye(4)
+    transform[:3, 3] = _vector3(f"{group}.{offset}", flat.get(f"{group}.{offset}", [0.0] * 3))
+    angles = _angles3(f"{group}.orientation", flat.get(f"{group}.orientation", [0.0] * 3))
+    transform[:3, :3] = tt_to_matrix(angles)
+    return transform
+
+
 def _singularity_min(value: Any) -> float:
     """``limits.singularity_min``: one finite number in [0, 1] (σ_min of a matrix of unit
     rows is at most √6, but a limit above 1 leaves no practical workspace)."""
@@ -462,6 +491,10 @@ class Manipulator:
         pus: slide stroke along the rail, m; rus: crank range, rad (max − min < 2π).
     transmission_min : float
         pus/rus: smallest |τ_i| allowed (constraint ``transmission``), in (0, 1).
+    collision : CollisionScene or None
+        The collision scene (``collision.*``: platform and tool bodies, obstacles), with its
+        moving bodies in this model's mobile frame; None when no scene is declared (then the
+        ``collision`` constraint does not exist: +inf, left out of the interfaces).
     """
 
     base_joints: NDArray[np.float64]
@@ -488,6 +521,7 @@ class Manipulator:
     actuator_min: NDArray[np.float64] | None = None
     actuator_max: NDArray[np.float64] | None = None
     transmission_min: float = 0.1
+    collision: CollisionScene | None = None
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -636,6 +670,8 @@ class Manipulator:
             **frozen_legs,
         )
         manipulator = _with_home_axes(manipulator, base_axes is None, platform_axes is None)
+        if any(name.startswith(COLLISION_PARAMETERS) for name in flat):
+            manipulator = _with_scene(manipulator, flat)
         if warn:
             reason = unusable_reason(manipulator)
             if reason is not None:
@@ -674,7 +710,14 @@ class Manipulator:
         """
         parameters = load_params_file(path)
         unknown = unknown_parameter(
-            parameters, (*PARAMETER_DEFAULTS, *NODE_PARAMETERS, *CELL_PARAMETERS, *ROS_PARAMETERS)
+            parameters,
+            (
+                *PARAMETER_DEFAULTS,
+                *NODE_PARAMETERS,
+                *CELL_PARAMETERS,
+                *COLLISION_PARAMETERS,
+                *ROS_PARAMETERS,
+            ),
         )
         if unknown is not None:
             msg = f"parameters file {path}: {unknown}"
@@ -719,7 +762,9 @@ class Manipulator:
 
         ups = self.architecture == "ups"
 
+        scene = dict(self.collision.parameters) if self.collision is not None else {}
         return {
+            **scene,
             "frame_id": self.frame_id,
             "geometry.base_joints": floats(self.base_joints),
             "geometry.platform_joints": floats(self.platform_joints),
@@ -800,9 +845,30 @@ class Manipulator:
             and self.singularity_min == other.singularity_min
             and self.frame_id == other.frame_id
             and self.axes_from_home == other.axes_from_home
+            and self.collision == other.collision
         )
 
     __hash__ = None  # type: ignore[assignment]
+
+
+def _with_scene(manipulator: Manipulator, flat: Mapping[str, Any]) -> Manipulator:
+    """The model with its collision scene (``collision.*``), built in the platform frame P.
+
+    Obstacles given in the work frame are placed with ``work.*``; the tool body starts at the
+    tool centre point of ``tool.*`` (the cell's tool frame). A scene with no pair to check
+    (no tool and no obstacle) leaves the model without one. Refuses, naming the pair, an
+    obstacle or body in collision at the home pose.
+    """
+    from dataclasses import replace
+
+    from .collision.params import collision_scene
+
+    work = _cell_transform(flat, "work", "origin")
+    tool = _cell_transform(flat, "tool", "offset")
+    scene = collision_scene(flat, work_transform=work, tool_transform=tool, manipulator=manipulator)
+    if scene.pair_count == 0:
+        return manipulator
+    return replace(manipulator, collision=scene)
 
 
 def _model_names() -> str:

@@ -20,9 +20,11 @@ from .jit import jit as _jit
 import numpy as np
 from numpy.typing import NDArray
 
+from .collision_kernels import SCRATCH_FLOATS, collision_margin
 from .constraint_table import (
     ACTUATOR,
     BASE_JOINT,
+    COLLISION,
     IK,
     LEG_INTERFERENCE,
     LEG_LENGTH,
@@ -40,6 +42,7 @@ from .model_layout import (
     BETA,
     BETA_EQUAL,
     BRANCH,
+    COLLISION_ON,
     CRANK,
     CROSS,
     DIAMETER,
@@ -50,6 +53,7 @@ from .model_layout import (
     LENGTH_FLOOR,
     LMAX,
     LMIN,
+    MODEL_SIZE,
     ORDER,
     PAIR_I,
     PAIR_J,
@@ -78,13 +82,16 @@ __all__ = ["ONE_SIZE", "SCRATCH_ROWS", "check_angles", "check_one", "margins_rot
 OUT_LEG = N_CONSTRAINTS  # limiting leg of each margin (N_CONSTRAINTS slots, as float)
 OUT_PAIR = 2 * N_CONSTRAINTS  # closest pair (2 slots)
 OUT_SHORTEST = OUT_PAIR + 2  # shortest leg length, m
-OUT_SIZE = OUT_SHORTEST + 1
+OUT_GAP = OUT_SHORTEST + 1  # the collision margin's gap to its upper bound, m (collision_kernels)
+OUT_SIZE = OUT_GAP + 1
 #: Size of :func:`check_one`'s result: margins, legs, pair (2), limiting constraint and leg,
 #: reachable (1.0 or 0.0).
 ONE_SIZE = 2 * N_CONSTRAINTS + 5
-#: Rows of the per-pose scratch (6 legs each): leg vector planes, squared length, 1/ℓ², and the
-#: base-side ends of pus/rus legs (three planes).
-SCRATCH_ROWS = 8
+#: First row of the collision margin's working memory in the per-pose scratch.
+_COLLISION_SCRATCH = 8
+#: Rows of the per-pose scratch (6 legs each): leg vector planes, squared length, 1/ℓ², the
+#: base-side ends of pus/rus legs (three planes), then the working memory of the collision margin.
+SCRATCH_ROWS = _COLLISION_SCRATCH + (SCRATCH_FLOATS + 5) // 6
 
 
 @_helper
@@ -199,6 +206,7 @@ def _pose(
     out[OUT_LEG + BASE_JOINT] = leg_a
     out[OUT_LEG + PLATFORM_JOINT] = leg_b
     out[OUT_SHORTEST] = shortest
+    _pose_collision(model, r, px, py, pz, scratch, out)
     out[OUT_LEG + SINGULARITY] = 0
     out[SINGULARITY] = _pose_singularity(model, r, scratch)
     if not want_pair or model[INTERFERENCE] == 0.0:
@@ -469,6 +477,7 @@ def _pose_moving(
     out[PLATFORM_JOINT] = m_b
     out[OUT_LEG + PLATFORM_JOINT] = leg_b
     out[OUT_SHORTEST] = model[LENGTH_FLOOR]
+    _pose_collision(model, r, px, py, pz, scratch, out)
     out[OUT_LEG + SINGULARITY] = 0
     out[OUT_LEG + LEG_INTERFERENCE] = 0
     out[OUT_PAIR] = 0
@@ -481,6 +490,9 @@ def _pose_moving(
         out[PLATFORM_JOINT] = np.nan
         out[SINGULARITY] = np.nan if model[SINGULARITY_ON] != 0.0 else np.inf
         out[LEG_INTERFERENCE] = np.nan if want_pair and model[INTERFERENCE] != 0.0 else np.inf
+        if model[COLLISION_ON] != 0.0:
+            out[COLLISION] = np.nan  # a leg body of an unsolved leg is nowhere
+            out[OUT_LEG + COLLISION] = -1.0
         return
     out[SINGULARITY] = _pose_singularity(model, r, scratch)
     if not want_pair or model[INTERFERENCE] == 0.0:
@@ -521,6 +533,31 @@ def _pose_moving(
     out[OUT_LEG + LEG_INTERFERENCE] = PAIR_I[best_pair]
     out[OUT_PAIR] = PAIR_I[best_pair]
     out[OUT_PAIR + 1] = PAIR_J[best_pair]
+
+
+@_helper
+def _pose_collision(
+    model: NDArray[np.float64],
+    r: NDArray[np.float64],
+    px: float,
+    py: float,
+    pz: float,
+    scratch: NDArray[np.float64],
+    out: NDArray[np.float64],
+) -> None:
+    """The collision margin, its pair (as the constraint's "leg") and gap into ``out``, from the
+    leg planes of ``scratch`` (the leg bodies run from B_k − L_k to B_k, so a moving base-side
+    end is where the leg architecture put it; +inf, −1, 0 without a scene)."""
+    if model[COLLISION_ON] != 0.0:
+        memory = scratch[_COLLISION_SCRATCH:].reshape(-1)
+        value, pair, gap = collision_margin(
+            model, MODEL_SIZE, B, r, px, py, pz, scratch[0], scratch[1], scratch[2], memory
+        )
+    else:
+        value, pair, gap = np.inf, -1.0, 0.0
+    out[COLLISION] = value
+    out[OUT_LEG + COLLISION] = pair
+    out[OUT_GAP] = gap
 
 
 # ------------------------------------------------------------------------------ singularity
@@ -711,6 +748,43 @@ def _block_singularity(
         work[_SIGMA * BLOCK + n] = _smallest_singular_value(rows) - model[SINGULARITY_MIN]
 
 
+@_helper
+def _block_collision(
+    model: NDArray[np.float64],
+    work: NDArray[np.float64],
+    count: int,
+    px: float,
+    py: float,
+    pz: float,
+    scratch: NDArray[np.float64],
+    r: NDArray[np.float64],
+) -> None:
+    """The collision margin and its pair of the poses of a block that take the vectorised path
+    (the others are computed whole by :func:`_pose`) into the _COLLIDE rows, from the leg and
+    rotation planes (before the outputs overwrite the rotation planes). The leg planes hold
+    L_k = B_k − A_k with A_k where the leg architecture puts it (NaN for an unsolved leg, whose
+    pose is answered by :func:`_unsolved_outputs`)."""
+    memory = scratch[_COLLISION_SCRATCH:].reshape(-1)
+    moving = model[ARCH] != 0.0
+    for n in range(count):
+        if work[(_MIN + _FIX) * BLOCK + n] != 0.0:
+            continue
+        if moving and work[(_MOVE + _UNSOLVED) * BLOCK + n] != 0.0:
+            continue
+        for i in range(9):
+            r[i] = work[(_R + i) * BLOCK + n]
+        for k in range(6):
+            leg = (_LEGS + 7 * k) * BLOCK + n
+            scratch[0, k] = work[leg + _LX * BLOCK]
+            scratch[1, k] = work[leg + _LY * BLOCK]
+            scratch[2, k] = work[leg + _LZ * BLOCK]
+        value, pair, _ = collision_margin(
+            model, MODEL_SIZE, B, r, px, py, pz, scratch[0], scratch[1], scratch[2], memory
+        )
+        work[_COLLIDE * BLOCK + n] = value
+        work[(_COLLIDE + 1) * BLOCK + n] = pair
+
+
 # ------------------------------------------------------------------------------ sin and cos
 # Cody–Waite reduction by π/2 in three parts of 33 bits (exact products for |k| < 2**20) and the
 # Cephes polynomials on [−π/4, π/4]: within 1 ulp of libm, and branch-free, so that loops over a
@@ -832,7 +906,8 @@ _BASE = _SIGMA + 1
 _MOVE = _BASE + 18
 # _UNSOLVED: 1.0 when some leg has no inverse-kinematics solution; _UNSOLVED_LEG: the first.
 _M_ACT, _LEG_ACT, _M_IK, _LEG_IK, _M_TAU, _LEG_TAU, _UNSOLVED, _UNSOLVED_LEG = range(8)
-_BLOCK_ROWS = _MOVE + 8
+_COLLIDE = _MOVE + 8  # 2 rows: collision margin and its pair (when a scene is declared)
+_BLOCK_ROWS = _COLLIDE + 2
 # Rows of the running minima (offsets from _MIN): margins or cosines and their leg or pair.
 _M_LEN, _LEG_LEN, _M_A, _LEG_A, _M_B, _LEG_B, _BEST, _PAIR, _FIX = range(9)
 # Rows of one leg (offsets from _LEGS + 7·k): vector, squared length, 1/ℓ², joint cosines.
@@ -1166,6 +1241,7 @@ def _unsolved_outputs(
     work[(OUT_LEG + LEG_INTERFERENCE) * BLOCK + n] = 0.0
     work[OUT_PAIR * BLOCK + n] = 0.0
     work[(OUT_PAIR + 1) * BLOCK + n] = 0.0
+    work[(OUT_LEG + COLLISION) * BLOCK + n] = -1.0  # no pair: a leg body is nowhere
 
 
 @_helper
@@ -1274,6 +1350,9 @@ def _check_block(
     singular = model[SINGULARITY_ON] != 0.0
     if singular:
         _block_singularity(model, work, count, np.empty(ROWS_SCRATCH))
+    collide = model[COLLISION_ON] != 0.0
+    if collide:
+        _block_collision(model, work, count, px, py, pz, scratch, r)
     # Per pose: the joint-angle margins (arccos), the rare poses that need care, the outputs.
     alpha_equal = model[ALPHA_EQUAL] != 0.0
     beta_equal = model[BETA_EQUAL] != 0.0
@@ -1324,6 +1403,10 @@ def _check_block(
             work[(OUT_PAIR + 1) * BLOCK + n] = 0.0
         work[SINGULARITY * BLOCK + n] = work[_SIGMA * BLOCK + n] if singular else np.inf
         work[(OUT_LEG + SINGULARITY) * BLOCK + n] = 0.0
+        work[COLLISION * BLOCK + n] = work[_COLLIDE * BLOCK + n] if collide else np.inf
+        work[(OUT_LEG + COLLISION) * BLOCK + n] = (
+            work[(_COLLIDE + 1) * BLOCK + n] if collide else -1.0
+        )
         # Rows of the moving-base architectures (+inf where they do not apply).
         for row, slot in ((ACTUATOR, _M_ACT), (IK, _M_IK), (TRANSMISSION, _M_TAU)):
             work[row * BLOCK + n] = moves[slot * BLOCK + n] if moving else np.inf

@@ -1,7 +1,9 @@
 """Model layout of the compiled kernels: a manipulator packed into one float64 vector.
 
 The kernels take a handful of arrays, which keeps numba's dispatch cheap (a few microseconds per
-call): :func:`model_vector` packs the model once per manipulator at the offsets below.
+call): :func:`model_vector` packs the model once per manipulator at the offsets below. A model
+with a collision scene has its scene appended after ``MODEL_SIZE``
+(:func:`hexapod_workspace.core.collision_kernels.pack_scene`; ``COLLISION_ON`` says so).
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .architectures import CODES
+from .collision_kernels import pack_scene
 from .constraint_table import CONSTRAINTS, N_CONSTRAINTS, applicable, scales
 
 if TYPE_CHECKING:
@@ -69,7 +72,8 @@ RAY_DRIVE = TAU_MIN + 1  # (actuate·g + crank/r_min + ends)·ρ, g = 1 (pus) or
 # Rows of the table the batch check writes: 1 + the last row that applies to the model (the
 # rows after it are +inf for every pose; check() neither allocates nor fills them).
 ROWS_USED = RAY_DRIVE + N_CONSTRAINTS
-MODEL_SIZE = ROWS_USED + 1
+COLLISION_ON = ROWS_USED + 1  # 1.0 when a collision block follows MODEL_SIZE
+MODEL_SIZE = COLLISION_ON + 1
 
 #: Leg pairs (i < j) in the order of numpy.triu_indices(6, 1).
 PAIR_I = np.array([i for i in range(6) for j in range(i + 1, 6)], dtype=np.int64)
@@ -94,15 +98,16 @@ def model_vector(manipulator: Manipulator, report_singularity: bool = False) -> 
 
     Returns
     -------
-    ndarray, shape (MODEL_SIZE,)
-        Read-only; layout given by the offsets of this module.
+    ndarray, shape (MODEL_SIZE + K,)
+        Read-only; layout given by the offsets of this module, then the collision block (K = 0
+        without a scene).
     """
     key = id(manipulator)  # one dictionary per kind: the per-call lookup stays an int's
     models = _REPORT_MODELS if report_singularity else _MODELS
     cached = models.get(key)
     if cached is not None:
         return cached
-    model = np.zeros(MODEL_SIZE)
+    model: NDArray[np.float64] = np.zeros(MODEL_SIZE)
     model[A : A + 18] = manipulator.base_joints.ravel()
     model[B : B + 18] = manipulator.platform_joints.ravel()
     model[JA : JA + 18] = manipulator.base_joint_axes.ravel()
@@ -135,21 +140,22 @@ def model_vector(manipulator: Manipulator, report_singularity: bool = False) -> 
     _pack_architecture(model, manipulator, code)
     for c, row in enumerate(CONSTRAINTS):
         rho = model[RHO]
-        model[RAY_CONSTANT + c] = row.speed * rho + row.spin
-        model[RAY_TURN + c] = row.turn * rho
+        speed, turn, spin, actuate, crank, ends = row.coefficients(manipulator)
+        model[RAY_CONSTANT + c] = speed * rho + spin
+        model[RAY_TURN + c] = turn * rho
         if code == 0:
             # 6-UPS: Q = E = V = ρ along a ray, no crank (constraint_table).
-            if row.actuate + row.ends != 0.0:
-                model[RAY_CONSTANT + c] += (row.actuate + row.ends) * rho
+            if actuate + ends != 0.0:
+                model[RAY_CONSTANT + c] += (actuate + ends) * rho
             model[ESTIMATE_RATE + c] = model[RAY_CONSTANT + c] + (
-                model[RAY_TURN + c] / model[ESTIMATE_FLOOR] if row.turn != 0.0 else 0.0
+                model[RAY_TURN + c] / model[ESTIMATE_FLOOR] if turn != 0.0 else 0.0
             )
         else:
             # pus/rus: Q = g·V/τ_f, K = V/(r_min·τ_f) (rus), E = V/τ_f, N = V(1 + 1/τ_f)/L_min.
             cranks = manipulator.crank_lengths
             inverse_r = 1.0 / float(np.min(cranks)) if cranks is not None else 0.0
             gain = inverse_r if code == 2 else 1.0
-            model[RAY_DRIVE + c] = (row.actuate * gain + row.crank * inverse_r + row.ends) * rho
+            model[RAY_DRIVE + c] = (actuate * gain + crank * inverse_r + ends) * rho
             tau = model[TAU_MIN]
             model[ESTIMATE_RATE + c] = (
                 model[RAY_CONSTANT + c]
@@ -159,6 +165,10 @@ def model_vector(manipulator: Manipulator, report_singularity: bool = False) -> 
     model[ROWS_USED] = max(applicable(manipulator)) + 1
     model[SINGULARITY_MIN] = manipulator.singularity_min
     model[SINGULARITY_ON] = 1.0 if manipulator.singularity_min > 0.0 or report_singularity else 0.0
+    scene = pack_scene(manipulator)
+    if scene.size:
+        model[COLLISION_ON] = 1.0
+        model = np.concatenate([model, scene])
     model.setflags(write=False)
     # The manipulator is frozen: nothing is written into it. The entry lives as long as the
     # object (its id is not reused before the finalizer has removed the entry).

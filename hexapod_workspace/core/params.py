@@ -16,6 +16,7 @@ from ..errors import ConfigError
 
 __all__ = [
     "CELL_PARAMETERS",
+    "COLLISION_PARAMETERS",
     "NODE_NAME",
     "NODE_PARAMETERS",
     "ROS_PARAMETERS",
@@ -63,6 +64,10 @@ CELL_PARAMETERS = (
     "tools.",
     "limits.actuator_speed_max",
 )
+#: Parameters of the collision scene (``collision.clearance``, ``collision.platform.*``,
+#: ``collision.tool.*``, ``collision.obstacles.*``), read by
+#: :func:`hexapod_workspace.core.collision.params.collision_scene`, which knows every name.
+COLLISION_PARAMETERS = ("collision.",)
 #: Parameters every ROS 2 node has (prefixes end with a dot).
 ROS_PARAMETERS = ("use_sim_time", "start_type_description_service", "qos_overrides.")
 

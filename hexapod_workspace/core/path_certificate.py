@@ -24,7 +24,9 @@ joints A_i are fixed, so each leg vector ``L_i = B_i − A_i`` moves at most at 
 margin is Lipschitz in s with the rate of its row of
 :mod:`hexapod_workspace.core.constraint_table`, ``speed·V + turn·N + spin·Ω + actuate·Q +
 crank·K + ends·E`` (for 6-UPS: V for ``leg_length``, V / ℓ_f for ``base_joint``, Ω + V / ℓ_f for
-``platform_joint``, 2V for ``leg_interference``; the derivations are written there).
+``platform_joint``, 2V for ``leg_interference``, V + ρ_c·Ω for ``collision``, ρ_c from the
+model's scene, bounding the derived |Δp| + ρ_c·Ω since V ≥ |Δp|; the derivations are written
+there).
 
 *Moving base joints (pus, rus).* The legs have fixed lengths (ℓ_f = min L_i) and the rates
 need a transmission floor τ_f. On an interval [a, b] of width w, ``|τ|`` changes at most at
@@ -135,7 +137,7 @@ class _Certifier:
             floor = 0.5 * (2.0 * self.length_min + length_start + length_end - travel)
             floor = np.where(low_length >= 0.0, np.maximum(floor, self.length_min), floor)
             turn = np.where(floor > 0.0, travel / np.where(floor > 0.0, floor, 1.0), np.inf)
-            lipschitz_travel = rate_bounds(travel, turn, omega * width)
+            lipschitz_travel = rate_bounds(self.manipulator, travel, turn, omega * width)
             low: NDArray[np.float64] = np.minimum(
                 np.minimum(start, end), 0.5 * (start + end - lipschitz_travel)
             )
@@ -176,6 +178,7 @@ class _Certifier:
             inverse = np.where(valid, 1.0 / np.where(valid, tau_f, 1.0), np.inf)
             gain = crank if self.manipulator.architecture == "rus" else 1.0
             lipschitz_travel = rate_bounds(
+                self.manipulator,
                 travel,
                 travel * (1.0 + inverse) / length,
                 omega * width,

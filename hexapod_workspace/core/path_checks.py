@@ -13,8 +13,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ResolutionError
-from .constraint_table import applicable
-from .constraints import CONSTRAINT_NAMES, PoseMargins, relative_margins
+from .constraint_table import COLLISION, applicable
+from .constraints import CONSTRAINT_NAMES, PoseMargins, collision_pair_names, relative_margins
 from .manipulator import Manipulator
 from .path_certificate import (
     DEFAULT_MAX_SAMPLE_ANGLE,
@@ -51,10 +51,19 @@ def _waypoint_checks(
         margins={CONSTRAINT_NAMES[k]: found.margins[k] for k in applicable(certifier.manipulator)},
         relative=certifier.relative(found.margins),
         limiting_constraint=limiting,
-        limiting_leg=found.limiting_legs[limiting, columns] + 1,
+        limiting_leg=np.where(limiting == COLLISION, 0, found.limiting_legs[limiting, columns] + 1),
         limiting_pair=found.limiting_pairs + 1 if enabled else found.limiting_pairs,
+        collision_pair=_pair_names(certifier.manipulator, found.limiting_legs[COLLISION]),
     )
     return result, found
+
+
+def _pair_names(manipulator: Manipulator, pairs: NDArray[np.int64]) -> tuple[str, ...]:
+    """Names of 0-based collision pair indices (−1: none); () when the model has no scene."""
+    names = collision_pair_names(manipulator)
+    if not names:
+        return ()
+    return tuple(names[k] if k >= 0 else "" for k in pairs.tolist())
 
 
 def check_waypoints(
@@ -169,7 +178,7 @@ def _segment_checks(certifier: _Certifier, moves: _Moves, raw: _MoveCheck) -> Se
     margins = samples["margins"][:, rows]
     relative = relative_margins(certifier.manipulator, margins)
     limiting = np.argmin(np.where(np.isnan(relative), -np.inf, relative), axis=0)
-    legs = samples["legs"][limiting, rows] + 1
+    legs = np.where(limiting == COLLISION, 0, samples["legs"][limiting, rows] + 1)
     enabled = certifier.manipulator.leg_diameter > 0.0
     pairs = samples["pairs"][rows] + 1 if enabled else np.zeros((count, 2), dtype=np.int64)
     s_bad = np.where(raw.ok, 0.0, raw.first_bad)
@@ -194,4 +203,5 @@ def _segment_checks(certifier: _Certifier, moves: _Moves, raw: _MoveCheck) -> Se
         angular_rate=moves.omega,
         translation=moves.translation,
         evaluations=raw.evaluations,
+        collision_pair=_pair_names(certifier.manipulator, samples["legs"][COLLISION, rows]),
     )

@@ -44,6 +44,9 @@ class WaypointChecks:
         1-based leg of the limiting constraint (interference: lower leg of the pair).
     limiting_pair : ndarray, shape (N, 2), int
         1-based closest leg pair (0, 0 when the interference check is disabled).
+    collision_pair : tuple of str
+        Per waypoint, the closest pair of the collision scene (``"tool vs leg 4"``); empty
+        (length 0) when the model declares no scene.
     """
 
     positions: NDArray[np.float64]
@@ -54,6 +57,7 @@ class WaypointChecks:
     limiting_constraint: NDArray[np.int64]
     limiting_leg: NDArray[np.int64]
     limiting_pair: NDArray[np.int64]
+    collision_pair: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return int(self.reachable.shape[0])
@@ -106,6 +110,9 @@ class SegmentChecks:
         |Δp|, m.
     evaluations : int
         Poses evaluated inside the moves (the waypoints excluded).
+    collision_pair : tuple of str
+        Per move, the closest pair of the collision scene at the first violation (else at the
+        smallest margin); empty (length 0) when the model declares no scene.
     """
 
     ok: NDArray[np.bool_]
@@ -122,6 +129,7 @@ class SegmentChecks:
     angular_rate: NDArray[np.float64]
     translation: NDArray[np.float64]
     evaluations: int
+    collision_pair: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return int(self.ok.shape[0])

@@ -17,10 +17,11 @@ from .jit import jit as _jit
 import numpy as np
 from numpy.typing import NDArray
 
-from .constraint_table import IK, LEG_LENGTH, N_CONSTRAINTS, TRANSMISSION
+from .constraint_table import COLLISION, IK, LEG_LENGTH, N_CONSTRAINTS, TRANSMISSION
 from .margin_kernels import (
     _BLOCK_ROWS,
     BLOCK,
+    OUT_GAP,
     OUT_SHORTEST,
     OUT_SIZE,
     SCRATCH_ROWS,
@@ -152,7 +153,8 @@ def _recovery_step_moving(model: NDArray[np.float64], out: NDArray[np.float64]) 
         for c in range(N_CONSTRAINTS):
             if c == IK or c == TRANSMISSION:  # noqa: SIM109 - plain comparisons for numba
                 continue
-            value = -out[c] / _rate_moving(model, c, tau_f) if out[c] < 0.0 else 0.0
+            margin = out[c] + out[OUT_GAP] if c == COLLISION else out[c]
+            value = -margin / _rate_moving(model, c, tau_f) if margin < 0.0 else 0.0
             if value > other:
                 other = value
         other = min(other, (tau_now - tau_f) / _rate_moving(model, TRANSMISSION, tau_f))
@@ -209,14 +211,17 @@ def certified_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> floa
 def recovery_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
     """Length over which a violated pose stays violated: the most violated constraint, in
     Lipschitz units, cannot climb back to zero within |m_c| / L_c; joint-angle bounds use half
-    the current shortest leg, and the step keeps every leg at least that long."""
+    the current shortest leg, and the step keeps every leg at least that long. The collision
+    margin is a lower bound within its gap of the true one (exact except in deep contact with a
+    box or cylinder): its recovery starts from value + gap, an upper bound."""
     if model[ARCH] != 0.0:
         return _recovery_step_moving(model, out)
     rho: float = model[RHO]
     floor: float = 0.5 * out[OUT_SHORTEST]
     recover = 0.0
     for c in range(N_CONSTRAINTS):
-        value = -out[c] / _rate(model, c, floor) if out[c] < 0.0 else 0.0
+        margin = out[c] + out[OUT_GAP] if c == COLLISION else out[c]
+        value = -margin / _rate(model, c, floor) if margin < 0.0 else 0.0
         if value > recover or value != value:
             recover = value
     return min(recover, floor / rho) * SAFETY

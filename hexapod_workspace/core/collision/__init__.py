@@ -8,8 +8,9 @@
 * :mod:`.params` — the ``collision.*`` parameters (clearance, platform, tool, obstacles by
   name), validated as a whole.
 
-The wiring of the ``collision`` margin into the constraint table (every check, workspace, move
-certificate) follows the constraint-table work; this package is what it will call.
+The ``collision`` row of the constraint table is evaluated inside the compiled kernels by
+:mod:`hexapod_workspace.core.collision_kernels` (same bodies, pairs and distances);
+:func:`scene_distances` is the standalone evaluation the tests compare it with.
 """
 
 from .distance import GJK_TOLERANCE, pair_distance, pair_distances, record

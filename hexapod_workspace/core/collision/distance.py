@@ -32,7 +32,9 @@ points), and inflations add: ``sd(A ⊕ r_A, B ⊕ r_B) = sd(A, B) − r_A − r
 * Closed forms (exact to rounding): point and segment cores against each other (Ericson's
   closest points of two segments, degenerate cases included; the Minkowski difference of two
   segments is flat, so their signed distance is their distance), a point against a box and
-  against a cylinder (signed: inside, minus the distance to the nearest face).
+  against a cylinder (signed: inside, minus the distance to the nearest face), a segment
+  against a cylinder whose curved surface holds the closest point (``_segment_cylinder``:
+  the distance to the axis minus the radius, exact there).
 * GJK (Gilbert–Johnson–Keerthi) for every other pair (segment, box or cylinder against box or
   cylinder). Each iteration has the upper bound ``|v|`` (a point of ``M``) and, by (1) with
   ``d = v/|v|``, the lower bound ``v·w/|v|`` (``w`` the support point of ``M`` in ``−v``).
@@ -60,7 +62,7 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import kernels
+from ..jit import CACHE_DIRECTORY
 
 __all__ = [
     "BOX",
@@ -87,10 +89,13 @@ _KIND, _C, _R, _P, _INFLATION = 0, 1, 4, 13, 16
 GJK_TOLERANCE = 1e-9
 #: Largest gap (upper − lower bound, m) the tests accept from GJK, stagnation included.
 GJK_GAP_BOUND = 1e-8
+#: Rows of the (WORK_ROWS, 3) working memory of :func:`_pair` (simplex, support points, the
+#: tetrahedron's face): callers allocate it once per batch.
+WORK_ROWS = 17
 #: Iteration cap of GJK (reached only in degenerate numerics; the lower bound stays valid).
 GJK_MAX_ITERATIONS = 64
 
-_CACHE = kernels.CACHE_DIRECTORY is not None
+_CACHE = CACHE_DIRECTORY is not None
 
 
 # numba ships no type information: the decorators are typed as returning the function they
@@ -209,6 +214,31 @@ def _axis_bound(
 
 
 @_helper
+def _segment_cylinder(segment: NDArray[np.float64], cylinder: NDArray[np.float64]) -> float:
+    """Distance from a point or segment core to a cylinder core, in closed form where it is
+    exact, else NaN.
+
+    The cylinder lies inside the capsule of its radius r around its axis segment, so
+    ``sd ≥ d − r`` with d the distance from the segment to the axis segment. When the closest
+    axis point q* is interior (parameter strictly inside (0, 1)), p* − q* is perpendicular to
+    the axis (first-order optimality), so ``q* + r (p* − q*)/d`` lies on the curved surface,
+    at d − r from p*: then, for d ≥ r, ``sd = d − r`` exactly. Otherwise (an end disc or rim is
+    closest, or the cores overlap) NaN, and the caller runs GJK.
+    """
+    p0x, p0y, p0z, d1x, d1y, d1z = _ends(segment)
+    h = cylinder[_P + 1]
+    ax, ay, az = cylinder[_R + 2] * h, cylinder[_R + 5] * h, cylinder[_R + 8] * h
+    q0x, q0y, q0z = cylinder[_C] - ax, cylinder[_C + 1] - ay, cylinder[_C + 2] - az
+    distance, t = _segment_segment_t(
+        p0x, p0y, p0z, d1x, d1y, d1z, q0x, q0y, q0z, 2.0 * ax, 2.0 * ay, 2.0 * az
+    )
+    radius = float(cylinder[_P])
+    if 0.0 < t < 1.0 and distance >= radius:
+        return float(distance - radius)
+    return math.nan
+
+
+@_helper
 def _segment_segment(
     p0x: float,
     p0y: float,
@@ -224,6 +254,27 @@ def _segment_segment(
     d2z: float,
 ) -> float:
     """Distance between segments p0 + s·d1 and q0 + t·d2, s, t in [0, 1] (Ericson 5.1.9)."""
+    distance, _ = _segment_segment_t(p0x, p0y, p0z, d1x, d1y, d1z, q0x, q0y, q0z, d2x, d2y, d2z)
+    return distance
+
+
+@_helper
+def _segment_segment_t(
+    p0x: float,
+    p0y: float,
+    p0z: float,
+    d1x: float,
+    d1y: float,
+    d1z: float,
+    q0x: float,
+    q0y: float,
+    q0z: float,
+    d2x: float,
+    d2y: float,
+    d2z: float,
+) -> tuple[float, float]:
+    """(distance, t) of segments p0 + s·d1 and q0 + t·d2, s, t in [0, 1] (Ericson 5.1.9), t
+    the second segment's parameter of the closest points."""
     rx, ry, rz = p0x - q0x, p0y - q0y, p0z - q0z
     a = d1x * d1x + d1y * d1y + d1z * d1z
     e = d2x * d2x + d2y * d2y + d2z * d2z
@@ -253,7 +304,7 @@ def _segment_segment(
     x = rx + s * d1x - t * d2x
     y = ry + s * d1y - t * d2y
     z = rz + s * d1z - t * d2z
-    return math.sqrt(x * x + y * y + z * z)
+    return math.sqrt(x * x + y * y + z * z), t
 
 
 @_helper
@@ -384,10 +435,16 @@ def _closest_triangle(simplex: NDArray[np.float64], v: NDArray[np.float64]) -> i
 
 @_helper
 def _closest_simplex(
-    simplex: NDArray[np.float64], count: int, v: NDArray[np.float64], tmp: NDArray[np.float64]
+    simplex: NDArray[np.float64],
+    count: int,
+    v: NDArray[np.float64],
+    tmp: NDArray[np.float64],
+    face: NDArray[np.float64],
+    candidate: NDArray[np.float64],
 ) -> int:
     """Closest point v of the simplex (count vertices) to the origin; reduces the simplex to
-    the vertices that support v and returns their count (0: the origin is inside)."""
+    the vertices that support v and returns their count (0: the origin is inside). ``face``
+    (3, 3) and ``candidate`` (3,) are working memory (no allocation per call)."""
     if count == 1:
         v[:] = simplex[0]
         return 1
@@ -419,8 +476,6 @@ def _closest_simplex(
     best = np.inf
     best_mask = 0
     best_face = -1
-    face = np.empty((3, 3))
-    candidate = np.empty(3)
     for opposite in range(4):
         k = 0
         for m in range(4):
@@ -465,10 +520,16 @@ def _closest_simplex(
 
 @_helper
 def _gjk(
-    a: NDArray[np.float64], b: NDArray[np.float64], work: NDArray[np.float64]
+    a: NDArray[np.float64],
+    b: NDArray[np.float64],
+    work: NDArray[np.float64],
+    tolerance: float = GJK_TOLERANCE,
+    cutoff: float = np.inf,
 ) -> tuple[float, float]:
-    """(lower, upper) bounds of sd(core A, core B), m; upper − lower ≤ GJK_TOLERANCE unless the
-    iteration cap or the numerics stopped it (lower stays a certified bound)."""
+    """(lower, upper) bounds of sd(core A, core B), m; upper − lower ≤ ``tolerance`` unless the
+    iteration cap or the numerics stopped it (lower stays a certified bound), or as soon as
+    lower > ``cutoff`` (a caller that looks for a minimum below it needs no more). ``work`` is
+    (WORK_ROWS, 3) working memory."""
     simplex = work[0:4]
     tmp = work[4:8]
     v = work[8]
@@ -500,7 +561,7 @@ def _gjk(
         w = sa - sb
         bound = (v[0] * w[0] + v[1] * w[1] + v[2] * w[2]) / vn
         lower = max(lower, bound)
-        if upper - lower <= GJK_TOLERANCE:
+        if upper - lower <= tolerance or lower > cutoff:
             break
         duplicate = False
         for k in range(count):
@@ -509,7 +570,7 @@ def _gjk(
         if duplicate:
             break
         simplex[count] = w
-        count = _closest_simplex(simplex, count + 1, v, tmp)
+        count = _closest_simplex(simplex, count + 1, v, tmp, work[13:16], work[16])
         if count == 0:
             overlap = True
             break
@@ -554,9 +615,15 @@ def _gjk(
 
 @_helper
 def _pair(
-    a: NDArray[np.float64], b: NDArray[np.float64], work: NDArray[np.float64]
+    a: NDArray[np.float64],
+    b: NDArray[np.float64],
+    work: NDArray[np.float64],
+    tolerance: float = GJK_TOLERANCE,
+    cutoff: float = np.inf,
 ) -> tuple[float, float]:
-    """(signed distance lower bound, gap to the upper bound) of two bodies, m."""
+    """(signed distance lower bound, gap to the upper bound) of two bodies, m; GJK's
+    ``tolerance`` and ``cutoff`` (on the cores' distance: stop once it cannot be below it) as
+    in :func:`_gjk`."""
     ka = int(a[_KIND])
     kb = int(b[_KIND])
     inflation = a[_INFLATION] + b[_INFLATION]
@@ -569,7 +636,15 @@ def _pair(
         return _point_solid(a, b) - inflation, 0.0
     if kb == POINT:
         return _point_solid(b, a) - inflation, 0.0
-    lower, upper = _gjk(a, b, work)
+    if ka == SEGMENT and kb == CYLINDER:
+        value = _segment_cylinder(a, b)
+        if value == value:
+            return value - inflation, 0.0
+    if kb == SEGMENT and ka == CYLINDER:
+        value = _segment_cylinder(b, a)
+        if value == value:
+            return value - inflation, 0.0
+    lower, upper = _gjk(a, b, work, tolerance, cutoff + inflation)
     # Both are lower bounds of sd; in contact the enclosing capsules' can be the better one
     # (and the scene's pair skipping relies on the value never being below it).
     value = max(lower - inflation, _capsule_bound(a, b))
@@ -583,7 +658,7 @@ def _pair_batch(
     distance: NDArray[np.float64],
     gap: NDArray[np.float64],
 ) -> None:
-    work = np.empty((13, 3))
+    work = np.empty((WORK_ROWS, 3))
     for k in range(first.shape[0]):
         distance[k], gap[k] = _pair(first[k], second[k], work)
 

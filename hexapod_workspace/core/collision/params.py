@@ -117,7 +117,7 @@ class Obstacle:
     record: NDArray[np.float64] = field(repr=False)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CollisionScene:
     """Everything the ``collision`` margin needs besides the manipulator.
 
@@ -129,7 +129,14 @@ class CollisionScene:
     tool : ToolBody or None
     obstacles : tuple of Obstacle
     tool_transform : ndarray, shape (4, 4)
-        Platform (mobile) frame <- tool frame; the identity unless the cell's tool frame is set.
+        Mobile frame <- tool frame; the identity unless the cell's tool frame is set.
+    platform_transform : ndarray, shape (4, 4)
+        Mobile frame <- platform frame P (where the platform cylinder is given); the identity
+        for a model in P, ``T_CP`` for a model that answers for tool-frame poses
+        (:meth:`in_tool_frame`).
+    parameters : dict
+        The ``collision.*`` parameters the scene was built from (dotted names), so that a model
+        gives them back (``Manipulator.to_parameters``).
     """
 
     clearance: float = 0.0
@@ -137,11 +144,56 @@ class CollisionScene:
     tool: ToolBody | None = None
     obstacles: tuple[Obstacle, ...] = ()
     tool_transform: NDArray[np.float64] = field(default_factory=lambda: np.eye(4), repr=False)
+    platform_transform: NDArray[np.float64] = field(default_factory=lambda: np.eye(4), repr=False)
+    parameters: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def empty(self) -> bool:
         """No pair to check apart from legs (no tool and no obstacle)."""
         return self.tool is None and not self.obstacles
+
+    @property
+    def pair_count(self) -> int:
+        """Number of pairs the scene checks (0: the ``collision`` constraint does not exist)."""
+        tool = 6 if self.tool is not None else 0
+        moving = 6 + (self.tool is not None) + (self.platform is not None)
+        return tool + moving * len(self.obstacles)
+
+    def in_tool_frame(self, tool_transform: NDArray[np.float64]) -> CollisionScene:
+        """The scene of a model whose mobile frame is the tool frame C.
+
+        Parameters
+        ----------
+        tool_transform : ndarray, shape (4, 4)
+            P <- C of the selected tool. The tool body follows that tool (it starts at C), the
+            platform stays where it is on P: its transform becomes ``T_CP = T_PC⁻¹``.
+        """
+        inverse = np.eye(4)
+        inverse[:3, :3] = tool_transform[:3, :3].T
+        inverse[:3, 3] = -tool_transform[:3, :3].T @ tool_transform[:3, 3]
+        from dataclasses import replace
+
+        return replace(
+            self, tool_transform=np.eye(4), platform_transform=inverse @ self.platform_transform
+        )
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, CollisionScene):
+            return NotImplemented
+        return (
+            self.clearance == other.clearance
+            and self.platform == other.platform
+            and self.tool == other.tool
+            and len(self.obstacles) == len(other.obstacles)
+            and all(
+                a.name == b.name and np.array_equal(a.record, b.record)
+                for a, b in zip(self.obstacles, other.obstacles, strict=True)
+            )
+            and np.array_equal(self.tool_transform, other.tool_transform)
+            and np.array_equal(self.platform_transform, other.platform_transform)
+        )
+
+    __hash__ = None  # type: ignore[assignment]
 
 
 def _describe(value: Any) -> str:
@@ -417,7 +469,9 @@ def collision_scene(
             msg = f"collision.obstacles.{name}: listed in collision.obstacles.names but not given"
             raise ConfigError(msg)
         obstacles.append(_obstacle(name, group, work))
-    scene = CollisionScene(clearance, platform, tool, tuple(obstacles), tool_frame)
+    scene = CollisionScene(
+        clearance, platform, tool, tuple(obstacles), tool_frame, parameters=dict(flat)
+    )
     if manipulator is not None:
         from .scene import scene_distances
 

@@ -64,6 +64,7 @@ from .distance import (
     CYLINDER,
     RECORD_SIZE,
     SEGMENT,
+    WORK_ROWS,
     _capsule_bound,
     _helper,
     _jit,
@@ -79,6 +80,7 @@ __all__ = [
     "RateBound",
     "SceneDistances",
     "pair_table",
+    "platform_record",
     "rate_bound",
     "scene_distances",
 ]
@@ -165,6 +167,37 @@ def _tool_ends(scene: CollisionScene) -> NDArray[np.float64]:
     return np.array([translation, translation + rotation @ np.array([0.0, 0.0, scene.tool.length])])
 
 
+def platform_record(scene: CollisionScene) -> NDArray[np.float64]:
+    """The platform cylinder as a record in the mobile frame (kind POINT with zero radius, never
+    read, when the scene has no platform body), shape (RECORD_SIZE,)."""
+    out = np.zeros(RECORD_SIZE)
+    if scene.platform is None:
+        return out
+    platform = scene.platform
+    rotation, translation = scene.platform_transform[:3, :3], scene.platform_transform[:3, 3]
+    out[0] = CYLINDER
+    out[_C : _C + 3] = translation + rotation @ np.array(
+        [0.0, 0.0, 0.5 * (platform.z_min + platform.z_max)]
+    )
+    out[_R : _R + 9] = rotation.ravel()
+    out[_P] = platform.radius
+    out[_P + 1] = 0.5 * (platform.z_max - platform.z_min)
+    return out
+
+
+def _cylinder_reach(record: NDArray[np.float64]) -> float:
+    """Largest distance of a cylinder core (record, mobile frame) from the mobile origin C:
+    attained on the rim of an end disc, sqrt((|e⊥| + r)² + (e·a)²) for end centre e."""
+    centre, axis = record[_C : _C + 3], record[_R : _R + 9].reshape(3, 3)[:, 2]
+    reach = 0.0
+    for sign in (-1.0, 1.0):
+        end = centre + sign * record[_P + 1] * axis
+        along = float(end @ axis)
+        across = float(np.linalg.norm(end - along * axis))
+        reach = max(reach, math.hypot(across + record[_P], along))
+    return reach
+
+
 def rate_bound(manipulator: Manipulator, scene: CollisionScene) -> RateBound:
     """The Lipschitz bound of the ``collision`` margin along a move (derivation: module doc).
 
@@ -177,7 +210,8 @@ def rate_bound(manipulator: Manipulator, scene: CollisionScene) -> RateBound:
     -------
     RateBound
         (1, ρ_c) with ρ_c in m/rad; along a search ray (ω ≤ 1 rad per unit s, fixed position)
-        the margin changes at most ρ_c per unit s.
+        the margin changes at most ρ_c per unit s. The platform's term is the largest distance
+        of its cylinder from C (exact, also when the model's mobile frame is the tool's).
     """
     legs = float(np.max(np.linalg.norm(manipulator.platform_joints, axis=1)))
     rotation = legs
@@ -185,9 +219,7 @@ def rate_bound(manipulator: Manipulator, scene: CollisionScene) -> RateBound:
         tool = float(np.max(np.linalg.norm(_tool_ends(scene), axis=1)))
         rotation = max(rotation, tool + legs)
     if scene.platform is not None:
-        platform = scene.platform
-        reach = max(abs(platform.z_min), abs(platform.z_max))
-        rotation = max(rotation, math.hypot(platform.radius, reach))
+        rotation = max(rotation, _cylinder_reach(platform_record(scene)))
     return RateBound(1.0, rotation)
 
 
@@ -248,7 +280,7 @@ def _scene_kernel(
     as over all pairs.
     """
     n_pairs = pairs.shape[0]
-    work = np.empty((13, 3))
+    work = np.empty((WORK_ROWS, 3))
     bound = np.empty(n_pairs)
     order = np.empty(n_pairs, dtype=np.int64)
     for pose in range(rotations.shape[0]):
@@ -359,14 +391,7 @@ def scene_distances(
         bodies[_FIRST_OBSTACLE + k] = obstacle.record
     tool_ends = _tool_ends(scene) if scene.tool is not None else np.zeros((0, 3))
     tool_radius = scene.tool.radius if scene.tool is not None else 0.0
-    platform_record = np.zeros(RECORD_SIZE)
-    if scene.platform is not None:
-        platform = scene.platform
-        platform_record[0] = CYLINDER
-        platform_record[_C + 2] = 0.5 * (platform.z_min + platform.z_max)
-        platform_record[_R : _R + 9] = np.eye(3).ravel()
-        platform_record[_P] = platform.radius
-        platform_record[_P + 1] = 0.5 * (platform.z_max - platform.z_min)
+    platform = platform_record(scene)
     distances = np.empty((count, pairs.shape[0]) if all_pairs else (0, 0))
     margin = np.empty(count)
     chosen = np.empty(count, dtype=np.int64)
@@ -379,7 +404,7 @@ def scene_distances(
             0.5 * manipulator.leg_diameter,
             tool_ends,
             tool_radius,
-            platform_record,
+            platform,
             bodies,
             pairs,
             all_pairs,
