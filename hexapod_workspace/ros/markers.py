@@ -55,11 +55,11 @@ CONE_AZIMUTHS = 72
 def node_scene(state: Any) -> CollisionScene | None:
     """The collision scene of the node's configured state, or None.
 
-    The one place the markers learn the scene: the ``collision_scene`` attribute of the node's
-    :class:`~hexapod_workspace.ros.parameters.State` once the node reads ``collision.*``; None
-    while it does not (the machine is then drawn without obstacles).
+    The one place the markers learn the scene: the model's own scene
+    (:attr:`~hexapod_workspace.core.manipulator.Manipulator.collision`, read from
+    ``collision.*``); None without one (the machine is then drawn without obstacles).
     """
-    scene = getattr(state, "collision_scene", None)
+    scene = getattr(getattr(state, "manipulator", None), "collision", None)
     return scene if isinstance(scene, CollisionScene) else None
 
 

@@ -147,21 +147,16 @@ def test_markers_are_recorded_and_read_by_every_reader(client, workspace_node, r
 
 
 def test_obstacles_appear_once_the_state_carries_a_collision_scene(ros_context, ros_client):
-    """The seam for the node's collision.* model (ros.markers.node_scene reads the state's
-    ``collision_scene``): a node in this process whose state carries a scene draws its
-    obstacles and colours the pair in violation."""
+    """The markers draw the model's collision scene (ros.markers.node_scene reads
+    ``state.manipulator.collision``): a node in this process whose model carries a scene draws
+    its obstacles and colours the pair in violation."""
     import dataclasses
 
     from rclpy.parameter import Parameter
 
-    from hexapod_workspace.core.collision import CollisionScene, collision_scene
+    from hexapod_workspace.core.collision import collision_scene
     from hexapod_workspace.ros.markers import attach
     from hexapod_workspace.ros.node import WorkspaceNode
-    from hexapod_workspace.ros.parameters import State
-
-    @dataclasses.dataclass(frozen=True)
-    class StateWithScene(State):
-        collision_scene: CollisionScene | None = None
 
     node = WorkspaceNode(
         context=ros_context,
@@ -183,10 +178,8 @@ def test_obstacles_appear_once_the_state_carries_a_collision_scene(ros_context, 
                 "collision.obstacles.clamp.radius": 0.05,
             }
         )
-        fields = {
-            field.name: getattr(node.state, field.name) for field in dataclasses.fields(State)
-        }
-        node.state = StateWithScene(**fields, collision_scene=scene)
+        model = dataclasses.replace(node.state.manipulator, collision=scene)
+        node.state = dataclasses.replace(node.state, manipulator=model)
 
         def drawn() -> bool:
             return bool(received) and "obstacles" in by_namespace(received[-1])
