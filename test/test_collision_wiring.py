@@ -45,12 +45,16 @@ def with_scene(plain: Manipulator, collision: dict) -> Manipulator:
 
 
 def test_no_scene_no_constraint(plain: Manipulator) -> None:
-    """Without a scene the row exists in the arrays, +inf, and is not applicable."""
+    """Without a scene the row is not applicable: check leaves it out, no pair is named, and
+    the kernels' row is +inf (never limiting)."""
     assert COLLISION not in applicable(plain)
     result = constraints.check(plain, [[0.1, 0.2, 0.3]], HOME)
-    assert np.isposinf(result.margins["collision"][0])
+    assert "collision" not in result.margins
+    assert "collision" not in result.limiting_legs
     assert result.collision_pairs == ()
-    assert result.limiting_legs["collision"][0] == 0
+    assert result.collision_pair == [""]
+    found = constraints.pose_margins(plain, tt_to_matrix([[0.1, 0.2, 0.3]]), np.array([HOME]))
+    assert np.isposinf(found.margins[COLLISION][0])
 
 
 def test_kernels_agree_with_scene_kernel_and_coal(plain: Manipulator) -> None:
@@ -233,9 +237,9 @@ def test_cli_check_json_names_the_pair() -> None:
 
 def test_collision_row_rate_depends_on_the_model(plain: Manipulator, cell: Manipulator) -> None:
     row = CONSTRAINTS[COLLISION]
-    assert row.coefficients(plain) == (1.0, 0.0, 0.0)
-    speed, turn, spin = row.coefficients(cell)
-    assert (speed, turn) == (1.0, 0.0)
+    assert row.coefficients(plain) == (1.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    speed, turn, spin, actuate, crank, ends = row.coefficients(cell)
+    assert (speed, turn, actuate, crank, ends) == (1.0, 0.0, 0.0, 0.0, 0.0)  # fixed base joints
     # ρ_c = tool reach + max |b_i| for the spindle (0.6 m) on the example's joints (0.3 m).
     assert spin == pytest.approx(0.6 + float(np.max(np.linalg.norm(cell.platform_joints, axis=1))))
 
@@ -257,3 +261,17 @@ def test_home_collision_refused_in_one_line(plain: Manipulator) -> None:
                 }
             },
         )
+
+
+def test_collision_row_adds_the_moving_base_joints_speed() -> None:
+    """6-PUS with a spindle: the leg bodies' base ends slide, so the row adds ends·E (E the leg
+    end rate of the constraint table) to the fixed-base bound."""
+    from hexapod_workspace.core.params import load_params_file
+
+    parameters = load_params_file(EXAMPLE.parent / "example_pus.yaml")
+    spindle = {"collision.tool.radius": 0.02, "collision.tool.length": 0.05}
+    pus = Manipulator.from_mapping({**parameters, **spindle}, warn=False)
+    assert COLLISION in applicable(pus)
+    speed, turn, spin, actuate, crank, ends = CONSTRAINTS[COLLISION].coefficients(pus)
+    assert (speed, turn, actuate, crank, ends) == (1.0, 0.0, 0.0, 0.0, 1.0)
+    assert spin > 0.0

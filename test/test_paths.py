@@ -175,8 +175,8 @@ def test_angular_rate_and_lipschitz_bounds_hold(example, rng, interpolation):
     model = Manipulator.from_mapping(
         {**example.to_parameters(), "limits.singularity_min": 0.01}, warn=False
     )
-    margins = pose_margins(model, rotations.reshape(-1, 3, 3), positions).margins
-    margins = margins[[INDEX[name] for name in UPS_ROWS]]  # the rows of a 6-UPS model
+    every_row = pose_margins(model, rotations.reshape(-1, 3, 3), positions).margins
+    margins = every_row[[INDEX[name] for name in UPS_ROWS]]  # the rows of a 6-UPS model
     margins = margins.reshape(margins.shape[0], count, steps)
     lengths = inverse_kinematics(model, rotations.reshape(-1, 3, 3), positions).lengths
     floor = lengths.reshape(count, steps, 6).min(axis=(1, 2))
@@ -193,7 +193,7 @@ def test_angular_rate_and_lipschitz_bounds_hold(example, rng, interpolation):
     )
     # The example declares no collision scene: that row is +inf (its rate bound is tested with
     # a scene in test_collision.py); the five rows above are compared.
-    assert np.all(np.isposinf(margins[COLLISION]))
+    assert np.all(np.isposinf(every_row[COLLISION]))
     rates = np.abs(np.diff(margins[: len(lipschitz)], axis=2)).max(axis=2) * (steps - 1)
     assert np.all(rates <= lipschitz * (1 + 1e-3) + 1e-9)
 
