@@ -261,8 +261,8 @@ def add_legend(figure: Any, view: SceneView) -> None:
     figure.legend(  # below the axes, so it hides no leg label
         handles,
         [label for _, label in entries],
-        loc="outside lower center",
-        ncols=min(len(entries), 3),
+        loc="outside right upper",
+        ncols=1,
         fontsize=8,
     )
 
