@@ -115,6 +115,15 @@ class WorkspaceServer:
         if inactive is not None:  # not active (lifecycle): refused, never silence
             return _Failed(inactive)
         settings = self._node.state.settings
+        base = self._node.state.manipulator.frame_id
+        if request.header.frame_id not in ("", base):
+            # Boundaries are T&T angles about the base frame's axes at a base-frame position:
+            # a request in another frame (the work frame included) would be answered for
+            # another point and other axes than the ones meant.
+            return _Failed(
+                f"header.frame_id: workspaces are computed in the base frame {base!r} (or ''), "
+                f"got {request.header.frame_id!r}"
+            )
         kind, position = int(request.kind), position_from_point(request.position)
         if WorkspaceKind.of(kind) is None:
             return _Failed(

@@ -180,6 +180,20 @@ def test_compute_workspace_refuses_bad_requests(client, request_fields, reason):
     assert response.boundary.width == 0
 
 
+@pytest.mark.parametrize("frame_id", ["work", "world"])
+def test_compute_workspace_refuses_a_position_in_another_frame(client, frame_id):
+    """A workspace is computed about the base frame's axes at a base-frame position: a request
+    in another frame is refused with the reason, not answered for another point."""
+    request = workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO)
+    request.header.frame_id = frame_id
+    response = compute(client, request)
+    assert not response.success
+    assert "header.frame_id" in response.message and repr(frame_id) in response.message
+    assert response.boundary.width == 0
+    request.header.frame_id = ""  # the base frame, by default: served
+    assert compute(client, request).success
+
+
 def test_unreachable_reference_is_an_empty_workspace_not_a_crash(client):
     # platform in the base plane: every leg far below its minimum length
     response = compute(client, workspace_request(WorkspaceKind.PROJECTED_TORSION_ZERO, (0, 0, 0)))
