@@ -204,6 +204,9 @@ class RosClient:
         self.context = context
         self.node = rclpy.create_node(name, context=context)
         self.executor = SingleThreadedExecutor(context=context)
+        #: Requests sent per service name by :meth:`call` (resends included: a node that answers
+        #: a resent request has handled, and recorded, it twice).
+        self.sent: dict[str, int] = {}
         self.executor.add_node(self.node)
         self._clients: dict[str, Any] = {}
 
@@ -241,6 +244,7 @@ class RosClient:
         deadline = time.monotonic() + timeout
         while True:
             future = client.call_async(request)
+            self.sent[name] = self.sent.get(name, 0) + 1
             wait = max(0.0, min(resend_after, deadline - time.monotonic()))
             self.executor.spin_until_future_complete(future, timeout_sec=wait)
             if future.done():
