@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 import yaml
 from cli_support import run_main
-from recording_support import read_with_rosbags
+from recording_support import read_with_foxglove, read_with_mcap_ros2, read_with_rosbags
 from ros_support import REPO, require_ros, running_node
 
 require_ros()
@@ -290,7 +290,7 @@ def test_the_markers_show_the_obstacles(client):
     np.testing.assert_allclose(ball.scale.x, 0.2, atol=1e-12)  # diameter
 
 
-def test_the_log_records_the_obstacle_changes(client, workspace_node):
+def test_the_log_records_the_obstacle_changes(client, workspace_node, tmp_path):
     time.sleep(1.0)  # the recorder thread writes within its flush interval
     assert workspace_node.stop() == 0
     (log,) = sorted(Path(workspace_node.record_dir).glob("*.mcap"))
@@ -302,6 +302,20 @@ def test_the_log_records_the_obstacle_changes(client, workspace_node):
     assert any(not m.accepted and "'cone'" in m.reason for m in changes)
     responses = [m for topic, _, m in messages if topic == f"{NODE}/check_poses/response"]
     assert any(r.results and r.results[0].collision_pair == "tool vs leg 3" for r in responses)
+    # the new string fields keep every reader in step (CDR alignment): mcap_ros2 and Foxglove's
+    # libraries decode the same pairs as rosbags
+    topic = f"{NODE}/check_path/response"
+    expected = [[s.collision_pair for s in m.segments] for name, _, m in messages if name == topic]
+    assert expected and expected[0][0] != ""
+    decoded = [m for name, _, m in read_with_mcap_ros2(log) if name == topic]
+    assert [[s.collision_pair for s in m.segments] for m in decoded] == expected
+    foxglove = read_with_foxglove(log, tmp_path)[topic]["messages"]
+    assert [[s["collision_pair"] for s in m["segments"]] for m in foxglove] == expected
+    flat = f"{NODE}/check_poses_flat/response"
+    pairs = [list(m.collision_pair) for name, _, m in messages if name == flat]
+    assert pairs and pairs[0][0] == "tool vs leg 3"
+    fox_flat = read_with_foxglove(log, tmp_path)[flat]["messages"]
+    assert [list(m["collision_pair"]) for m in fox_flat] == pairs
 
 
 def test_a_bad_scene_in_the_file_stops_the_start_with_the_reason(ros_domain, tmp_path):
