@@ -145,6 +145,11 @@ def test_the_node_answers_what_the_cli_says_with_the_pair(client):
     core = check(model_with(), np.radians([COLLIDING_DEG, (0, 0, 0)]), POSITION)
     assert list(flat.collision_pair) == core.collision_pair
     assert flat.margins[width + column] == pytest.approx(core.margins["collision"][1], abs=1e-12)
+    # a refused flat call (every array empty) is recorded too: the log test decodes it
+    refused = client.call(
+        CheckPosesFlat, f"{NODE}/check_poses_flat", CheckPosesFlat.Request(angles=[0.1, 0.2])
+    )
+    assert not refused.success and not refused.collision_pair
 
 
 def test_check_path_names_the_pair_at_the_first_violation(client):
@@ -313,7 +318,7 @@ def test_the_log_records_the_obstacle_changes(client, workspace_node, tmp_path):
     assert [[s["collision_pair"] for s in m["segments"]] for m in foxglove] == expected
     flat = f"{NODE}/check_poses_flat/response"
     pairs = [list(m.collision_pair) for name, _, m in messages if name == flat]
-    assert pairs and pairs[0][0] == "tool vs leg 3"
+    assert pairs and pairs[0][0] == "tool vs leg 3" and [] in pairs  # and the refusal
     fox_flat = read_with_foxglove(log, tmp_path)[flat]["messages"]
     assert [list(m["collision_pair"]) for m in fox_flat] == pairs
 
