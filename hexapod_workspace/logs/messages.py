@@ -12,7 +12,7 @@ Units are SI (m, rad) as everywhere in the package. Stamps are ns since the epoc
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
@@ -115,6 +115,7 @@ def unchecked_motion_fields() -> dict[str, Any]:
         "min_relative_margin": nan,
         "min_at_s": nan,
         "min_relative_margin_bound": nan,
+        "collision_pair": "",
     }
 
 
@@ -130,6 +131,7 @@ def pose_check_fields(result: CheckResult, index: int) -> dict[str, Any]:
         "constraint_names": list(margins),
         "margins": [float(values[index]) for values in margins.values()],
         "limiting_leg": int(result.limiting_leg[index]),
+        "collision_pair": result.collision_pair[index],
     }
 
 
@@ -149,6 +151,9 @@ class PoseChecks(Protocol):
     @property
     def violated(self) -> list[list[str]]: ...
 
+    @property
+    def collision_pair(self) -> Sequence[str]: ...
+
     def __len__(self) -> int: ...
 
 
@@ -159,6 +164,7 @@ def pose_checks_fields(result: PoseChecks) -> list[dict[str, Any]]:
     margins = np.stack([result.margins[name] for name in names], axis=1).tolist()
     reachable = result.reachable.tolist()
     limiting = np.asarray(result.limiting_leg).tolist()
+    pairs = list(result.collision_pair) or [""] * len(reachable)  # empty: no scene
     return [
         {
             "reachable": bool(reachable[i]),
@@ -166,6 +172,7 @@ def pose_checks_fields(result: PoseChecks) -> list[dict[str, Any]]:
             "constraint_names": names,
             "margins": margins[i],
             "limiting_leg": int(limiting[i]),
+            "collision_pair": pairs[i],
         }
         for i in range(len(reachable))
     ]
@@ -179,6 +186,7 @@ def _failed_pose_check() -> dict[str, Any]:
         "constraint_names": list(CONSTRAINT_NAMES),
         "margins": [nan] * len(CONSTRAINT_NAMES),
         "limiting_leg": 0,
+        "collision_pair": "",
     }
 
 

@@ -119,6 +119,8 @@ def segment_checks_fields(segments: SegmentChecks, *, pairs: bool = True) -> lis
         "min_relative_margin": segments.min_relative_margin.tolist(),
         "min_at_s": segments.min_at_s.tolist(),
         "min_relative_margin_bound": segments.min_relative_margin_bound.tolist(),
+        # the pair at the first violation (a move that is ok: ""; no scene: no names)
+        "collision_pair": list(segments.collision_pair) or [""] * len(segments),
     }
     fields = []
     for k in range(len(segments)):
@@ -136,6 +138,7 @@ def segment_checks_fields(segments: SegmentChecks, *, pairs: bool = True) -> lis
                 "min_relative_margin": float(columns["min_relative_margin"][k]),
                 "min_at_s": float(columns["min_at_s"][k]),
                 "min_relative_margin_bound": float(columns["min_relative_margin_bound"][k]),
+                "collision_pair": "" if columns["ok"][k] else columns["collision_pair"][k],
             }
         )
     return fields

@@ -19,7 +19,14 @@ Run-time changes
     requests, and every change, accepted or refused, is recorded in the log
     (``/hexapod_workspace/parameter_changes``, ``ParameterChange``) and shown on
     ``/diagnostics`` (:class:`CellStatus`). A tool-table entry not given at start is declared
-    when a client first sets it (:func:`new_tool_table_parameters`).
+    when a client first sets it (:func:`new_dynamic_parameters`).
+    The collision scene (``collision.*``: clearance, platform and tool bodies, the obstacles as
+    ``collision.obstacles.names`` plus one group ``collision.obstacles.<name>.*`` per name) is
+    declared the same way: the names the parameters file gives, and any a client sets (an
+    obstacle added: its name in the list and its group in one atomic call). The whole scene
+    is checked by :func:`~hexapod_workspace.core.collision.params.collision_scene` as part of
+    the model (the CLI's one validation); an obstacle is removed by taking its name off the
+    list and unsetting its group in one call.
 Feeds
     :func:`path_speeds`: the per-move ``SegmentSpeed`` of a ``~/check_path`` request that gives
     feeds or durations.
@@ -69,7 +76,7 @@ from hexapod_workspace.logs.cell import (
 )
 
 from .conversions import to_message, type_name
-from .parameters import State, tool_table_specs
+from .parameters import State, dynamic_specs
 
 __all__ = [
     "PARAMETER_CHANGES_TOPIC",
@@ -78,7 +85,7 @@ __all__ = [
     "angles_to_base",
     "frames_message",
     "in_work_frame",
-    "new_tool_table_parameters",
+    "new_dynamic_parameters",
     "path_speeds",
     "poses_to_base",
 ]
@@ -270,13 +277,13 @@ def path_speeds(state: State, request: Any, result: PathCheck | TorsionPlan) -> 
 
 
 # --------------------------------------------------------------------------- parameter changes
-def new_tool_table_parameters(node: Any, parameters: list[Any]) -> dict[str, Any]:
-    """Specs of the tool-table parameters in ``parameters`` that ``node`` has not declared yet
-    (a client adding a tool at run time); empty when there are none."""
+def new_dynamic_parameters(node: Any, parameters: list[Any]) -> dict[str, Any]:
+    """Specs of the tool-table and collision parameters in ``parameters`` that ``node`` has not
+    declared yet (a client adding a tool or an obstacle at run time); empty when there are
+    none."""
+    names = [p.name for p in parameters]
     return {
-        name: spec
-        for name, spec in tool_table_specs(p.name for p in parameters).items()
-        if not node.has_parameter(name)
+        name: spec for name, spec in dynamic_specs(names).items() if not node.has_parameter(name)
     }
 
 

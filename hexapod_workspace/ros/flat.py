@@ -106,6 +106,8 @@ def flat_response(
     response.margins = _doubles(flat_margins(result).reshape(-1))
     response.reachable = reachable.tolist()
     response.limiting_leg = _int32s(np.asarray(result.limiting_leg))
+    if "collision" in result.margins:  # a scene: one pair per pose (none: empty, no cost)
+        response.collision_pair = result.collision_pair
     return response
 
 

@@ -23,8 +23,9 @@ The cone
     between them is drawn straight). No cone when the reference orientation is unreachable at
     the position.
 The collision scene
-    :func:`node_scene` (the node's ``collision.*`` model once the node reads it; until then
-    the machine is drawn alone, with the closest leg pair when ``limits.leg_diameter`` > 0).
+    :func:`node_scene`: the scene of the node's model (``collision.*``, read from the
+    parameters file and changed at run time like every model parameter); without one the
+    machine is drawn alone, with the closest leg pair when ``limits.leg_diameter`` > 0.
 """
 
 from __future__ import annotations

@@ -103,13 +103,13 @@ from .parameters import (
     MODEL_GROUPS,
     State,
     command_line_override_names,
+    dynamic_specs,
     missing_model_parameters,
     model_default,
     model_given,
     parameter_specs,
     refusal,
     state_from,
-    tool_table_specs,
 )
 from .paths import attach as attach_paths
 from .paths import check_poses_from_poses
@@ -375,7 +375,7 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         of the node declares (misspelt key or section), a model given in part, a wrong type.
         With no model parameter given the packaged example is the model, and the log says so."""
         names = set(self._override_names) | set(getattr(self, "_parameter_overrides", {}))
-        self._specs.update(tool_table_specs(names))  # the tool table given (tools.T<n>.*)
+        self._specs.update(dynamic_specs(names))  # the tool table and collision.* given
         unknown = unknown_parameter(names, (*self._specs, *NODE_PARAMETERS, *ROS_PARAMETERS))
         if unknown is not None:
             raise ConfigError(f"unknown parameter given to the node: {unknown}")
@@ -424,8 +424,8 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         return result
 
     def _set_parameters_checked(self, parameter_list: list[Parameter]) -> SetParametersResult:
-        new_tools = cell.new_tool_table_parameters(self, parameter_list)
-        if new_tools:  # a tool added at run time: checked as a whole set, then declared
+        new_tools = cell.new_dynamic_parameters(self, parameter_list)
+        if new_tools:  # a tool or obstacle added: checked as a whole set, then declared
             self._specs.update(new_tools)
             reason = next((r for p in parameter_list if (r := refusal(self._specs, p))), None)
             checked = (
@@ -437,12 +437,20 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
                 for name in new_tools:
                     del self._specs[name]
                 return checked
-            for name, spec in new_tools.items():
-                given = next((p for p in parameter_list if p.name == name), None)
-                value = given.value if given is not None else spec.default
-                self.declare_parameter(name, value, spec.descriptor())
+            # declared one by one: rclpy's callbacks see each alone, so they stand aside (the
+            # set was checked whole above) and the state is swapped once, with the rest
+            self._declaring = True
+            try:
+                for name, spec in new_tools.items():
+                    given = next((p for p in parameter_list if p.name == name), None)
+                    value = given.value if given is not None else spec.default
+                    self.declare_parameter(name, value, spec.descriptor())
+            finally:
+                self._declaring = False
+            declared = [p for p in parameter_list if p.name in new_tools]
             parameter_list = [p for p in parameter_list if p.name not in new_tools]
             if not parameter_list:
+                self._apply_parameters(declared)
                 return SetParametersResult(successful=True)
         for parameter in parameter_list:
             if parameter.name not in self._specs and self.has_parameter(parameter.name):
@@ -460,7 +468,7 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
     def _validate_parameters(self, parameters: list[Parameter]) -> SetParametersResult:
         """Accept an update only when the would-be full parameter set is valid (while
         unconfigured, configure validates the whole set)."""
-        if not self.configured:
+        if not self.configured or getattr(self, "_declaring", False):
             return SetParametersResult(successful=True)
         values = self._parameter_values()
         values.update({p.name: p.value for p in parameters if p.name in self._specs})
@@ -475,7 +483,7 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
     def _apply_parameters(self, parameters: list[Parameter]) -> None:
         """Swap in the new model and settings after an accepted update (configured only)."""
         names = [p.name for p in parameters if p.name in self._specs]
-        if not names:  # an extension declaring its own parameter (motion.current_pose_topic)
+        if not names or getattr(self, "_declaring", False):  # an extension's own; a new group
             return
         if self.state is None or not self.configured:
             self.get_logger().info(f"parameters set: {', '.join(names)}")

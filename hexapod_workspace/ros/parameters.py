@@ -53,6 +53,7 @@ __all__ = [
     "Spec",
     "State",
     "command_line_override_names",
+    "dynamic_specs",
     "missing_model_parameters",
     "model_default",
     "model_given",
@@ -343,6 +344,8 @@ CELL_DESCRIPTIONS = {
 #: The tool table's parameter names (declared from the parameters given at start, or when a
 #: client sets a new one).
 TOOL_TABLE_NAME = re.compile(r"^tools\.T([1-9][0-9]*)\.(offset|orientation)$")
+#: The cell parameters the collision scene is placed with (as the CLI reads them).
+_SCENE_FRAMES = ("tool.offset", "tool.orientation", "work.origin", "work.orientation")
 #: ~/axis_limits settings.
 AXIS_LIMITS_FRAMES = ("base", "work", "tool")
 
@@ -392,6 +395,41 @@ def tool_table_specs(names: Iterable[str]) -> dict[str, Spec]:
                 continue
             full = f"tools.T{number}.{key}"
             specs[full] = Spec(full, [0.0, 0.0, 0.0], f"Tool table, tool {number}: {text}.")
+    return specs
+
+
+#: The collision scene's parameter names (``collision.*``): declared like the tool table, from
+#: the parameters given at start or when a client first sets one (an obstacle added at run
+#: time); their names and values are checked as a whole by
+#: :func:`~hexapod_workspace.core.collision.params.collision_scene`.
+COLLISION_NAME = re.compile(r"^collision\.[A-Za-z0-9_.]+$")
+#: Descriptions of the collision parameters by their last name part.
+COLLISION_DESCRIPTIONS = {
+    "clearance": "m, kept between every checked pair (subtracted from each distance)",
+    "radius": "m (platform cylinder, tool capsule, obstacle cylinder, capsule or sphere)",
+    "z_min": "m, platform cylinder's lower end along z of the platform frame",
+    "z_max": "m, platform cylinder's upper end along z of the platform frame",
+    "length": "m (tool capsule from C along +z of the tool frame; obstacle along its local z)",
+    "names": "the obstacles, one group collision.obstacles.<name>.* per name",
+    "shape": "box, cylinder, sphere or capsule",
+    "frame": "base or work: the frame of position and orientation (default base)",
+    "position": "m, the obstacle's centre in its frame (3 floats)",
+    "orientation": "roll, pitch, yaw (rad) or a quaternion x, y, z, w (default identity)",
+    "size": "m, box: full edge lengths along its local x, y, z (3 floats)",
+}
+
+
+def dynamic_specs(names: Iterable[str]) -> dict[str, Spec]:
+    """Specs of the parameters declared by name among ``names``: the tool table
+    (:func:`tool_table_specs`) and the collision scene (``collision.*``, dynamically typed:
+    the scene's own validation names a wrong type with the parameter and the value; unset =
+    removed, so that an obstacle can be taken out at run time)."""
+    names = list(names)
+    specs = tool_table_specs(names)
+    for name in sorted(names):
+        if COLLISION_NAME.match(name):
+            text = COLLISION_DESCRIPTIONS.get(name.rsplit(".", 1)[1], "see docs/collision.md")
+            specs[name] = Spec(name, None, f"Collision scene: {text}.", dynamic_typing=True)
     return specs
 
 
@@ -501,11 +539,18 @@ def state_from(values: dict[str, Any]) -> State:
     ConfigError
         Invalid model or settings; the message names the parameter and the value.
     """
-    platform = require_usable(
-        Manipulator.from_mapping(
-            {name: _plain(values[name]) for name in MODEL_DESCRIPTIONS}, warn=False
+    model = {name: _plain(values[name]) for name in MODEL_DESCRIPTIONS}
+    scene = {
+        name: _plain(value)
+        for name, value in values.items()
+        if COLLISION_NAME.match(name) and value is not None  # None: unset (removed)
+    }
+    if scene:  # with the cell frames it is placed with (work-frame obstacles, the tool body)
+        model.update(scene)
+        model.update(
+            {name: _plain(values[name]) for name in _SCENE_FRAMES if values.get(name) is not None}
         )
-    )
+    platform = require_usable(Manipulator.from_mapping(model, warn=False))
     cell = cell_from_mapping(
         {
             name: _plain(value)
