@@ -46,7 +46,7 @@ or ``r_i·t_i`` (rus, ``t_i = w_i × (C_i − A0_i)/r_i`` the crank end's unit v
 and ``dD/ds = v − A'·g`` is ⟂ n, whence ``dn/ds = (v − A'g)/L`` and
 ``|dn/ds| ≤ (V + ρ|g|)/L ≤ V(1 + 1/τ_f)/L =: N`` where ``|τ| ≥ τ_f``. Differentiating
 ``ρτg = n·v``, with ``d(ρτ)/ds = dn/ds·A' + g·n·A''`` (A'' = 0 for pus, ``−(C − A0)`` of
-norm r for rus):
+norm r for rus)::
 
     ρτ·dg/ds = dn/ds·(v − A'g) + n·dv/ds − g²·n·A''
              = L|dn/ds|² + n·dv/ds − g²·n·A'',
