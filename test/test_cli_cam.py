@@ -294,3 +294,32 @@ def test_record_of_a_cl_file_holds_one_check_path_call_per_tool(tmp_path):
             assert [w.reachable for w in response.waypoints] == [
                 w["reachable"] for w in part["waypoints"]
             ]
+
+
+@pytest.mark.parametrize(("architecture", "z", "unit"), [("pus", -0.80, "m"), ("rus", 0.52, "rad")])
+def test_feed_check_for_slides_and_cranks(tmp_path, architecture, z, unit):
+    config_dir = Path(__file__).resolve().parents[1] / "config"
+    text = (config_dir / f"example_{architecture}.yaml").read_text(encoding="utf-8")
+    limit = 0.02 if architecture == "pus" else 0.2  # m/s or rad/s
+    text = text.replace("    limits:\n", f"    limits:\n      actuator_speed_max: [{limit}]\n", 1)
+    config = tmp_path / "cell.yaml"
+    config.write_text(text, encoding="utf-8")
+    csv = tmp_path / "line.csv"
+    csv.write_text(
+        "x,y,z,phi_deg,theta_deg,psi_deg\n"
+        f"0,0,{z},0,0,0\n0.03,0,{z},0,0,0\n0.03,0.02,{z + 0.01},30,4,2\n",
+        encoding="utf-8",
+    )
+    code, out, _ = run_main(
+        "--config", str(config), "check-path", str(csv), "--feed-mm-min", "1200", "--json"
+    )  # fmt: skip
+    document = json.loads(out)
+    assert document["ok"] is (code == 0)
+    assert document["speed"]["actuator_unit"] == unit
+    for segment in document["segments"]:
+        travel = segment["duration_s"] * 0.02  # 1200 mm/min = 0.02 m/s
+        assert travel > 0.0 and segment["actuator_speed_peak"] > 0.0
+        # one limit for every actuator: feed_max is the feed that brings the bound to the limit
+        feed_max = 1200.0 * limit / segment["actuator_speed_peak"]
+        assert segment["feed_max_mm_min"] == pytest.approx(feed_max, rel=1e-9)
+        assert segment["speed_ok"] is (segment["actuator_speed_peak"] <= limit)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -77,6 +78,26 @@ def test_check_table_says_its_columns_are_margins():
     assert " yes " in lines[4] and " NO " in lines[5]
     assert lines[5].endswith("leg_length,platform_joint")
     assert lines[-1] == "1/2 poses reachable"
+
+
+@pytest.mark.parametrize(
+    ("architecture", "z", "unit", "factor"),
+    [("pus", -0.80, "[mm]", 1e3), ("rus", 0.52, "[deg]", math.degrees(1.0))],
+)
+def test_check_table_gives_the_actuator_margin_in_the_architecture_unit(
+    architecture, z, unit, factor
+):
+    """A slide's stroke left in mm, a crank's range left in deg; JSON stays SI."""
+    config = str(Path(__file__).resolve().parents[1] / "config" / f"example_{architecture}.yaml")
+    pose = ("--config", config, "check", "--position", "0", "0", str(z), "--pose", "0", "5", "10")
+    code, out, _ = run_main(*pose)
+    lines = out.splitlines()
+    column = lines[2].split().index("actuator") - 1  # the unit row has no "reachable" heading
+    assert code == 0 and lines[3].split()[column] == unit
+    _, text, _ = run_main("--json", *pose)
+    si = json.loads(text)["poses"][0]["margins"]["actuator"]
+    value = float(lines[4].split()[column + 1])  # "yes" under "reachable"
+    assert value == pytest.approx(si * factor, abs=1e-3)
 
 
 def test_huge_angles_get_the_verdict_of_the_orientation_they_denote(example):

@@ -410,3 +410,30 @@ def test_singular_ends_take_the_other_azimuth_and_keep_their_rotation():
     np.testing.assert_allclose(tt_to_matrix(aligned), tt_to_matrix(angles), atol=1e-14)
     np.testing.assert_array_equal(aligned[:2, 0], other[:2, 0])
     np.testing.assert_array_equal(aligned[2], angles[2])  # regular: unchanged
+
+
+def test_report_singularity_fills_the_waypoints_as_check_does(example):
+    """At limits.singularity_min 0 the path leaves the singularity margin +inf; the report
+    evaluates it at every waypoint (as check(..., singularity=True)) and changes nothing else."""
+    from hexapod_workspace.core.paths import report_singularity
+
+    rng = np.random.default_rng(5)
+    positions = np.array([0.0, 0.0, -1.15]) + rng.uniform(-0.1, 0.1, (6, 3))
+    angles = np.column_stack(
+        [rng.uniform(-np.pi, np.pi, 6), rng.uniform(0, 0.4, 6), rng.uniform(-0.5, 0.5, 6)]
+    )
+    result = check_path(example, positions, angles=angles)
+    assert np.all(np.isposinf(result.waypoints.margins["singularity"]))
+    reported = report_singularity(example, result)
+    expected = [
+        check(example, angles[k : k + 1], positions[k], singularity=True).margins["singularity"][0]
+        for k in range(len(positions))
+    ]
+    np.testing.assert_allclose(reported.waypoints.margins["singularity"], expected, rtol=1e-12)
+    assert reported.ok == result.ok and reported.segments is result.segments
+    for name, values in result.waypoints.margins.items():
+        if name != "singularity":
+            np.testing.assert_array_equal(reported.waypoints.margins[name], values)
+    plan = plan_torsion(example, positions[:3], np.tile([0.0, 0.0, 1.0], (3, 1)))
+    planned = report_singularity(example, plan)
+    assert np.all(np.isfinite(planned.baseline.waypoints.margins["singularity"]))

@@ -62,7 +62,7 @@ from ..core.paths import (
     reported_parts,
 )
 from ..core.rotations import degrees_to_radians, matrix_to_quaternion, matrix_to_tt, tt_to_matrix
-from ..core.speeds import UPS, FeedLimits, actuator_rates, feed_limits
+from ..core.speeds import ACTUATOR_MODELS, FeedLimits, actuator_rates, feed_limits
 from .check_path import (
     _degrees_flag,
     _text,
@@ -362,7 +362,7 @@ def _check_part(
         segment.update(
             rapid=bool(part.rapid[k + 1]),
             duration_s=float(speeds.duration[k]) if known else None,
-            actuator_speed_peak=float(speeds.speed_peak[k]) if known else None,
+            actuator_speed_peak=_finite(float(speeds.speed_peak[k])) if known else None,
             speed_ok=speeds.speed_ok[k],
             feed_max_mm_min=None if rotary or math.isnan(feed_max) else _finite(per_minute),
         )
@@ -373,6 +373,11 @@ def _check_part(
             segment["feed_mm_min"] = float(feed[k]) / _MM_MIN if known else None
         if not known:
             segment["speed_note"] = "no feed for this move: no duration, no speed verdict"
+        elif not math.isfinite(float(speeds.speed_peak[k])):
+            segment["speed_note"] = (
+                "actuator speed unbounded: a leg has no inverse-kinematics solution or a "
+                "transmission |τ| of 0 on this move (see the ik and transmission constraints)"
+            )
     if part.lines is not None:
         for k, waypoint in enumerate(document["waypoints"]):
             waypoint["line"] = int(part.lines[k])
@@ -451,7 +456,9 @@ def _finite(value: float) -> float | None:
     return value if math.isfinite(value) else None
 
 
-def _speed_summary(documents: list[dict[str, Any]], limits: NDArray[np.float64]) -> dict[str, Any]:
+def _speed_summary(
+    documents: list[dict[str, Any]], limits: NDArray[np.float64], unit: str
+) -> dict[str, Any]:
     slow, without = [], 0
     for document in documents:
         for segment in document["segments"]:
@@ -467,7 +474,7 @@ def _speed_summary(documents: list[dict[str, Any]], limits: NDArray[np.float64])
                 )
             without += segment["duration_s"] is None
     return {
-        "actuator_unit": UPS.unit,
+        "actuator_unit": unit,
         "actuator_speed_max": limits.tolist(),
         "limited": bool(np.any(limits > 0.0)),
         "moves_to_slow_down": slow,
@@ -504,7 +511,8 @@ def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str])
             _to_frame(document, cell.work)
         results.append(result)
         documents.append(document)
-    speed = _speed_summary(documents, cell.actuator_speed_max)
+    unit = ACTUATOR_MODELS[platform.architecture].unit
+    speed = _speed_summary(documents, cell.actuator_speed_max, unit)
     ok = all(d["ok"] for d in documents) and not speed["moves_to_slow_down"]
     common = {
         "frame": frame,
@@ -562,9 +570,10 @@ def _speed_text(report: dict[str, Any], out: IO[str]) -> None:
             if move["feed_max_mm_min"] is not None
             else f"{move['feed_max_deg_min']:.0f} deg/min"
         )
+        peak = move["actuator_speed_peak"]
+        up_to = "unbounded" if peak is None else f"up to {peak:.4g} {speed['actuator_unit']}/s"
         out.write(
-            f"  part {move['part']} move {move['segment']}: actuator speed up to "
-            f"{move['actuator_speed_peak']:.4g} {speed['actuator_unit']}/s (limit "
+            f"  part {move['part']} move {move['segment']}: actuator speed {up_to} (limit "
             f"{max(speed['actuator_speed_max']):g}), slow down to {limit}\n"
         )
 

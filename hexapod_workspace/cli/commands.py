@@ -85,7 +85,7 @@ def check_command(
     if as_json:
         reports.check_json(result, out, poses_deg)
     else:
-        reports.check_table(result, out, poses_deg)
+        reports.check_table(result, out, poses_deg, manipulator)
     unreachable = len(result) - int(np.count_nonzero(result.reachable))
     if unreachable:
         err.write(f"{PROG}: {unreachable} of {len(result)} poses unreachable\n")

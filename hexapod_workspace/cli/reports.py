@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 
 from ..core.constraint_table import CONSTRAINTS, SINGULARITY
 from ..core.constraints import CheckResult
+from ..core.manipulator import Manipulator
 from ..core.orientation import OrientationWorkspace, TorsionRange
 from ..core.projected import ProjectedWorkspace
 from ..core.resolution import WorkspaceKind
@@ -124,11 +125,17 @@ def check_json(result: CheckResult, out: IO[str], degrees: NDArray[np.float64]) 
     out.write("]}\n")
 
 
-def check_table(result: CheckResult, out: IO[str], degrees: NDArray[np.float64]) -> None:
+def check_table(
+    result: CheckResult,
+    out: IO[str],
+    degrees: NDArray[np.float64],
+    manipulator: Manipulator,
+) -> None:
     """Write a readable table: angles in degrees, margins (distance to each limit) in mm and
     degrees, the limiting leg and the violated constraints.
 
-    Parameters are those of :func:`check_json`.
+    Parameters are those of :func:`check_json`, and the model the result is of (the unit of a
+    row can depend on it: the ``actuator`` stroke in mm for slides, deg for cranks).
     """
     x, y, z = result.position
     out.write(f"position: ({x:.4f}, {y:.4f}, {z:.4f}) m\n")
@@ -144,8 +151,9 @@ def check_table(result: CheckResult, out: IO[str], degrees: NDArray[np.float64])
             row is not CONSTRAINTS[SINGULARITY] or not np.all(np.isposinf(result.margins[row.name]))
         )
     ]
+    report = [row.report(manipulator) for row in shown]  # (unit, factor), read once
     names = " ".join(f"{row.column:>11}" for row in shown)
-    units = " ".join(f"{'[' + row.report_unit + ']':>11}" for row in shown)
+    units = " ".join(f"{'[' + unit + ']':>11}" for unit, _ in report)
     header = (
         f"{'':>9} {'':>9} {'':>9}  {'':<9}  {'margin to each limit (>= 0 holds, < 0 violated)'}",
         f"{'phi':>9} {'theta':>9} {'psi':>9}  {'reachable':<9}  {names}  {'limiting':>8}  violated"
@@ -164,7 +172,10 @@ def check_table(result: CheckResult, out: IO[str], degrees: NDArray[np.float64])
     columns = [
         *angle_columns,
         np.where(result.reachable, "yes", "NO").tolist(),
-        *((result.margins[row.name] * row.report_factor).tolist() for row in shown),
+        *(
+            (result.margins[row.name] * factor).tolist()
+            for row, (_, factor) in zip(shown, report, strict=True)
+        ),
         result.limiting_leg.tolist(),
         [",".join(v) or "-" for v in result.violated],
     ]

@@ -159,10 +159,12 @@ class Constraint:
         Report text (CLI tables, messages to humans).
     column : str
         Column heading of the CLI table (at most 11 characters).
-    report_unit : str
-        Unit of the CLI table (``"mm"``, ``"deg"``).
-    report_factor : float
-        SI margin × ``report_factor`` = margin in ``report_unit``.
+    report_unit : str or callable
+        Unit of the CLI table (``"mm"``, ``"deg"``); a callable ``unit(manipulator)`` where it
+        depends on the model (read both through :meth:`report`).
+    report_factor : float or callable
+        SI margin × ``report_factor`` = margin in ``report_unit`` (callable like
+        ``report_unit``).
     scale : callable
         ``scale(manipulator)``, float > 0 in the margin's unit: the natural scale of the margin;
         margin / scale is its relative margin (dimensionless).
@@ -188,8 +190,8 @@ class Constraint:
     margin: str
     label: str
     column: str
-    report_unit: str
-    report_factor: float
+    report_unit: str | Callable[[Manipulator], str]
+    report_factor: float | Callable[[Manipulator], float]
     scale: Callable[[Manipulator], float]
     scale_text: str
     speed: float | Callable[[Manipulator], float]
@@ -213,6 +215,19 @@ class Constraint:
             _value(self.crank, manipulator),
             _value(self.ends, manipulator),
         )
+
+    def report(self, manipulator: Manipulator) -> tuple[str, float]:
+        """(report_unit, report_factor) of this row for ``manipulator``: the CLI table's unit
+        and the factor from the SI margin to it."""
+        unit = self.report_unit(manipulator) if callable(self.report_unit) else self.report_unit
+        return unit, _value(self.report_factor, manipulator)
+
+
+def _actuator_report(manipulator: Manipulator) -> tuple[str, float]:
+    """The stroke of a slide in mm, the range of a crank in deg."""
+    if manipulator.architecture == "rus":
+        return "deg", float(np.degrees(1.0))
+    return "mm", 1e3
 
 
 def _value(coefficient: float | Callable[[Manipulator], float], manipulator: Manipulator) -> float:
@@ -373,8 +388,8 @@ CONSTRAINTS: tuple[Constraint, ...] = (
         margin="min_i min(q_i − qmin_i, qmax_i − q_i): slide stroke (pus, m), crank (rus, rad)",
         label="actuator",
         column="actuator",
-        report_unit="m or rad",
-        report_factor=1.0,
+        report_unit=lambda manipulator: _actuator_report(manipulator)[0],
+        report_factor=lambda manipulator: _actuator_report(manipulator)[1],
         scale=_half_actuator_range,
         scale_text="half the mean actuator range (qmax − qmin)/2",
         speed=0.0,

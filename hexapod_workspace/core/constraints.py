@@ -254,6 +254,7 @@ def pose_margins(
     position: ArrayLike,
     *,
     interference: bool = True,
+    singularity: bool = False,
 ) -> PoseMargins:
     """The constraint margins of N poses given as rotation matrices.
 
@@ -267,6 +268,9 @@ def pose_margins(
     interference : bool
         Evaluate ``leg_interference`` (False leaves it +inf, for callers that only need the
         others).
+    singularity : bool
+        Evaluate the singularity margin even when ``limits.singularity_min`` is 0 (a report;
+        otherwise it is +inf there).
 
     Returns
     -------
@@ -284,7 +288,13 @@ def pose_margins(
     legs = np.empty((N_CONSTRAINTS, count), dtype=np.int64)
     pairs = np.empty((count, 2), dtype=np.int64)
     kernels.margins_rotations(
-        kernels.model_vector(manipulator), rotations, positions, interference, margins, legs, pairs
+        kernels.model_vector(manipulator, report_singularity=singularity),
+        rotations,
+        positions,
+        interference,
+        margins,
+        legs,
+        pairs,
     )
     return PoseMargins(margins, legs, pairs)
 

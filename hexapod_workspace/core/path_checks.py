@@ -8,13 +8,20 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ResolutionError
-from .constraint_table import COLLISION, applicable
-from .constraints import CONSTRAINT_NAMES, PoseMargins, collision_pair_names, relative_margins
+from .constraint_table import COLLISION, SINGULARITY, applicable
+from .constraints import (
+    CONSTRAINT_NAMES,
+    PoseMargins,
+    collision_pair_names,
+    pose_margins,
+    relative_margins,
+)
 from .manipulator import Manipulator
 from .path_certificate import (
     DEFAULT_MAX_SAMPLE_ANGLE,
@@ -30,10 +37,10 @@ from .path_interpolation import (
     _validate_positions,
     _validate_tolerance,
 )
-from .path_results import PathCheck, SegmentChecks, WaypointChecks
-from .rotations import matrix_to_tt
+from .path_results import PathCheck, SegmentChecks, TorsionPlan, WaypointChecks
+from .rotations import matrix_to_tt, tt_to_matrix
 
-__all__ = ["check_path", "check_waypoints"]
+__all__ = ["check_path", "check_waypoints", "report_singularity"]
 
 
 def _waypoint_checks(
@@ -205,3 +212,48 @@ def _segment_checks(certifier: _Certifier, moves: _Moves, raw: _MoveCheck) -> Se
         evaluations=raw.evaluations,
         collision_pair=_pair_names(certifier.manipulator, samples["legs"][COLLISION, rows]),
     )
+
+
+def report_singularity(
+    manipulator: Manipulator, result: PathCheck | TorsionPlan
+) -> PathCheck | TorsionPlan:
+    """The same result with the singularity margin of every waypoint evaluated, as
+    :func:`~hexapod_workspace.core.constraints.check` reports it with ``singularity=True``.
+
+    With ``limits.singularity_min`` > 0 the margin is enforced and already evaluated: the result
+    is returned as it is. At 0 it is a report only: it never limits, so the verdicts, relative
+    margins and limiting constraints stay; the moves are not searched for its minimum.
+
+    Parameters
+    ----------
+    manipulator : Manipulator
+        The model the result was computed with.
+    result : PathCheck or TorsionPlan
+        A path check, or a torsion plan (its path and its ψ = 0 baseline).
+
+    Returns
+    -------
+    PathCheck or TorsionPlan
+    """
+    if manipulator.singularity_min > 0.0:
+        return result
+    if isinstance(result, TorsionPlan):
+        path = None if result.path is None else _with_singularity(manipulator, result.path)
+        return replace(result, path=path, baseline=_with_singularity(manipulator, result.baseline))
+    return _with_singularity(manipulator, result)
+
+
+def _with_singularity(manipulator: Manipulator, path: PathCheck) -> PathCheck:
+    waypoints = path.waypoints
+    if len(waypoints) == 0:
+        return path
+    found = pose_margins(
+        manipulator,
+        tt_to_matrix(waypoints.angles),
+        waypoints.positions,
+        interference=False,
+        singularity=True,
+    )
+    margins = dict(waypoints.margins)
+    margins[CONSTRAINT_NAMES[SINGULARITY]] = found.margins[SINGULARITY]
+    return replace(path, waypoints=replace(waypoints, margins=margins))

@@ -22,7 +22,7 @@ The work is split by job: interpolation and the motion inputs
 from __future__ import annotations
 
 from .path_certificate import DEFAULT_MAX_SAMPLE_ANGLE, DEFAULT_PATH_TOLERANCE
-from .path_checks import check_path, check_waypoints
+from .path_checks import check_path, check_waypoints, report_singularity
 from .path_interpolation import INTERPOLATIONS
 from .path_planner import DEFAULT_MARGIN_RESOLUTION, plan_torsion
 from .path_results import (
@@ -49,5 +49,6 @@ __all__ = [
     "check_path",
     "check_waypoints",
     "plan_torsion",
+    "report_singularity",
     "reported_parts",
 ]

@@ -34,9 +34,46 @@ rotation without translation) run at feed f lasts T = D/f, so actuator i runs at
 least ``feed_max = D·min_i(vmax_i / U_i)`` (a certified lower bound), and at most
 ``D·min_i(vmax_i / S_i)`` with S_i the sampled maximum: within ``rel`` of the true value.
 
-**Other architectures.** An :class:`ActuatorModel` gives ``g`` from the leg quantities of
-:class:`LegMotion` and the bound K from (V, A, ℓ_f); a new leg architecture registers one in
-:data:`ACTUATOR_MODELS` under its name.
+**6-PUS slides and 6-RUS cranks** (:data:`PUS`, :data:`RUS`; q_i the slide position, m, or
+the crank angle, rad). The leg of fixed length L_i joins the base-side end A_i(q_i) to B_i:
+``D_i = B_i − A_i(q_i)``, ``|D_i| = L_i``, ``n_i = D_i/L_i``, with ``A' = dA/dq = u_i`` (pus)
+or ``r_i·t_i`` (rus, ``t_i = w_i × (C_i − A0_i)/r_i`` the crank end's unit velocity) and
+``τ_i = n_i·u_i`` or ``n_i·t_i`` (the ``transmission`` row). Differentiating ``|D|² = L²``:
+``n·(v − A'·g) = 0``, so (dropping i, ρ = 1 for pus, r for rus)
+
+    g = dq/ds = (n·v)/(ρ·τ),       |g| ≤ V/(ρ·|τ|),
+
+and ``dD/ds = v − A'·g`` is ⟂ n, whence ``dn/ds = (v − A'g)/L`` and
+``|dn/ds| ≤ (V + ρ|g|)/L ≤ V(1 + 1/τ_f)/L =: N`` where ``|τ| ≥ τ_f``. Differentiating
+``ρτg = n·v``, with ``d(ρτ)/ds = dn/ds·A' + g·n·A''`` (A'' = 0 for pus, ``−(C − A0)`` of
+norm r for rus)::
+
+    ρτ·dg/ds = dn/ds·(v − A'g) + n·dv/ds − g²·n·A''
+             = L|dn/ds|² + n·dv/ds − g²·n·A'',
+    |dg/ds| ≤ (V²(1 + 1/τ_f)²/L + A [+ V²/(r·τ_f²) for rus]) / (ρ·τ_f)  =: K.
+
+The floor τ_f comes from the rate of |τ| (as ℓ_f above from the rate of ℓ): pus
+``dτ/ds = dn/ds·u``, ``|dτ/ds| ≤ N``; rus ``dτ/ds = dn/ds·t + n·dt/ds`` with
+``|dt/ds| = |g|``, ``|dτ/ds| ≤ N + V/(r·τ_f)``; both are ``c₀ + c₁/τ_f`` with ``c₀ = V/L``,
+``c₁ = V/L`` (pus) or ``V/L + V/r`` (rus). On [a, b] of width w, any ``τ_f ≤ min(|τ(a)|,
+|τ(b)|)`` with ``|τ(a)| + |τ(b)| − 2τ_f ≥ (c₀ + c₁/τ_f)·w`` holds on the whole interval: the
+stretches ``[a, a + (|τ(a)| − τ_f)/rate]`` and ``[b − (|τ(b)| − τ_f)/rate, b]`` cover it, and
+on each the first point where |τ| fell below τ_f would contradict the rate that holds until
+then. That is ``2τ_f² − (S − c₀w)τ_f + c₁w ≤ 0`` (S = |τ(a)| + |τ(b)|): the interval takes
+the smaller of its larger root and ``min(|τ(a)|, |τ(b)|)`` if that is still above the smaller
+root, and is split otherwise. The same argument keeps the leg's inverse kinematics solvable on
+the branch it has at a: a solution ceases to exist only where τ reaches 0 (pus: the
+discriminant ``L² − h²`` vanishes when D ⟂ u; rus: ``|c| = √(a² + b²)`` when D ⟂ t).
+
+**Unbounded.** Where some leg has no inverse-kinematics solution at a sample, or τ = 0 there,
+its rate is +inf: the peak bound of the move is +inf and its ``feed_max`` 0 (no feed is safe;
+the move is refused anyway by the ``ik`` or ``transmission`` constraint). A move whose |τ|
+approaches 0 without reaching it gets a finite but large bound: the true peak is large too.
+
+**Other architectures.** An :class:`ActuatorModel` gives ``g`` and its floor quantity (ℓ or
+|τ|) from the platform joints of :class:`LegMotion`, the floor over an interval, and the bound
+K from (V, A, floor); a new leg architecture registers one in :data:`ACTUATOR_MODELS` under its
+name.
 
 What the check covers: speeds along the programmed moves, each move at constant feed. Corner
 blending, accelerations and the controller's look-ahead are the controller's.
@@ -51,6 +88,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
+from . import architectures
 from .manipulator import Manipulator
 from .rotations import (
     matrix_to_quaternion,
@@ -61,6 +99,8 @@ from .rotations import (
 
 __all__ = [
     "ACTUATOR_MODELS",
+    "PUS",
+    "RUS",
     "UPS",
     "ActuatorModel",
     "FeedLimits",
@@ -82,21 +122,38 @@ MAX_INTERVALS = 2_000_000
 
 @dataclass(frozen=True)
 class LegMotion:
-    """Leg quantities at n samples (move, s).
+    """Platform joints and their velocities at n samples (move, s).
 
     Attributes
     ----------
-    vectors : ndarray, shape (n, 6, 3)
-        L_i = B_i − A_i, base frame, m.
-    lengths : ndarray, shape (n, 6)
-        ℓ_i, m.
+    platform : ndarray, shape (n, 6, 3)
+        B_i, base frame, m.
     joint_velocities : ndarray, shape (n, 6, 3)
         v_i = dB_i/ds, m per unit s.
     """
 
-    vectors: NDArray[np.float64]
-    lengths: NDArray[np.float64]
+    platform: NDArray[np.float64]
     joint_velocities: NDArray[np.float64]
+
+
+#: ``evaluate(manipulator, motion) -> (g (n, 6), floor quantity (n, 6))``.
+Evaluate = Callable[[Manipulator, LegMotion], tuple[NDArray[np.float64], NDArray[np.float64]]]
+#: ``interval_floor(manipulator, at_a, at_b, V, width) -> floor (m, 6)`` (≤ 0 or NaN: none).
+IntervalFloor = Callable[
+    [
+        Manipulator,
+        NDArray[np.float64],
+        NDArray[np.float64],
+        NDArray[np.float64],
+        NDArray[np.float64],
+    ],
+    NDArray[np.float64],
+]
+#: ``rate_bound(manipulator, V, A, floor) -> K (m, 6)``.
+RateBound = Callable[
+    [Manipulator, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]],
+    NDArray[np.float64],
+]
 
 
 @dataclass(frozen=True)
@@ -106,44 +163,144 @@ class ActuatorModel:
     Attributes
     ----------
     name : str
-        Architecture name (``"ups"``).
+        Architecture name (``"ups"``, ``"pus"``, ``"rus"``).
     unit : str
-        Unit of the actuated coordinate (``"m"``; speeds are per second).
-    rates : callable
-        ``rates(motion: LegMotion) -> ndarray (n, 6)``: g_i = dq_i/ds.
+        Unit of the actuated coordinate (``"m"`` or ``"rad"``; speeds are per second).
+    evaluate : callable
+        ``evaluate(manipulator, motion) -> (g, f)``, both (n, 6): g_i = dq_i/ds (+inf where the
+        leg has no solution or |τ_i| = 0) and the quantity whose floor the rate bound needs
+        (ℓ_i for ups, |τ_i| for pus and rus; 0 where the leg has no solution).
+    interval_floor : callable
+        ``interval_floor(manipulator, f_a, f_b, V, width)``: a lower bound of f_i over an
+        interval from its end values (not positive, or NaN: no bound, the interval is split).
     rate_bound : callable
-        ``rate_bound(V (n, 6), A (n, 6), length_floor (n, 6)) -> ndarray (n, 6)``: a bound on
-        |dg_i/ds| over an interval where |v_i| ≤ V, |dv_i/ds| ≤ A and ℓ_i ≥ length_floor > 0.
+        ``rate_bound(manipulator, V, A, floor)``: a bound K_i of |dg_i/ds| over an interval
+        where |v_i| ≤ V, |dv_i/ds| ≤ A and f_i ≥ floor > 0.
     """
 
     name: str
     unit: str
-    rates: Callable[[LegMotion], NDArray[np.float64]]
-    rate_bound: Callable[
-        [NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]
-    ]
+    evaluate: Evaluate
+    interval_floor: IntervalFloor
+    rate_bound: RateBound
 
 
-def _ups_rates(motion: LegMotion) -> NDArray[np.float64]:
-    """dℓ_i/ds = n_i·v_i (module documentation)."""
+def _ups_evaluate(
+    manipulator: Manipulator, motion: LegMotion
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """dℓ_i/ds = n_i·v_i and ℓ_i (module documentation)."""
+    vectors = motion.platform - manipulator.base_joints
+    lengths = np.linalg.norm(vectors, axis=2)
     rates: NDArray[np.float64] = (
-        np.einsum("nij,nij->ni", motion.vectors, motion.joint_velocities) / motion.lengths
+        np.einsum("nij,nij->ni", vectors, motion.joint_velocities) / lengths
     )
-    return rates
+    return rates, lengths
+
+
+def _ups_floor(
+    manipulator: Manipulator,
+    at_a: NDArray[np.float64],
+    at_b: NDArray[np.float64],
+    speed: NDArray[np.float64],
+    width: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """ℓ_f = (ℓ(a) + ℓ(b) − V·w)/2 (module documentation)."""
+    floor: NDArray[np.float64] = 0.5 * (at_a + at_b - speed * width)
+    return floor
 
 
 def _ups_rate_bound(
-    speed: NDArray[np.float64], accel: NDArray[np.float64], floor: NDArray[np.float64]
+    manipulator: Manipulator,
+    speed: NDArray[np.float64],
+    accel: NDArray[np.float64],
+    floor: NDArray[np.float64],
 ) -> NDArray[np.float64]:
     """|d²ℓ_i/ds²| ≤ V_i²/ℓ_f + A_i (module documentation)."""
     bound: NDArray[np.float64] = speed**2 / floor + accel
     return bound
 
 
+def _fixed_leg_evaluate(
+    manipulator: Manipulator, motion: LegMotion
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """g_i = n_i·v_i / (r_i·τ_i) (r = 1 for pus) and |τ_i| (module documentation)."""
+    arch = architectures.module(manipulator.architecture)
+    q, _ = arch.inverse_kinematics(manipulator, motion.platform)
+    solved = np.isfinite(q)
+    q = np.where(solved, q, 0.0)
+    vectors = motion.platform - arch.base_ends(manipulator, q)
+    directions = vectors / np.linalg.norm(vectors, axis=2, keepdims=True)
+    tau = arch.transmission(manipulator, directions, q)
+    usable = solved & (tau != 0.0)
+    along = np.einsum("nij,nij->ni", directions, motion.joint_velocities)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rates = along / (_crank_radius(manipulator) * tau)
+    return np.where(usable, rates, np.inf), np.where(usable, np.abs(tau), 0.0)
+
+
+def _crank_radius(manipulator: Manipulator) -> NDArray[np.float64]:
+    """r_i for rus, 1 for pus (dq = n·dB / (r·τ))."""
+    if manipulator.architecture == "rus":
+        radius = manipulator.crank_lengths
+        assert radius is not None
+        return radius
+    return np.ones(6)
+
+
+def _tau_rate(
+    manipulator: Manipulator, speed: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """(c₀, c₁) with |dτ_i/ds| ≤ c₀ + c₁/τ_f (module documentation)."""
+    length = manipulator.leg_lengths
+    assert length is not None
+    c0 = speed / length
+    c1 = c0 + (speed / _crank_radius(manipulator) if manipulator.architecture == "rus" else 0.0)
+    return c0, c1
+
+
+def _fixed_leg_floor(
+    manipulator: Manipulator,
+    at_a: NDArray[np.float64],
+    at_b: NDArray[np.float64],
+    speed: NDArray[np.float64],
+    width: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """The largest τ_f ≤ min(|τ(a)|, |τ(b)|) with |τ(a)| + |τ(b)| − 2τ_f ≥ (c₀ + c₁/τ_f)·w."""
+    c0, c1 = _tau_rate(manipulator, speed)
+    head = at_a + at_b - c0 * width
+    with np.errstate(invalid="ignore"):
+        root = np.sqrt(head * head - 8.0 * c1 * width)
+    upper, lower = 0.25 * (head + root), 0.25 * (head - root)
+    floor = np.minimum(upper, np.minimum(at_a, at_b))
+    ok = (head > 0.0) & np.isfinite(root) & (floor >= lower) & (floor > 0.0)
+    return np.where(ok, floor, np.nan)
+
+
+def _fixed_leg_rate_bound(
+    manipulator: Manipulator,
+    speed: NDArray[np.float64],
+    accel: NDArray[np.float64],
+    floor: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """K_i = (V²(1 + 1/τ_f)²/L + A [+ V²/(r τ_f²)]) / (r τ_f) (module documentation)."""
+    length = manipulator.leg_lengths
+    assert length is not None
+    radius = _crank_radius(manipulator)
+    numerator = speed**2 * (1.0 + 1.0 / floor) ** 2 / length + accel
+    if manipulator.architecture == "rus":
+        numerator = numerator + speed**2 / (radius * floor**2)
+    bound: NDArray[np.float64] = numerator / (radius * floor)
+    return bound
+
+
 #: 6-UPS legs: the actuated coordinate is the leg length (m).
-UPS = ActuatorModel("ups", "m", _ups_rates, _ups_rate_bound)
+UPS = ActuatorModel("ups", "m", _ups_evaluate, _ups_floor, _ups_rate_bound)
+#: 6-PUS slides: the actuated coordinate is the slide position on its rail (m).
+PUS = ActuatorModel("pus", "m", _fixed_leg_evaluate, _fixed_leg_floor, _fixed_leg_rate_bound)
+#: 6-RUS cranks: the actuated coordinate is the crank angle (rad).
+RUS = ActuatorModel("rus", "rad", _fixed_leg_evaluate, _fixed_leg_floor, _fixed_leg_rate_bound)
 #: Actuator models by architecture name.
-ACTUATOR_MODELS: dict[str, ActuatorModel] = {UPS.name: UPS}
+ACTUATOR_MODELS: dict[str, ActuatorModel] = {m.name: m for m in (UPS, PUS, RUS)}
 
 
 @dataclass(frozen=True)
@@ -182,7 +339,6 @@ class _SlerpMoves:
         rotations0: NDArray[np.float64],
         rotations1: NDArray[np.float64],
     ) -> None:
-        self.base = manipulator.base_joints
         self.joints = manipulator.platform_joints
         self.p0 = positions0
         self.dp = positions1 - positions0
@@ -214,10 +370,9 @@ class _SlerpMoves:
         rotation = turn @ self.r0[moves]
         arms = np.einsum("nij,kj->nki", rotation, self.joints)  # R·b_i (n, 6, 3)
         position = self.p0[moves] + s[:, None] * self.dp[moves]
-        vectors = position[:, None, :] + arms - self.base[None, :, :]
         w = (self.omega[moves])[:, None] * u
         velocities = self.dp[moves][:, None, :] + np.cross(w[:, None, :], arms)
-        return LegMotion(vectors, np.linalg.norm(vectors, axis=2), velocities)
+        return LegMotion(position[:, None, :] + arms, velocities)
 
 
 def _weights(limits: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -272,9 +427,13 @@ def actuator_rates(
     if not (np.all(np.isfinite(p)) and np.all(np.isfinite(r))):
         msg = "poses: expected finite positions and rotations"
         raise InputError(msg)
-    name = architecture or getattr(manipulator, "architecture", "ups")
+    own = manipulator.architecture
+    name = own if architecture is None else architecture
     if name not in ACTUATOR_MODELS:
         msg = f"architecture: expected one of {', '.join(ACTUATOR_MODELS)}, got {name!r}"
+        raise InputError(msg)
+    if name != own:
+        msg = f"architecture: expected the model's {own!r}, got {name!r}"
         raise InputError(msg)
     if not 0.0 < relative < 1.0:
         msg = f"relative: expected a value in (0, 1), got {relative!r}"
@@ -293,23 +452,24 @@ def actuator_rates(
     grid = np.linspace(0.0, 1.0, INITIAL_INTERVALS + 1)
     index = np.repeat(np.arange(count), grid.size)
     s = np.tile(grid, count)
-    motion = moves.motion(index, s)
-    g = np.abs(model.rates(motion)).reshape(count, grid.size, 6)
-    lengths = motion.lengths.reshape(count, grid.size, 6)
+    g, at = model.evaluate(manipulator, moves.motion(index, s))
+    g = np.abs(g).reshape(count, grid.size, 6)
+    at = at.reshape(count, grid.size, 6)
     evaluations = index.size
     np.maximum.reduce(g, axis=1, out=sampled)
     move = np.repeat(np.arange(count), INITIAL_INTERVALS)
     a = np.tile(grid[:-1], count)
     b = np.tile(grid[1:], count)
-    g_a, g_b = g[:, :-1].reshape(-1, 6), g[:, 1:].reshape(-1, 6)
-    l_a: NDArray[np.float64] = lengths[:, :-1].reshape(-1, 6)
-    l_b: NDArray[np.float64] = lengths[:, 1:].reshape(-1, 6)
+    g_a: NDArray[np.float64] = g[:, :-1].reshape(-1, 6)
+    g_b: NDArray[np.float64] = g[:, 1:].reshape(-1, 6)
+    f_a: NDArray[np.float64] = at[:, :-1].reshape(-1, 6)
+    f_b: NDArray[np.float64] = at[:, 1:].reshape(-1, 6)
     for round_ in range(MAX_ROUNDS + 1):
         width = (b - a)[:, None]
         speed, accel = moves.speed[move], moves.accel[move]
-        floor = 0.5 * (l_a + l_b - speed * width)
+        floor = model.interval_floor(manipulator, f_a, f_b, speed, width)
         positive = floor > 0.0
-        rate = model.rate_bound(speed, accel, np.where(positive, floor, 1.0))
+        rate = model.rate_bound(manipulator, speed, accel, np.where(positive, floor, 1.0))
         # a move that does not move has zero rates everywhere (V = A = 0)
         rate = np.where(positive | (speed == 0.0), rate, np.inf)
         upper = np.where(speed == 0.0, 0.0, 0.5 * (g_a + g_b + rate * width))
@@ -326,16 +486,16 @@ def actuator_rates(
         np.maximum.at(bound, move[keep], upper[keep])
         mid = 0.5 * (a[loose] + b[loose])
         split = move[loose]
-        motion = moves.motion(split, mid)
-        g_m = np.abs(model.rates(motion))
+        g_m, f_m = model.evaluate(manipulator, moves.motion(split, mid))
+        g_m = np.abs(g_m)
         evaluations += mid.size
         np.maximum.at(sampled, split, g_m)
         move = np.concatenate([split, split])
         a = np.concatenate([a[loose], mid])
         b = np.concatenate([mid, b[loose]])
         g_a, g_b = np.concatenate([g_a[loose], g_m]), np.concatenate([g_m, g_b[loose]])
-        l_a = np.concatenate([l_a[loose], motion.lengths])
-        l_b = np.concatenate([motion.lengths, l_b[loose]])
+        f_a = np.concatenate([f_a[loose], f_m])
+        f_b = np.concatenate([f_m, f_b[loose]])
     return MoveRates(bound, sampled, moves.translation, moves.omega, evaluations)
 
 

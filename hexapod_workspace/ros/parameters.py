@@ -262,7 +262,8 @@ def parameter_specs() -> dict[str, Spec]:
             "check.report_singularity",
             False,
             "Report the singularity margin (sigma_min of the legs' Pluecker matrix) in the "
-            "answers of check_poses, check_poses_flat and the command stream even when "
+            "answers of check_poses, check_poses_flat, the command stream and the waypoints of "
+            "check_path even when "
             "limits.singularity_min is 0 (then it never changes a verdict); false: null/+inf "
             "there, at no cost.",
         ),

@@ -46,6 +46,7 @@ from ..core.paths import (
     check_path,
     check_waypoints,
     plan_torsion,
+    report_singularity,
 )
 from ..core.rotations import matrix_to_tt, quaternion_to_matrix, tt_to_matrix, wrap_angle
 from ..errors import HexapodWorkspaceError, InputError
@@ -193,6 +194,8 @@ def check_path_response_fields(
                 interpolation=interpolation,
                 tolerance=tolerance,
             )
+        if state is not None and state.settings.report_singularity:
+            result = report_singularity(manipulator, result)
         fields = path_fields.check_path_response_fields(
             result,
             pairs=manipulator.leg_diameter > 0.0,

@@ -1,7 +1,8 @@
 """workspace_node started with the 6-PUS and 6-RUS example files, over real Fast DDS from
 another process: it serves them (the margins by name of each architecture, ``ik`` violated and
 NaN margins where a leg has no solution; the singularity margin reported on request with
-``check.report_singularity``), computes their workspaces, and refuses a file that mixes
+``check.report_singularity``, on ``~/check_poses`` and on the waypoints of ``~/check_path``),
+computes their workspaces, and refuses a file that mixes
 architectures, naming the parameter.
 """
 
@@ -17,10 +18,12 @@ from ros_support import require_ros, running_node
 
 require_ros()
 
+from geometry_msgs.msg import Pose  # noqa: E402
 from hexapod_workspace_msgs.msg import TiltTorsion, WorkspaceRequest  # noqa: E402
-from hexapod_workspace_msgs.srv import CheckPoses  # noqa: E402
+from hexapod_workspace_msgs.srv import CheckPath, CheckPoses  # noqa: E402
 
 from hexapod_workspace import Manipulator, check, projected_workspace  # noqa: E402
+from hexapod_workspace.core.rotations import matrix_to_quaternion, tt_to_matrix  # noqa: E402
 from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402
 
 NODE = "/hexapod_workspace"
@@ -51,6 +54,17 @@ def params_text(architecture: str, directory: Path, **changes: object) -> str:
 def unsolved_legs(result) -> np.ndarray:
     """Poses where some leg has no inverse-kinematics solution (NaN actuator margin)."""
     return np.isnan(result.margins["actuator"])
+
+
+def ros_poses(position, angles: np.ndarray) -> list[Pose]:
+    """geometry_msgs/Pose at one position, orientations from (φ, θ, ψ) rad."""
+    poses = []
+    for x, y, z, w in matrix_to_quaternion(tt_to_matrix(angles)).tolist():
+        pose = Pose()
+        pose.position.x, pose.position.y, pose.position.z = (float(v) for v in position)
+        pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w = x, y, z, w
+        poses.append(pose)
+    return poses
 
 
 def check_request(angles: np.ndarray, position) -> CheckPoses.Request:
@@ -92,6 +106,16 @@ def test_node_serves_an_architecture_file(architecture, ros_domain, ros_client, 
             np.testing.assert_array_equal(got, expected.margins[name])
         unsolved = np.isnan(expected.margins["actuator"])
         assert all("ik" in response.results[k].violated for k in np.flatnonzero(unsolved))
+
+        # ~/check_path reports it too, at every waypoint, with the same values
+        tilted = angles[:8] * np.array([1.0, 0.2, 0.2])
+        path = CheckPath.Request(poses=ros_poses(model.position, tilted))
+        response = ros_client.call(CheckPath, f"{NODE}/check_path", path)
+        assert response.success, response.message
+        reported = check(model, tilted, model.position, singularity=True).margins["singularity"]
+        got = [margins_by_name(w)["singularity"] for w in response.waypoints]
+        np.testing.assert_allclose(got, reported, rtol=1e-12)
+        assert np.all(np.isfinite(reported))
 
         request = WorkspaceRequest(kind=WorkspaceRequest.PROJECTED_TORSION_ZERO, request_id="a")
         request.position.x, request.position.y, request.position.z = model.position.tolist()
