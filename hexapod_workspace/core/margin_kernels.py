@@ -1302,7 +1302,7 @@ def _check_block(
         work[(_R + 8) * BLOCK + n] = cb
     rotation = _planes(work, _R, 9)
     minima = _planes(work, _MIN, 9)
-    moves = _planes(work, _MOVE, 6)
+    moves = _planes(work, _MOVE, 8)
     if moving:
         for n in range(count):
             for row in (_M_ACT, _M_IK, _M_TAU, _UNSOLVED):
