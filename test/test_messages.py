@@ -119,13 +119,21 @@ def test_reachability_result_success_and_invalid(check_result: constraints.Check
         stamp_ns=0,
         frame_id="base",
         message="NaN in command",
+        names=list(check_result.margins),
     )
     assert bad["success"] is False and bad["message"] == "NaN in command"
-    assert bad["check"]["constraint_names"] == list(CONSTRAINT_NAMES)
+    # The model's rows (6-UPS: not actuator, ik, transmission or collision), all NaN.
+    assert bad["check"]["constraint_names"] == list(check_result.margins)
+    assert "actuator" not in bad["check"]["constraint_names"]
     assert all(math.isnan(margin) for margin in bad["check"]["margins"])
     decoded = roundtrip("hexapod_workspace_msgs/msg/ReachabilityResult", bad)
-    assert decoded["check"]["margins"] == [NAN] * len(CONSTRAINT_NAMES)
+    assert decoded["check"]["margins"] == [NAN] * len(check_result.margins)
     assert decoded == plain(bad)
+    unconfigured = messages.reachability_result_fields(
+        None, position=[0, 0, 1], angles=[0, 0, 0], stamp_ns=0, frame_id="", message="inactive"
+    )
+    assert unconfigured["check"]["constraint_names"] == []
+    assert unconfigured["check"]["margins"] == []
 
 
 @pytest.mark.parametrize("method", ["torsion_zero", "exact"])

@@ -17,7 +17,6 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
-from ..core.constraint_table import CONSTRAINT_NAMES
 from ..core.orientation import OrientationWorkspace
 from ..core.projected import ProjectedWorkspace
 from ..core.resolution import WorkspaceKind
@@ -178,13 +177,14 @@ def pose_checks_fields(result: PoseChecks) -> list[dict[str, Any]]:
     ]
 
 
-def _failed_pose_check() -> dict[str, Any]:
-    nan = math.nan
+def _failed_pose_check(names: Sequence[str]) -> dict[str, Any]:
+    """A PoseCheck that was not made: the constraint ``names`` of the model (its rows, not the
+    whole table), every margin NaN."""
     return {
         "reachable": False,
         "violated": [],
-        "constraint_names": list(CONSTRAINT_NAMES),
-        "margins": [nan] * len(CONSTRAINT_NAMES),
+        "constraint_names": list(names),
+        "margins": [math.nan] * len(names),
         "limiting_leg": 0,
         "collision_pair": "",
     }
@@ -268,14 +268,16 @@ def reachability_result_fields(
     request_id: str = "",
     index: int = 0,
     message: str | None = None,
+    names: Sequence[str] = (),
 ) -> dict[str, Any]:
     """hexapod_workspace_msgs/msg/ReachabilityResult answering one CommandedPose.
 
-    ``result=None`` means the command itself was invalid: ``success`` false, margins NaN,
-    ``message`` the reason.
+    ``result=None`` means the command was not checked (invalid, overloaded, or no model):
+    ``success`` false, ``message`` the reason, ``check.constraint_names`` the model's rows
+    ``names`` (empty where no model is loaded) with NaN margins.
     """
     if result is None:
-        check = _failed_pose_check()
+        check = _failed_pose_check(names)
         verdict = message or "invalid command"
     else:
         check = pose_check_fields(result, index)

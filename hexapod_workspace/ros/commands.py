@@ -27,6 +27,7 @@ import numpy as np
 from hexapod_workspace_msgs.msg import CommandedPose, ReachabilityResult
 from rclpy.exceptions import InvalidHandle
 
+from hexapod_workspace.core.constraint_table import constraint_names
 from hexapod_workspace.core.constraints import check
 from hexapod_workspace.errors import InputError
 from hexapod_workspace.logs import messages
@@ -103,6 +104,7 @@ class CommandStream:
             for g in range(keys.shape[0]):
                 members = todo[groups.reshape(-1) == g]
                 self._check_group(state, keys[g], angles, members, verdicts)
+        names = constraint_names(state.manipulator)
         for k, command in enumerate(batch):
             result, index, reason = verdicts[k]
             fields = messages.reachability_result_fields(
@@ -114,6 +116,7 @@ class CommandStream:
                 stamp_ns=now_ns,
                 frame_id=state.manipulator.frame_id,
                 request_id=command.request_id,
+                names=names,
             )
             if result is not None and node.paths is not None:  # the move from the current pose
                 fields = node.paths.with_motion(
@@ -126,6 +129,7 @@ class CommandStream:
     def _refuse_all(self, batch: list[CommandedPose], reason: str, now_ns: int, state: Any) -> None:
         """Answer every command of ``batch`` ``success`` false with ``reason``."""
         frame_id = state.manipulator.frame_id if state is not None else ""
+        names = constraint_names(state.manipulator) if state is not None else ()
         for command in batch:
             try:
                 position, target = commanded_target(command)
@@ -141,6 +145,7 @@ class CommandStream:
                 stamp_ns=now_ns,
                 frame_id=frame_id,
                 request_id=command.request_id,
+                names=names,
             )
             self._node.publish(self._publisher, to_message(ReachabilityResult, fields))
         self._node.stats.commands_refused += len(batch)
