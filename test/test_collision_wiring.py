@@ -263,6 +263,31 @@ def test_home_collision_refused_in_one_line(plain: Manipulator) -> None:
         )
 
 
+def test_home_collision_checked_with_the_active_tool(plain: Manipulator) -> None:
+    """The home pose is checked with the tool ``tool.number`` selects: a ball 0.5 m under the
+    platform centre is clear of a short spindle at the platform (T0) and hit by the same spindle
+    hung 0.5 m lower (T2)."""
+    scene = {
+        "collision": {
+            "tool": {"radius": 0.02, "length": 0.05},
+            "obstacles": {
+                "names": ["ball"],
+                "ball": {
+                    "shape": "sphere",
+                    "position": (HOME + np.array([0.0, 0.0, -0.5])).tolist(),
+                    "radius": 0.05,
+                },
+            },
+        },
+        "tools": {"T2": {"offset": [0.0, 0.0, -0.5]}},
+    }
+    assert with_scene(plain, {**scene, "tool": {"number": 0}}).collision is not None
+    with pytest.raises(ConfigError, match=r"^collision: tool vs ball collide at the home pose"):
+        with_scene(plain, {**scene, "tool": {"number": 2}})
+    with pytest.raises(ConfigError, match=r"^tool.number: tool 3 is not in the tool table .*T2"):
+        with_scene(plain, {**scene, "tool": {"number": 3}})
+
+
 def test_collision_row_adds_the_moving_base_joints_speed() -> None:
     """6-PUS with a spindle: the leg bodies' base ends slide, so the row adds ends·E (E the leg
     end rate of the constraint table) to the fixed-base bound."""

@@ -47,7 +47,16 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ConfigError, InputError
-from .manipulator import Manipulator, _angles3, _describe, _frozen, _numbers, _vector3
+from .manipulator import (
+    Manipulator,
+    _angles3,
+    _describe,
+    _frozen,
+    _numbers,
+    _tool_number,
+    _unknown_tool,
+    _vector3,
+)
 from .params import flatten, load_params_file
 from .rotations import tt_to_matrix
 
@@ -268,19 +277,12 @@ def cell_from_mapping(parameters: Mapping[str, Any]) -> CellFrames:
 def _selected(tool: Tool, tools: dict[int, Tool], number: Any) -> Tool:
     """The active tool: ``tool`` for ``tool.number`` 0, else the table's entry (ConfigError
     naming ``tool.number`` and the defined tools when there is none)."""
-    if isinstance(number, bool) or not isinstance(number, (int, np.integer)) or number < 0:
-        msg = f"tool.number: expected an integer >= 0 (0 = tool.offset), got {_describe(number)}"
-        raise ConfigError(msg)
+    number = _tool_number(number)
     if number == 0:
         return tool
-    if int(number) not in tools:
-        have = ", ".join(f"T{n}" for n in sorted(tools)) or "none"
-        msg = (
-            f"tool.number: tool {int(number)} is not in the tool table (tools.T<n>; "
-            f"defined: {have})"
-        )
-        raise ConfigError(msg)
-    return tools[int(number)]
+    if number not in tools:
+        raise _unknown_tool(number, tools)
+    return tools[number]
 
 
 def cell_from_params_file(path: str | Path) -> CellFrames:

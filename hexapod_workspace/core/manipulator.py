@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -855,20 +855,51 @@ def _with_scene(manipulator: Manipulator, flat: Mapping[str, Any]) -> Manipulato
     """The model with its collision scene (``collision.*``), built in the platform frame P.
 
     Obstacles given in the work frame are placed with ``work.*``; the tool body starts at the
-    tool centre point of ``tool.*`` (the cell's tool frame). A scene with no pair to check
-    (no tool and no obstacle) leaves the model without one. Refuses, naming the pair, an
-    obstacle or body in collision at the home pose.
+    tool centre point of the active tool (``tool.*``, or ``tools.T<n>.*`` when ``tool.number``
+    is n > 0), so the home pose is checked with the tool the machine carries. A scene with no
+    pair to check (no tool and no obstacle) leaves the model without one. Refuses, naming the
+    pair, an obstacle or body in collision at the home pose.
     """
     from dataclasses import replace
 
     from .collision.params import collision_scene
 
     work = _cell_transform(flat, "work", "origin")
-    tool = _cell_transform(flat, "tool", "offset")
+    tool = _cell_transform(flat, *_active_tool_group(flat))
     scene = collision_scene(flat, work_transform=work, tool_transform=tool, manipulator=manipulator)
     if scene.pair_count == 0:
         return manipulator
     return replace(manipulator, collision=scene)
+
+
+def _tool_number(value: Any) -> int:
+    """``tool.number`` as an int >= 0 (0: ``tool.*``, n: ``tools.T<n>.*``), else ConfigError."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+        msg = f"tool.number: expected an integer >= 0 (0 = tool.offset), got {_describe(value)}"
+        raise ConfigError(msg)
+    return int(value)
+
+
+def _unknown_tool(number: int, defined: Iterable[int]) -> ConfigError:
+    """The refusal of a ``tool.number`` that names no entry of the tool table."""
+    have = ", ".join(f"T{n}" for n in sorted(defined)) or "none"
+    return ConfigError(
+        f"tool.number: tool {number} is not in the tool table (tools.T<n>; defined: {have})"
+    )
+
+
+def _active_tool_group(flat: Mapping[str, Any]) -> tuple[str, str]:
+    """The parameter group and offset name of the tool ``tool.number`` selects: ``("tool",
+    "offset")`` for 0, ``("tools.T<n>", "offset")`` for n (ConfigError naming ``tool.number``
+    otherwise, worded as the cell's loader words it)."""
+    number = _tool_number(flat.get("tool.number", 0))
+    if number == 0:
+        return "tool", "offset"
+    group = f"tools.T{number}"
+    if f"{group}.offset" not in flat:
+        tags = {name.split(".")[1][1:] for name in flat if name.startswith("tools.T")}
+        raise _unknown_tool(number, (int(tag) for tag in tags if tag.isdigit()))
+    return group, "offset"
 
 
 def _model_names() -> str:
