@@ -34,10 +34,12 @@ points), and inflations add: ``sd(A ⊕ r_A, B ⊕ r_B) = sd(A, B) − r_A − r
   segments is flat, so their signed distance is their distance), a point against a box and
   against a cylinder (signed: inside, minus the distance to the nearest face), a segment
   against a cylinder whose curved surface holds the closest point (``_segment_cylinder``:
-  the distance to the axis minus the radius, exact there).
-* GJK (Gilbert–Johnson–Keerthi) for every other pair (segment, box or cylinder against box or
-  cylinder). Each iteration has the upper bound ``|v|`` (a point of ``M``) and, by (1) with
-  ``d = v/|v|``, the lower bound ``v·w/|v|`` (``w`` the support point of ``M`` in ``−v``).
+  the distance to the axis minus the radius, exact there), a segment apart from a box
+  (``_segment_box``: its ends against the box and the box's 12 edges against it).
+* GJK (Gilbert–Johnson–Keerthi) for every other pair (a segment meeting a box, a segment
+  against a cylinder's end, box or cylinder against box or cylinder). Each iteration has the
+  upper bound ``|v|`` (a point of ``M``) and, by (1) with ``d = v/|v|``, the lower bound
+  ``v·w/|v|`` (``w`` the support point of ``M`` in ``−v``).
   The iteration stops when the two are within :data:`GJK_TOLERANCE` (1e-9 m), after
   :data:`GJK_MAX_ITERATIONS`, or when an iteration makes no progress (the closest point of a
   sliver simplex has lost its digits: a few in 10⁵ placements, gaps up to 4e-9 m seen); the
@@ -236,6 +238,68 @@ def _segment_cylinder(segment: NDArray[np.float64], cylinder: NDArray[np.float64
     if 0.0 < t < 1.0 and distance >= radius:
         return float(distance - radius)
     return math.nan
+
+
+@_helper
+def _segment_box(segment: NDArray[np.float64], box: NDArray[np.float64]) -> float:
+    """Distance from a segment core to a box core in closed form when they are apart, else NaN.
+
+    In the box's frame: if the segment meets the box (slab test, touching included) NaN, and
+    the caller runs GJK. Otherwise the closest pair (x on the segment, y on the box) has x an
+    end of the segment (the point–box distance of that end), or y on one of the 12 edges (the
+    segment–segment distance to that edge), or y inside a face with x interior; in the last
+    case the segment is parallel to the face (x − y is the face normal, orthogonal to the
+    segment at an interior minimum), so the distance is constant along the segment while its
+    projection stays in the face, and is attained again at an end or where the projection
+    crosses an edge. Every candidate is the distance of two points of the bodies (≥ the
+    distance), and one of them attains it: the minimum of the 14 is exact.
+    """
+    p0x, p0y, p0z, d1x, d1y, d1z = _ends(segment)
+    r = box[_R : _R + 9]
+    x, y, z = p0x - box[_C], p0y - box[_C + 1], p0z - box[_C + 2]
+    # Local frame: Rᵀ (p0 − c) and Rᵀ d.
+    lx = r[0] * x + r[3] * y + r[6] * z
+    ly = r[1] * x + r[4] * y + r[7] * z
+    lz = r[2] * x + r[5] * y + r[8] * z
+    ux = r[0] * d1x + r[3] * d1y + r[6] * d1z
+    uy = r[1] * d1x + r[4] * d1y + r[7] * d1z
+    uz = r[2] * d1x + r[5] * d1y + r[8] * d1z
+    hx, hy, hz = box[_P], box[_P + 1], box[_P + 2]
+    # Slab test on s in [0, 1].
+    low, high = 0.0, 1.0
+    meets = True
+    for p, u, h in ((lx, ux, hx), (ly, uy, hy), (lz, uz, hz)):
+        if u == 0.0:
+            if abs(p) > h:
+                meets = False
+        else:
+            t1 = (-h - p) / u
+            t2 = (h - p) / u
+            if t1 > t2:
+                t1, t2 = t2, t1
+            low = max(low, t1)
+            high = min(high, t2)
+            if low > high:
+                meets = False
+    if meets:
+        return math.nan
+    best = np.inf
+    for s in (0.0, 1.0):
+        qx = abs(lx + s * ux) - hx
+        qy = abs(ly + s * uy) - hy
+        qz = abs(lz + s * uz) - hz
+        ox, oy, oz = max(qx, 0.0), max(qy, 0.0), max(qz, 0.0)
+        best = min(best, math.sqrt(ox * ox + oy * oy + oz * oz))
+    for sa in (-1.0, 1.0):
+        for sb in (-1.0, 1.0):
+            # Edges along x, y and z: the other two coordinates at their ± half extents.
+            best = min(
+                best,
+                _segment_segment(lx, ly, lz, ux, uy, uz, -hx, sa * hy, sb * hz, 2.0 * hx, 0.0, 0.0),
+                _segment_segment(lx, ly, lz, ux, uy, uz, sa * hx, -hy, sb * hz, 0.0, 2.0 * hy, 0.0),
+                _segment_segment(lx, ly, lz, ux, uy, uz, sa * hx, sb * hy, -hz, 0.0, 0.0, 2.0 * hz),
+            )
+    return float(best)
 
 
 @_helper
@@ -636,12 +700,13 @@ def _pair(
         return _point_solid(a, b) - inflation, 0.0
     if kb == POINT:
         return _point_solid(b, a) - inflation, 0.0
-    if ka == SEGMENT and kb == CYLINDER:
-        value = _segment_cylinder(a, b)
-        if value == value:
-            return value - inflation, 0.0
-    if kb == SEGMENT and ka == CYLINDER:
-        value = _segment_cylinder(b, a)
+    if ka == SEGMENT or kb == SEGMENT:
+        # A segment against a box or a cylinder: the closed form where it holds, else NaN.
+        segment, solid = (a, b) if ka == SEGMENT else (b, a)
+        if int(solid[_KIND]) == BOX:
+            value = _segment_box(segment, solid)
+        else:
+            value = _segment_cylinder(segment, solid)
         if value == value:
             return value - inflation, 0.0
     lower, upper = _gjk(a, b, work, tolerance, cutoff + inflation)
