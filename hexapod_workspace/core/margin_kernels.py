@@ -870,10 +870,12 @@ def _tt_matrix(phi: float, theta: float, psi: float, r: NDArray[np.float64]) -> 
 
 @_helper
 def _limiting_constraint(model: NDArray[np.float64], out: NDArray[np.float64]) -> int:
-    """Index of the smallest relative margin (first on ties; NaN wins)."""
+    """Index of the smallest relative margin (first on ties; NaN wins). Only the rows in use
+    (``model[ROWS_USED]``) are read: the others are +inf with a finite positive scale, so they
+    never limit a pose."""
     best = out[0] / model[SCALE]
     index = 0
-    for c in range(1, N_CONSTRAINTS):
+    for c in range(1, int(model[ROWS_USED])):
         value = out[c] / model[SCALE + c]
         if value < best or (value != value and best == best):
             best = value
@@ -1482,11 +1484,13 @@ def check_angles(
         _check_block(model, angles, position, first, count, work, scratch, out, r)
         for m in range(count):
             n = first + m
-            for c in range(N_CONSTRAINTS):
-                out[c] = work[c * BLOCK + m]
+            # Only the rows in use: the others are +inf (never limiting, never violated).
+            feasible = True
             for c in range(used):
+                out[c] = work[c * BLOCK + m]
                 margins[c, n] = out[c]
                 ints[c, n] = int(work[(OUT_LEG + c) * BLOCK + m]) + 1
+                feasible = feasible and out[c] >= 0.0  # NaN counts as violated
             ints[LEG_INTERFERENCE, n] *= enabled
             ints[SINGULARITY, n] = 0  # a property of all legs together: no limiting leg
             pairs[n, 0] = (int(work[OUT_PAIR * BLOCK + m]) + 1) * enabled
@@ -1494,7 +1498,7 @@ def check_angles(
             worst = _limiting_constraint(model, out)
             ints[used, n] = worst
             ints[used + 1, n] = ints[worst, n] if worst < used else 0
-            reachable[n] = _feasible(out)
+            reachable[n] = feasible
     return -1
 
 
