@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import signal
 import subprocess
 import sys
 import tempfile
@@ -39,35 +38,25 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from _node import missing_install, print_failures, ros_domain, start_node, stop  # same folder
 
-REPO = Path(__file__).resolve().parents[1]
-NODE_EXECUTABLE = (
-    REPO / "install" / "hexapod_workspace" / "lib" / "hexapod_workspace" / "workspace_node"
-)
 NODES = ("before", "after", "pose", "axis")
 STREAMED = ("pose", "axis")
 
 
-def start_node(name: str, source: Path | None, folder: Path) -> subprocess.Popen:
-    args = [
-        str(NODE_EXECUTABLE),
-        "--ros-args",
-        "--params-file",
-        str(REPO / "config" / "example_gpm.yaml"),
-        "-r",
-        f"__ns:=/{name}",
-        "-p",
-        f"recording.directory:={folder / name}",
-    ]
+def start_named(name: str, source: Path | None, folder: Path) -> subprocess.Popen:
+    """Start the node ``name`` (its namespace) in ``folder / name``."""
+    args = ["-r", f"__ns:=/{name}"]
     if name != "before":
         args += ["-p", f"motion.current_pose_topic:=/{name}/current_pose"]
     if name in STREAMED:
         args += ["-p", f"axis_limits.rate:={100.0 if name == 'axis' else 0.0}"]
-    env = dict(os.environ)
-    if source is not None and name == "before":
-        env["PYTHONPATH"] = f"{source.resolve()}:{env.get('PYTHONPATH', '')}"
-    log = (folder / f"{name}.log").open("wb")
-    return subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT, env=env)
+    return start_node(
+        folder / name,
+        args,
+        source if name == "before" else None,
+        log=folder / f"{name}.log",
+    )
 
 
 def stats(samples: list[float]) -> tuple[float, float, float]:
@@ -205,31 +194,18 @@ def main(argv: list[str] | None = None) -> int:
         help="a checkout (or git archive) of the node before the change",
     )
     args = parser.parse_args(argv)
-    if not NODE_EXECUTABLE.is_file():
-        print(f"{NODE_EXECUTABLE} missing: run `make ros` first", file=sys.stderr)
+    missing = missing_install()
+    if missing:
+        print(missing, file=sys.stderr)
         return 2
-    import domain_coordinator
-
-    with domain_coordinator.domain_id() as domain, tempfile.TemporaryDirectory() as tmp:
-        os.environ["ROS_DOMAIN_ID"] = str(domain)
-        os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    with ros_domain() as domain, tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        processes = [start_node(name, args.node_source, folder) for name in NODES]
+        processes = [start_named(name, args.node_source, folder) for name in NODES]
         try:
             return run(args, domain)
         finally:
-            for process in processes:
-                if process.poll() is None:
-                    process.send_signal(signal.SIGINT)
-                    try:
-                        process.wait(timeout=30)
-                    except subprocess.TimeoutExpired:
-                        process.kill()
-                        process.wait()
-            for name in NODES:
-                text = (folder / f"{name}.log").read_text(errors="replace")
-                if "Traceback" in text or "error" in text.lower():
-                    print(f"---- {name} node log:\n{text[-2000:]}", file=sys.stderr)
+            stop(processes)
+            print_failures([folder / f"{name}.log" for name in NODES], ("Traceback", "rror"))
 
 
 if __name__ == "__main__":

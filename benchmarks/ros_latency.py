@@ -26,8 +26,6 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import signal
-import subprocess
 import sys
 import tempfile
 import threading
@@ -36,11 +34,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from _node import missing_install, ros_domain, start_node, start_python, stop  # same folder
 
-REPO = Path(__file__).resolve().parents[1]
-NODE_EXECUTABLE = (
-    REPO / "install" / "hexapod_workspace" / "lib" / "hexapod_workspace" / "workspace_node"
-)
 GOAL_MS = 2.0
 #: Goal for 1000 poses in the flat form, as a ratio to the in-process core.
 GOAL_FLAT_CORE_RATIO = 3.0
@@ -186,58 +181,21 @@ def main(argv: list[str] | None = None) -> int:
         help="DDS domain of the run (default: a free one, picked by domain_coordinator)",
     )
     args = parser.parse_args(argv)
-    if not NODE_EXECUTABLE.is_file():
-        print(f"{NODE_EXECUTABLE} missing: run `make ros` first", file=sys.stderr)
+    missing = missing_install()
+    if missing:
+        print(missing, file=sys.stderr)
         return 2
-
-    import contextlib
-
-    import domain_coordinator
-
-    chosen = (
-        contextlib.nullcontext(args.domain_id)
-        if args.domain_id is not None
-        else domain_coordinator.domain_id()
-    )
-    with chosen as domain, tempfile.TemporaryDirectory() as tmp:
-        os.environ["ROS_DOMAIN_ID"] = str(domain)
-        os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-        log = Path(tmp) / "node.log"
-        with log.open("wb") as out:
-            node = subprocess.Popen(
-                [
-                    str(NODE_EXECUTABLE),
-                    "--ros-args",
-                    "--params-file",
-                    str(REPO / "config" / "example_gpm.yaml"),
-                    "-p",
-                    f"recording.directory:={tmp}",
-                    *args.node_arg,
-                ],
-                stdout=out,
-                stderr=subprocess.STDOUT,
-                env=dict(os.environ),
-            )
-            floors = [
-                subprocess.Popen(
-                    [sys.executable, "-c", source],
-                    stdout=out,
-                    stderr=subprocess.STDOUT,
-                    env=dict(os.environ),
-                )
-                for source in (FLOOR_SERVER, FLAT_FLOOR_SERVER)
-            ]
+    with ros_domain(args.domain_id) as domain, tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        node = start_node(folder, args.node_arg)
+        floors = [
+            start_python(source, folder / "node.log")
+            for source in (FLOOR_SERVER, FLAT_FLOOR_SERVER)
+        ]
         try:
             return run(args, domain)
         finally:
-            for process in (node, *floors):
-                if process.poll() is None:
-                    process.send_signal(signal.SIGINT)
-                    try:
-                        process.wait(timeout=30)
-                    except subprocess.TimeoutExpired:
-                        process.kill()
-                        process.wait()
+            stop((node, *floors))
 
 
 def run(args: argparse.Namespace, domain: int) -> int:

@@ -26,7 +26,6 @@ import argparse
 import json
 import math
 import os
-import signal
 import subprocess
 import sys
 import tempfile
@@ -35,12 +34,17 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _node import (
+    describe_node,
+    missing_install,
+    print_failures,
+    ros_domain,
+    start_node,
+    start_python,
+    stop,
+)
 from ros_latency import check_requests, floor_server_source, timed_call  # same folder
 
-REPO = Path(__file__).resolve().parents[1]
-NODE_EXECUTABLE = (
-    REPO / "install" / "hexapod_workspace" / "lib" / "hexapod_workspace" / "workspace_node"
-)
 NODE = "/hexapod_workspace"
 FLOOR = "/load_floor/check_poses"
 FLOOR_SERVER = floor_server_source(FLOOR, "load_floor")
@@ -424,6 +428,9 @@ def run(args: argparse.Namespace, node: subprocess.Popen, out_dir: Path) -> int:
         rclpy.try_shutdown()
 
     one, floor, batch, core = idle["one"], idle["floor"], idle["batch"], idle["core"]
+    print(f"node: {describe_node(args.node_source)}")
+    if args.node_arg:
+        print(f"node arguments: {' '.join(args.node_arg)}")
     floor_ratio = one["p50"] / floor["p50"]
     core_ratio = batch["p50"] / core["p50"]
     latency = command["latency_ms"]
@@ -506,8 +513,9 @@ def main(argv: list[str] | None = None) -> int:
         "--node-source",
         type=Path,
         metavar="DIR",
-        help="run the node of another checkout (e.g. a git worktree of an older commit) "
-        "instead of the install space's, for a before/after comparison in the same conditions",
+        help="run the node of another source tree (a checkout, or `git archive` of a whole "
+        "commit: the node reads config/ and msg_defs/ beside the package) instead of the "
+        "install space's, for a before/after comparison in the same conditions",
     )
     parser.add_argument(
         "--timeline",
@@ -529,65 +537,20 @@ def main(argv: list[str] | None = None) -> int:
     if args.role == "checker":
         print(json.dumps(checker(args.duration + 2.0)), flush=True)
         return 0
-    if not NODE_EXECUTABLE.is_file():
-        print(f"{NODE_EXECUTABLE} missing: run `make ros` first", file=sys.stderr)
+    missing = missing_install()
+    if missing:
+        print(missing, file=sys.stderr)
         return 2
-
-    import contextlib
-
-    import domain_coordinator
-
-    chosen = (
-        contextlib.nullcontext(args.domain_id)
-        if args.domain_id is not None
-        else domain_coordinator.domain_id()
-    )
-    with chosen as domain, tempfile.TemporaryDirectory() as tmp:
-        os.environ["ROS_DOMAIN_ID"] = str(domain)
-        os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    with ros_domain(args.domain_id), tempfile.TemporaryDirectory() as tmp:
         out_dir = Path(tmp)
-        env = dict(os.environ)
-        command = [str(NODE_EXECUTABLE)]
-        if args.node_source is not None:
-            env["PYTHONPATH"] = f"{args.node_source.resolve()}:{env.get('PYTHONPATH', '')}"
-            command = [
-                sys.executable,
-                "-c",
-                "import sys; from hexapod_workspace.ros import main; sys.exit(main(sys.argv))",
-            ]
-        with (out_dir / "node.log").open("wb") as out:
-            node = subprocess.Popen(
-                [
-                    *command,
-                    "--ros-args",
-                    "--params-file",
-                    str(REPO / "config" / "example_gpm.yaml"),
-                    "-p",
-                    f"recording.directory:={tmp}",
-                    *args.node_arg,
-                ],
-                stdout=out,
-                stderr=subprocess.STDOUT,
-                env=env,
-                cwd=tmp,  # not this checkout: "-c" puts the working directory first on sys.path
-            )
-            floor = subprocess.Popen(
-                [sys.executable, "-c", FLOOR_SERVER], stdout=out, stderr=subprocess.STDOUT
-            )
+        node = start_node(out_dir, args.node_arg, args.node_source)
+        floor = start_python(FLOOR_SERVER, out_dir / "node.log")
         try:
             return run(args, node, out_dir)
         finally:
-            for process in (node, floor):
-                if process.poll() is None:
-                    process.send_signal(signal.SIGINT)
-                    try:
-                        process.wait(timeout=30)
-                    except subprocess.TimeoutExpired:
-                        process.kill()
-                        process.wait()
-            log_text = (out_dir / "node.log").read_text(errors="replace")
-            if "Traceback" in log_text:
-                print(log_text[-3000:], file=sys.stderr)
+            stop((node, floor))
+            if print_failures([out_dir / "node.log"]):
+                print("the node's log has a traceback (above): these figures are not valid")
 
 
 if __name__ == "__main__":

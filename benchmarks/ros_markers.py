@@ -21,8 +21,6 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import signal
-import subprocess
 import sys
 import tempfile
 import threading
@@ -30,11 +28,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _node import missing_install, ros_domain, start_node, stop  # same folder
 
-REPO = Path(__file__).resolve().parents[1]
-NODE_EXECUTABLE = (
-    REPO / "install" / "hexapod_workspace" / "lib" / "hexapod_workspace" / "workspace_node"
-)
 NODE = "/hexapod_workspace"
 CURRENT_POSE = "/bench_current_pose"
 POSE_RATE = 50.0
@@ -53,52 +48,18 @@ def main(argv: list[str] | None = None) -> int:
         "`git archive` of the commit before ~/markers, for a same-machine before/after)",
     )
     args = parser.parse_args(argv)
-    if not NODE_EXECUTABLE.is_file():
-        print(f"{NODE_EXECUTABLE} missing: run `make ros` first", file=sys.stderr)
+    missing = missing_install()
+    if missing:
+        print(missing, file=sys.stderr)
         return 2
-    import domain_coordinator
-
-    with domain_coordinator.domain_id() as domain, tempfile.TemporaryDirectory() as tmp:
-        os.environ["ROS_DOMAIN_ID"] = str(domain)
-        os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-        env = dict(os.environ)
-        command = [str(NODE_EXECUTABLE)]
-        if args.node_source is not None:
-            env["PYTHONPATH"] = f"{args.node_source.resolve()}:{env.get('PYTHONPATH', '')}"
-            command = [
-                sys.executable,
-                "-c",
-                "import sys; from hexapod_workspace.ros import main; sys.exit(main(sys.argv))",
-            ]
-        with (Path(tmp) / "node.log").open("wb") as out:
-            node = subprocess.Popen(
-                [
-                    *command,
-                    "--ros-args",
-                    "--params-file",
-                    str(REPO / "config" / "example_gpm.yaml"),
-                    "-p",
-                    f"recording.directory:={tmp}",
-                    "-p",
-                    f"motion.current_pose_topic:={CURRENT_POSE}",
-                ],
-                stdout=out,
-                stderr=subprocess.STDOUT,
-                env=env,
-                # not the repository: `python -c` puts the working directory first on sys.path,
-                # before PYTHONPATH, so --node-source would run this tree's package instead
-                cwd=tmp,
-            )
+    with ros_domain() as domain, tempfile.TemporaryDirectory() as tmp:
+        node = start_node(
+            Path(tmp), ["-p", f"motion.current_pose_topic:={CURRENT_POSE}"], args.node_source
+        )
         try:
             return run(args, domain)
         finally:
-            if node.poll() is None:
-                node.send_signal(signal.SIGINT)
-                try:
-                    node.wait(timeout=30)
-                except subprocess.TimeoutExpired:
-                    node.kill()
-                    node.wait()
+            stop([node])
 
 
 def run(args: argparse.Namespace, domain: int) -> int:

@@ -100,18 +100,23 @@ def test_check_poses_request_and_response(check_result: constraints.CheckResult)
 
 
 def test_reachability_result_success_and_invalid(check_result: constraints.CheckResult) -> None:
-    ok = messages.reachability_result_fields(
-        check_result,
-        position=check_result.position,
-        angles=check_result.angles[2],
-        stamp_ns=1_500_000_000_123,
-        frame_id="base",
-        request_id="cmd-7",
-        index=2,
-    )
+    command = {
+        "position": check_result.position,
+        "angles": check_result.angles[2],
+        "stamp_ns": 1_500_000_000_123,
+        "frame_id": "base",
+        "request_id": "cmd-7",
+        "index": 2,
+    }
+    ok = messages.reachability_result_fields(check_result, **command)
     assert ok["success"] is True
     assert ok["header"] == {"stamp": {"sec": 1500, "nanosec": 123}, "frame_id": "base"}
     assert ok["check"]["reachable"] == bool(check_result.reachable[2])
+    # the command stream's form: every pose's fields computed once for the whole result
+    pose_checks = messages.pose_checks_fields(check_result)
+    given = messages.reachability_result_fields(check_result, **command, check=pose_checks[2])
+    assert given == ok
+    assert ok["message"].startswith("unreachable: ")  # the pose's violated names in the verdict
     bad = messages.reachability_result_fields(
         None,
         position=[0, 0, 1],

@@ -269,18 +269,23 @@ def reachability_result_fields(
     index: int = 0,
     message: str | None = None,
     names: Sequence[str] = (),
+    check: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """hexapod_workspace_msgs/msg/ReachabilityResult answering one CommandedPose.
 
     ``result=None`` means the command was not checked (invalid, overloaded, or no model):
     ``success`` false, ``message`` the reason, ``check.constraint_names`` the model's rows
-    ``names`` (empty where no model is loaded) with NaN margins.
+    ``names`` (empty where no model is loaded) with NaN margins. ``check``: the pose's PoseCheck
+    fields when the caller has them (``pose_checks_fields(result)[index]``): a caller that answers
+    the poses of one large result one by one computes them once for all, since
+    :func:`pose_check_fields` reads properties of the result that are computed for every pose at
+    each call.
     """
     if result is None:
         check = _failed_pose_check(names)
         verdict = message or "invalid command"
     else:
-        check = pose_check_fields(result, index)
+        check = pose_check_fields(result, index) if check is None else check
         verdict = message or (
             "reachable" if check["reachable"] else "unreachable: " + ", ".join(check["violated"])
         )

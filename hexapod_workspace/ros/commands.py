@@ -1,6 +1,6 @@
 """The CommandedPose stream: every command gets exactly one ReachabilityResult.
 
-The subscription is reliable KEEP_ALL (:data:`~hexapod_workspace.ros.node.COMMAND_QOS`): DDS
+The subscription is reliable KEEP_ALL (:data:`~hexapod_workspace.ros.qos.COMMAND_QOS`): DDS
 never drops a command on the node's side. When the executor hands over one command, the callback
 also takes the commands that arrived since (up to :data:`BATCH`) from the same subscription, as
 the executor would, one after the other, and answers them together: one pass of the executor per
@@ -105,12 +105,20 @@ class CommandStream:
                 members = todo[groups.reshape(-1) == g]
                 self._check_group(state, keys[g], angles, members, verdicts)
         names = constraint_names(state.manipulator)
+        # the PoseCheck fields of each check, computed once for all its poses: one pose's
+        # fields read properties computed for the whole result, so a batch answered pose by
+        # pose would cost its size squared, and the further behind the node, the slower it
+        # would answer
+        checks: dict[int, list[dict[str, Any]]] = {}
         for k, command in enumerate(batch):
             result, index, reason = verdicts[k]
+            if result is not None and id(result) not in checks:
+                checks[id(result)] = messages.pose_checks_fields(result)
             fields = messages.reachability_result_fields(
                 result,
                 index=index,
                 message=reason,
+                check=None if result is None else checks[id(result)][index],
                 position=positions[k],
                 angles=angles[k],
                 stamp_ns=now_ns,

@@ -113,6 +113,7 @@ from .parameters import (
 )
 from .paths import attach as attach_paths
 from .paths import check_poses_from_poses
+from .qos import COMMAND_QOS, SERVICE_QOS_PROFILE
 from .recorder import Recorder
 from .worker import WorkspaceWorker
 from .workspaces import WorkspaceServer
@@ -141,22 +142,6 @@ def _attach_markers(node: WorkspaceNode) -> object:
 
 #: Functions ``attach(node)`` run by :func:`main` after the node is built (one per extension).
 EXTENSIONS: list[Callable[[WorkspaceNode], object]] = [_attach_atlas, _attach_markers]
-#: The commanded-pose subscription: nothing is dropped on the node's side.
-COMMAND_QOS = QoSProfile(
-    history=HistoryPolicy.KEEP_ALL, depth=1, reliability=ReliabilityPolicy.RELIABLE
-)
-#: The services' answers: reliable, volatile, the last 1000 kept until every client has them.
-#: rmw's default keeps 10: under load a client whose answer was lost in transport (a full
-#: shared-memory port) asks again once it sees the gap, and when the node has answered ten other
-#: calls meanwhile the answer is gone and the client waits forever. Fast DDS drops a volatile
-#: writer's sample once every reader has acknowledged it, so the depth costs memory only while
-#: a client lags.
-SERVICE_QOS_PROFILE = QoSProfile(
-    history=HistoryPolicy.KEEP_LAST,
-    depth=1000,
-    reliability=ReliabilityPolicy.RELIABLE,
-    durability=DurabilityPolicy.VOLATILE,
-)
 #: ~/reachability keeps 1000 results (1 s at 1 kHz) for a reliable reader that lags.
 REACHABILITY_DEPTH = 1000
 #: GIL switch interval of the node process, s: a callback waits at most about this long for the

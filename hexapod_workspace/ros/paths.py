@@ -56,6 +56,7 @@ from ..logs.interfaces import relative_name
 from . import cell
 from .conversions import to_message, type_name
 from .parameters import State
+from .qos import SERVICE_QOS_PROFILE
 
 __all__ = [
     "CURRENT_POSE_PARAMETER",
@@ -269,7 +270,11 @@ class PathServices:
         self.parameter_names = [CURRENT_POSE_PARAMETER]
         group = ReentrantCallbackGroup()
         self.service = node.create_service(
-            CheckPath, relative_name("check_path"), self._on_check_path, callback_group=group
+            CheckPath,
+            relative_name("check_path"),
+            self._on_check_path,
+            qos_profile=SERVICE_QOS_PROFILE,
+            callback_group=group,
         )
         self._request_topic, self._response_topic = service_topics(
             node.resolve_service_name(relative_name("check_path"))

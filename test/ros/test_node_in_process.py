@@ -394,3 +394,16 @@ def test_a_blocking_extension_callback_runs_in_a_thread_while_the_executor_serve
     finally:
         executor.shutdown()
         node.destroy_node()
+
+
+def test_the_answering_services_keep_1000_answers_for_a_lagging_client(node):
+    """~/check_path is created outside node.py; its answers must be kept as long as the other
+    services' (rmw's default history keeps 10: a client whose answer was lost in transport
+    would wait forever once ten other calls were answered)."""
+    from hexapod_workspace.ros.qos import SERVICE_QOS_PROFILE
+
+    profiles = {service.srv_name: service.qos_profile for service in node.services}
+    for name in ("check_path", "check_poses", "check_poses_flat"):
+        (profile,) = [p for n, p in profiles.items() if n.endswith(f"/{name}")]
+        assert profile.depth == SERVICE_QOS_PROFILE.depth == 1000, name
+        assert profile.history == SERVICE_QOS_PROFILE.history, name
