@@ -7,7 +7,9 @@ a cylinder column, a sphere) around it: 6 + 3 × 8 = 30 pairs. The same question
 the model without a scene and with it:
 
 * ``check_pose`` (one pose, plain Python numbers) and ``check`` (a batch of poses);
-* the projected workspace (certified ray searches, ψ = 0) at the home position;
+* the projected workspace (certified ray searches, ψ = 0) at the home position, with the
+  scene also with the collision margin evaluated at every probe of the searches
+  (``RaySearch.lazy_collision = False``: the searches before the lazy bound);
 * for reference, the standalone scene kernel ``scene_distances`` on the batch.
 
 Goals: a pose check within 2× of today's, the projected workspace within 3×. Times are the
@@ -30,6 +32,7 @@ from hexapod_workspace.core.constraints import check, check_pose
 from hexapod_workspace.core.params import flatten, load_params_file
 from hexapod_workspace.core.projected import projected_workspace
 from hexapod_workspace.core.rotations import tt_to_matrix
+from hexapod_workspace.core.search import RaySearch
 
 SCENE = {
     "collision": {
@@ -91,6 +94,9 @@ def main() -> None:
             "check": best_of(5, lambda m=model: check(m, angles, position)) / count,
             "projected": best_of(3, lambda m=model: projected_workspace(m, position)),
         }
+    RaySearch.lazy_collision = False
+    eager = best_of(3, lambda: projected_workspace(cell, position))
+    RaySearch.lazy_collision = True
     t_scene = best_of(5, lambda: scene_distances(cell, scene, rotations, position)) / count
     margin = check(cell, angles, position).margins["collision"]
     print(
@@ -107,6 +113,11 @@ def main() -> None:
             f"{key:<12} today {times['today'][key] * factor:9.3f} {unit:<8}"
             f"with scene {times['scene'][key] * factor:9.3f} {unit:<8} ratio {ratio:6.2f}"
         )
+    print(
+        f"projected, scene, collision at every probe {eager * 1e3:9.3f} ms"
+        f"   ratio {eager / times['today']['projected']:6.2f}"
+        f" (lazy/eager {times['scene']['projected'] / eager:.2f})"
+    )
     print(f"scene_distances (standalone, batch) {t_scene * 1e6:8.3f} µs/pose")
     print("goals: check_pose and check ratio <= 2, projected ratio <= 3")
 

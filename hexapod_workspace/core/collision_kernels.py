@@ -85,7 +85,8 @@ TOOL_ON = 4
 TOOL_RADIUS = 5
 TOOL_ENDS = 6  # q0, q1 in the mobile frame (6)
 PLATFORM_ON = 12
-PLATFORM_RECORD = 13  # the platform cylinder in the mobile frame (RECORD_SIZE)
+SEARCH_RATE = 13  # ρ_c: the margin's rate per rad of rotation at a fixed position
+PLATFORM_RECORD = 14  # the platform cylinder in the mobile frame (RECORD_SIZE)
 OBSTACLES = PLATFORM_RECORD + RECORD_SIZE
 OBSTACLE_STRIDE = RECORD_SIZE  # the obstacle's record, base frame
 # Then the pairs: (moving body, other body) per pair, bodies numbered as in collision.scene
@@ -113,7 +114,7 @@ def pack_scene(manipulator: Manipulator) -> NDArray[np.float64]:
     ndarray, shape (K,)
         Layout given by the offsets of this module.
     """
-    from .collision.scene import _tool_ends, pair_table, platform_record
+    from .collision.scene import _tool_ends, pair_table, platform_record, rate_bound
 
     scene = manipulator.collision
     if scene is None or scene.pair_count == 0:
@@ -125,6 +126,7 @@ def pack_scene(manipulator: Manipulator) -> NDArray[np.float64]:
     block[N_PAIRS] = pairs.shape[0]
     block[CLEARANCE] = scene.clearance
     block[LEG_RADIUS] = 0.5 * manipulator.leg_diameter
+    block[SEARCH_RATE] = rate_bound(manipulator, scene).rotation
     if scene.tool is not None:
         block[TOOL_ON] = 1.0
         block[TOOL_RADIUS] = scene.tool.radius

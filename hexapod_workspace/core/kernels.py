@@ -22,6 +22,7 @@ import numpy as np
 from .constraint_table import N_CONSTRAINTS
 from .margin_kernels import FAST_TRIG_LIMIT, ONE_SIZE, check_angles, check_one, margins_rotations
 from .model_layout import (
+    COLLISION_ON,
     ESTIMATE_FLOOR,
     LENGTH_FLOOR,
     LMAX,
@@ -38,6 +39,7 @@ from .search_kernels import KIND_CYLINDRICAL, KIND_TT, MAX_STEP, SAFETY, search_
 
 __all__ = [
     "CACHE_DIRECTORY",
+    "COLLISION_ON",
     "FAST_TRIG_LIMIT",
     "KIND_CYLINDRICAL",
     "KIND_TT",
@@ -130,6 +132,7 @@ def warm_up() -> float:
         np.empty(1),
         np.empty(1, dtype=np.int64),
         np.empty(1, dtype=np.bool_),
+        True,
     )
     torsion_scan(
         model, position, 0.0, 0.0, 1e-3, 0.25, 1e-3, np.empty(8), np.empty(8, dtype=np.bool_)

@@ -110,6 +110,10 @@ class RaySearch:
         ``h_min`` of the module documentation, rad.
     """
 
+    #: Evaluate the collision margin along rays only where its Lipschitz bound cannot decide a
+    #: probe (False: at every probe, as a reference; see ``search_kernels.search_rays``).
+    lazy_collision: bool = True
+
     def __init__(
         self, manipulator: Manipulator, position: NDArray[np.float64], min_step: float = 1e-3
     ) -> None:
@@ -118,6 +122,9 @@ class RaySearch:
         self.min_step = float(min_step)
         self.model = kernels.model_vector(manipulator)
         self.evaluations = 0
+        #: Poses at which the collision margin was evaluated (the ray searches evaluate it only
+        #: where it can change the answer: ``search_kernels.search_rays``).
+        self.collision_evaluations = 0
 
     def margins(self, angles: NDArray[np.float64]) -> NDArray[np.float64]:
         """The margins of poses (n, 3) at the search position; shape (C, n), C constraints."""
@@ -139,6 +146,8 @@ class RaySearch:
             np.empty(count, dtype=np.bool_),
         )
         self.evaluations += count
+        if self.model[kernels.COLLISION_ON] != 0.0:
+            self.collision_evaluations += count
         return margins
 
     def rays(
@@ -177,7 +186,7 @@ class RaySearch:
         violated = np.empty(count)
         limiting = np.empty(count, dtype=np.int64)
         start_feasible = np.empty(count, dtype=np.bool_)
-        evaluations = kernels.search_rays(
+        evaluations, collisions = kernels.search_rays(
             self.model,
             self.position,
             RAY_KINDS[kind],
@@ -191,6 +200,8 @@ class RaySearch:
             violated,
             limiting,
             start_feasible,
+            self.lazy_collision,
         )
         self.evaluations += evaluations
+        self.collision_evaluations += collisions
         return RaySearchResult(feasible, violated, limiting, start_feasible, evaluations)

@@ -17,6 +17,7 @@ from .jit import jit as _jit
 import numpy as np
 from numpy.typing import NDArray
 
+from .collision_kernels import SEARCH_RATE
 from .constraint_table import COLLISION, IK, LEG_LENGTH, N_CONSTRAINTS, TRANSMISSION
 from .margin_kernels import (
     _BLOCK_ROWS,
@@ -33,8 +34,10 @@ from .margin_kernels import (
 )
 from .model_layout import (
     ARCH,
+    COLLISION_ON,
     ESTIMATE_RATE,
     LENGTH_FLOOR,
+    MODEL_SIZE,
     RAY_CONSTANT,
     RAY_DRIVE,
     RAY_TURN,
@@ -231,6 +234,106 @@ def recovery_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> float
 _MARCH, _GUESS, _PLUS, _DONE = 0, 1, 2, 3
 
 
+# ------------------------------------------------------------------------------ lazy collision
+#: Subtracted from the collision margin's lower bound, m: the margin the kernels compute is
+#: itself a lower bound of the true one, below it by at most GJK's tolerance (1e-7 m; gaps
+#: ≤ 1e-8 m where it stagnates), so the bound minus this is also below the value an evaluation
+#: would return at the probe (which keeps the guess phase's decisions those of an evaluation).
+LAZY_SLACK = 1e-6
+#: Along the march, the lazy bound may shorten the certified step to this fraction of the step
+#: the other margins allow before the collision margin is evaluated (a few more cheap probes
+#: instead of many expensive ones).
+LAZY_STEP = 0.5
+
+
+@_helper
+def _lazy_rate(model: NDArray[np.float64]) -> float:
+    """Rate of the collision margin for the lazy bound of :func:`search_rays`, or 0 (no laziness).
+
+    Fixed base joints: ρ_c per rad of rotation at a fixed position (``SEARCH_RATE`` of the
+    packed scene, :func:`hexapod_workspace.core.collision.scene.rate_bound`: the tool and the
+    platform turn about the fixed tool centre point, so their points move at ≤ Ω·r; a leg point
+    A + λ(B − A) with A fixed at ≤ λ|Ḃ| ≤ ρ; obstacles stand still; a pair's signed distance
+    changes at most at the sum of its two bodies' speeds, ≤ ρ_c = max(ρ, r_tool + ρ, platform
+    reach), and so does their minimum). It holds between *any* two orientations at the search
+    position (along the rotation that joins them), with no condition on the other margins.
+    pus/rus: the table's rate with |τ| ≥ τ_lim (:func:`_rate_moving`), valid only along
+    certified march steps (each keeps |τ| ≥ τ_f ≥ τ_lim)."""
+    if model[COLLISION_ON] == 0.0 or model[RAY_TURN + COLLISION] != 0.0:
+        return 0.0
+    if model[ARCH] == 0.0:
+        return float(model[MODEL_SIZE + SEARCH_RATE])
+    return _rate_moving(model, COLLISION, model[TAU_MIN])
+
+
+@_helper
+def _turn_between(anchors: NDArray[np.float64], row: int, rotation: NDArray[np.float64]) -> float:
+    """Angle of the rotation between R_a = anchors[row] and R (both row-major), rad:
+    |R_a − R|_F = 2√2·sin(θ/2) for rotations (rounding is far inside LAZY_SLACK)."""
+    squared = 0.0
+    for i in range(9):
+        d = anchors[row, i] - rotation[i]
+        squared += d * d
+    return 2.0 * math.asin(min(1.0, math.sqrt(squared) / (2.0 * math.sqrt(2.0))))
+
+
+@_helper
+def _lazy_collision(
+    model: NDArray[np.float64],
+    out: NDArray[np.float64],
+    bound: float,
+    reference: float,
+    march: bool,
+) -> bool:
+    """Whether ``bound`` > 0, a lower bound of the collision margin at the probe, may stand in
+    for the margin; if so it is stored in ``out[COLLISION]`` (else that slot stays +inf).
+
+    ``out`` holds the probe's other margins (its collision slot +inf). What the search reads
+    from a probe is monotone in each margin: the verdict (all ≥ 0), the certified step (a
+    minimum of m_c/L_c), the estimate (a minimum of m_c/E_c) and the limiting constraint (the
+    smallest m_c/S_c, first on ties; collision is the last row). The evaluated margin m lies in
+    [bound, +inf], so where a quantity is the same at both ends it is the same at m.
+
+    * The verdict: bound > 0 makes the probe collision-free, as m would.
+    * A feasible march probe: the certified step from ``bound`` is certified (bound ≤ m), and
+      is accepted when it is at least :data:`LAZY_STEP` of the step from ``reference`` (the
+      evaluated margin the bound comes from, a stand-in for the unknown m): a bound from a
+      nearby anchor is taken, one worn down by a long way from its anchor is not.
+    * Any other probe (a violated one, the secant/bisection phase): the estimate and the
+      limiting constraint must be the same at both ends, so the probe is decided exactly as
+      an evaluation would decide it.
+
+    A NaN margin (a leg without a solution) is always evaluated."""
+    if not bound > 0.0:
+        return False
+    feasible = True
+    for c in range(N_CONSTRAINTS):
+        if out[c] != out[c]:
+            return False
+        if out[c] < 0.0:
+            feasible = False
+    if march and feasible:
+        # The certified step is min(S, m/r)·SAFETY (S from the other margins, r the collision
+        # rate), so bound ≥ LAZY_STEP·reference already gives the step LAZY_STEP asks for.
+        if bound >= LAZY_STEP * reference:
+            out[COLLISION] = bound
+            return True
+        out[COLLISION] = reference
+        step = certified_step(model, out)
+        out[COLLISION] = bound
+        same = certified_step(model, out) >= LAZY_STEP * step
+    else:
+        estimate = _estimate(model, out)
+        limiting = -1 if feasible else _limiting_constraint(model, out)
+        out[COLLISION] = bound
+        same = _estimate(model, out) == estimate
+        if same and not feasible:
+            same = _limiting_constraint(model, out) == limiting
+    if not same:
+        out[COLLISION] = np.inf
+    return same
+
+
 @_jit
 def search_rays(
     model: NDArray[np.float64],
@@ -246,7 +349,8 @@ def search_rays(
     violated: NDArray[np.float64],
     limiting: NDArray[np.int64],
     start_feasible: NDArray[np.bool_],
-) -> int:
+    lazy: bool = True,
+) -> tuple[int, int]:
     """First violation along rays (the algorithm of core.search, all rays in lockstep).
 
     Each round takes the next probe of every unfinished ray and evaluates them together with
@@ -254,6 +358,41 @@ def search_rays(
     alone: a march with certified steps, then secant guesses on the distance estimate
     (bisection when a secant step fails to halve the bracket), two probes around each guess,
     the second only when the first is feasible.
+
+    Lazy collision margin
+    ---------------------
+    The collision margin costs tens of times the others (a signed distance per pair of bodies)
+    and along most of a ray decides nothing, so it is evaluated only where it could. With fixed
+    base joints it is Lipschitz in the orientation at the search position with rate
+    L_c = ρ_c per rad (:func:`_lazy_rate`): from its value m₀ at an *anchor* orientation R₀ (an
+    evaluated probe: itself a lower bound of the true margin),
+
+        m_c(R) ≥ m₀ − L_c·∠(R₀ᵀR)                                                  (1)
+
+    for every orientation R, ∠ the rotation angle (:func:`_turn_between`). The anchors are the
+    ray's own last evaluated probe, the most recently evaluated probe of the round and those of
+    the rays on either side (two each way; the rays of a workspace come in order, so
+    neighbours are a fraction of a degree apart); the best bound (1) minus
+    :data:`LAZY_SLACK` is the candidate. With moving base joints (pus/rus) the rate depends on
+    the transmission, which is only known along certified steps: the bound is
+    m₀ − L_c(τ_lim)·|s − s₀| from the ray's own anchor s₀ in the march, dropped after a step
+    floored at ``min_step``, and the secant/bisection phase evaluates every probe.
+
+    Each round evaluates all probes without the collision margin (the block kernel on the
+    model with its scene off), then walks them in order: where :func:`_lazy_collision`
+    accepts the candidate bound it stands in for the margin, else the probe is evaluated with
+    the scene on (the block kernel on that pose: the margin of a search without laziness) and
+    becomes an anchor. **Why nothing is missed**: a probe whose bound is > 0 is collision-free
+    (the bound is below the true margin), and a march step taken from the bound is certified
+    for the collision margin exactly as one taken from the margin itself (a smaller lower bound
+    only shortens it), so the march's guarantee (no violated band wider than ``min_step``
+    stepped over) is unchanged. Violated probes and the secant/bisection phase are decided
+    exactly as with the margin evaluated (same verdict, estimate and limiting constraint).
+    The march may take a few more, shorter steps than without laziness (at least
+    :data:`LAZY_STEP` of the others' step), so a ray's probes can differ from a search with
+    ``lazy=False``; both answers are certified, and agree to the tolerance where the boundary
+    crosses once (``test/test_collision_lazy.py`` compares them and checks both against dense
+    sampling).
 
     Parameters
     ----------
@@ -270,11 +409,16 @@ def search_rays(
         Bracket width at which the search stops; shortest march step (rad).
     feasible, violated, limiting, start_feasible : ndarray, shape (n,)
         Outputs, see core.search.RaySearchResult.
+    lazy : bool
+        Evaluate the collision margin only where it can change the search (above).
 
     Returns
     -------
-    int
+    evaluations : int
         Poses evaluated.
+    collision_evaluations : int
+        Poses at which the collision margin was evaluated (``evaluations`` with a scene and
+        ``lazy=False``, 0 without a scene).
     """
     count = origins.shape[0]
     phase = np.zeros(count, dtype=np.int64)
@@ -300,6 +444,26 @@ def search_rays(
     r = np.empty(9)
     half = 0.25 * tolerance
     evaluations = 0
+    collisions = 0
+    # Lazy collision margin: the model with its scene off, the margins of every probe of a
+    # round, and per ray the last evaluated collision margin (anchor_s NaN: none usable).
+    collide = model[COLLISION_ON] != 0.0
+    rate_c = _lazy_rate(model) if lazy else 0.0
+    lazy = rate_c > 0.0
+    everywhere = model[ARCH] == 0.0  # (1) holds for every s, not only along certified steps
+    plain = model.copy()  # (a copy of a few hundred floats per call)
+    if lazy:
+        plain[COLLISION_ON] = 0.0
+    margins = np.empty((count, N_CONSTRAINTS))
+    at = np.empty(count)
+    anchor_s = np.full(count, np.nan)  # per ray: s, a lower bound of the margin there and
+    anchor_value = np.zeros(count)  # the evaluated margin that bound comes from
+    anchor_reference = np.zeros(count)
+    posed = np.zeros(count, dtype=np.bool_)  # per ray: its last evaluated pose and margin
+    posed_value = np.zeros(count)
+    anchor_r = np.zeros((count, 9))
+    rotation = np.empty(9)
+    recent = 0
     while True:
         # The next probe of every unfinished ray.
         probes = 0
@@ -328,61 +492,119 @@ def search_rays(
                 probe = plus[ray]
             _ray_angles(kind, origins[ray], directions[ray], probe, angles, probes)
             rays[probes] = ray
+            at[probes] = probe
             probes += 1
         if probes == 0:
             break
         evaluations += probes
+        # Margins of every probe, the collision margin left out where lazy (its own pass).
         for block in range(0, probes, BLOCK):
             size = min(BLOCK, probes - block)
-            _check_block(model, angles, position, block, size, work, scratch, out, r)
+            _check_block(plain, angles, position, block, size, work, scratch, out, r)
             for m in range(size):
-                ray = rays[block + m]
                 for slot in range(N_CONSTRAINTS):
-                    out[slot] = work[slot * BLOCK + m]
-                ok = _feasible(out)
-                estimate = _estimate(model, out)
-                state = phase[ray]
-                if state == _MARCH:
-                    if not ok:
-                        violated[ray] = s[ray]
-                        high_value[ray] = estimate
-                        limiting[ray] = _limiting_constraint(model, out)
-                        if first[ray]:
-                            start_feasible[ray] = False
-                            phase[ray] = _DONE
-                        else:
-                            phase[ray] = _GUESS
+                    margins[block + m, slot] = work[slot * BLOCK + m]
+        if lazy:
+            for n in range(probes):
+                ray = rays[n]
+                for slot in range(N_CONSTRAINTS):
+                    out[slot] = margins[n, slot]
+                march = phase[ray] == _MARCH
+                # The ray's own anchor first (no trigonometry: the turn is at most |Δs|).
+                since = anchor_s[ray]
+                if since == since and (everywhere or march):
+                    bound = anchor_value[ray] - rate_c * abs(at[n] - since) - LAZY_SLACK
+                    if _lazy_collision(model, out, bound, anchor_reference[ray], march):
+                        margins[n, COLLISION] = bound
                         continue
-                    first[ray] = False
-                    feasible[ray] = s[ray]
-                    low_value[ray] = estimate
-                    step = max(certified_step(model, out), min_step)
-                    if s[ray] >= s_end[ray]:
+                if everywhere:  # then the evaluated poses of nearby rays, by their turn
+                    _tt_matrix(angles[n, 0], angles[n, 1], angles[n, 2], rotation)
+                    bound = -np.inf
+                    reference = np.inf
+                    for candidate in (ray, recent, ray - 1, ray + 1, ray - 2, ray + 2):
+                        if 0 <= candidate < count and posed[candidate]:
+                            turn = _turn_between(anchor_r, candidate, rotation)
+                            value = posed_value[candidate] - rate_c * turn
+                            if value > bound:
+                                bound = value
+                                reference = posed_value[candidate]
+                    bound -= LAZY_SLACK
+                    if _lazy_collision(model, out, bound, reference, march):
+                        margins[n, COLLISION] = bound
+                        anchor_s[ray] = at[n]  # a lower bound at s is an anchor of (1) too
+                        anchor_value[ray] = bound
+                        anchor_reference[ray] = reference
+                        continue
+                # Evaluated: the block kernel on this one pose (the margin of a search without
+                # laziness), which becomes the ray's anchor.
+                _check_block(model, angles, position, n, 1, work, scratch, out, r)
+                value = work[COLLISION * BLOCK]
+                margins[n, COLLISION] = value
+                usable = value == value
+                anchor_s[ray] = at[n] if usable else np.nan
+                anchor_value[ray] = value
+                anchor_reference[ray] = value
+                if everywhere:
+                    for i in range(9):
+                        anchor_r[ray, i] = rotation[i]
+                    posed[ray] = usable
+                    posed_value[ray] = value
+                    if usable:
+                        recent = ray
+                collisions += 1
+        elif collide:
+            collisions += probes
+        for n in range(probes):
+            ray = rays[n]
+            for slot in range(N_CONSTRAINTS):
+                out[slot] = margins[n, slot]
+            ok = _feasible(out)
+            estimate = _estimate(model, out)
+            state = phase[ray]
+            if state == _MARCH:
+                if not ok:
+                    violated[ray] = s[ray]
+                    high_value[ray] = estimate
+                    limiting[ray] = _limiting_constraint(model, out)
+                    if first[ray]:
+                        start_feasible[ray] = False
                         phase[ray] = _DONE
                     else:
-                        s[ray] = min(s[ray] + step, s_end[ray])
-                elif state == _GUESS:  # the probe below the guess
-                    if not ok:
-                        violated[ray] = minus[ray]
-                        high_value[ray] = estimate
-                        limiting[ray] = _limiting_constraint(model, out)
-                        bisect[ray] = (violated[ray] - feasible[ray]) > 0.5 * width[ray]
-                    else:
-                        minus_value[ray] = estimate
-                        phase[ray] = _PLUS
-                else:  # the probe above the guess
-                    if not ok:
-                        feasible[ray] = minus[ray]
-                        low_value[ray] = minus_value[ray]
-                        violated[ray] = plus[ray]
-                        high_value[ray] = estimate
-                        limiting[ray] = _limiting_constraint(model, out)
-                    else:
-                        feasible[ray] = plus[ray]
-                        low_value[ray] = estimate
+                        phase[ray] = _GUESS
+                    continue
+                first[ray] = False
+                feasible[ray] = s[ray]
+                low_value[ray] = estimate
+                certified = certified_step(model, out)
+                step = max(certified, min_step)
+                if step > certified and not everywhere:
+                    anchor_s[ray] = np.nan  # (1) does not reach over an uncertified step
+                if s[ray] >= s_end[ray]:
+                    phase[ray] = _DONE
+                else:
+                    s[ray] = min(s[ray] + step, s_end[ray])
+            elif state == _GUESS:  # the probe below the guess
+                if not ok:
+                    violated[ray] = minus[ray]
+                    high_value[ray] = estimate
+                    limiting[ray] = _limiting_constraint(model, out)
                     bisect[ray] = (violated[ray] - feasible[ray]) > 0.5 * width[ray]
-                    phase[ray] = _GUESS
-    return evaluations
+                else:
+                    minus_value[ray] = estimate
+                    phase[ray] = _PLUS
+            else:  # the probe above the guess
+                if not ok:
+                    feasible[ray] = minus[ray]
+                    low_value[ray] = minus_value[ray]
+                    violated[ray] = plus[ray]
+                    high_value[ray] = estimate
+                    limiting[ray] = _limiting_constraint(model, out)
+                else:
+                    feasible[ray] = plus[ray]
+                    low_value[ray] = estimate
+                bisect[ray] = (violated[ray] - feasible[ray]) > 0.5 * width[ray]
+                phase[ray] = _GUESS
+    return evaluations, collisions
 
 
 @_jit

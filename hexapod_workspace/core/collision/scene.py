@@ -259,7 +259,7 @@ def _segment_record(
 def _scene_kernel(
     rotations: NDArray[np.float64],
     positions: NDArray[np.float64],
-    base_joints: NDArray[np.float64],
+    base_ends: NDArray[np.float64],
     platform_joints: NDArray[np.float64],
     leg_radius: float,
     tool_ends: NDArray[np.float64],
@@ -272,7 +272,8 @@ def _scene_kernel(
     best_distance: NDArray[np.float64],
     best_pair: NDArray[np.int64],
 ) -> None:
-    """Per pose: fill the moving bodies (rows 0–7 of ``bodies``), then the closest pair.
+    """Per pose: fill the moving bodies (rows 0–7 of ``bodies``; leg k from
+    ``base_ends[pose, k]``), then the closest pair.
 
     Unless ``all_pairs``, pairs are visited by increasing lower bound (the signed distance of
     capsules that hold the two bodies: ≤ sd, by inclusion; exact for capsule pairs) and the
@@ -288,7 +289,7 @@ def _scene_kernel(
         p = positions[pose]
         for leg in range(6):
             b = _transform(r, platform_joints[leg], p)
-            _segment_record(bodies[leg], base_joints[leg], b, leg_radius)
+            _segment_record(bodies[leg], base_ends[pose, leg], b, leg_radius)
         if tool_ends.shape[0] == 2:
             q0 = _transform(r, tool_ends[0], p)
             q1 = _transform(r, tool_ends[1], p)
@@ -346,7 +347,9 @@ def scene_distances(
     Parameters
     ----------
     manipulator : Manipulator
-        Base joints a_i (base frame), platform joints b_i (mobile frame), leg diameter.
+        Leg architecture (the legs' base-side ends come from
+        :func:`hexapod_workspace.core.legs.leg_endpoints`), platform joints b_i (mobile frame),
+        leg diameter.
     scene : CollisionScene
         Clearance, platform and tool bodies, obstacles in the base frame
         (:func:`hexapod_workspace.core.collision.params.collision_scene`).
@@ -385,6 +388,11 @@ def scene_distances(
             first = int(np.flatnonzero(~np.isfinite(values.reshape(count, -1)).all(axis=1))[0])
             msg = f"{name}: expected finite values, pose {first} is {values[first].tolist()}"
             raise InputError(msg)
+    # The legs' base-side ends where the architecture puts them (a slide's joint, a crank's end;
+    # NaN for a leg without an inverse-kinematics solution, whose margin is then NaN).
+    from ..legs import leg_endpoints
+
+    base_ends, _ = leg_endpoints(manipulator, rotations, positions)
     pairs, names = pair_table(scene)
     bodies = np.zeros((_FIRST_OBSTACLE + len(scene.obstacles), RECORD_SIZE))
     for k, obstacle in enumerate(scene.obstacles):
@@ -399,7 +407,7 @@ def scene_distances(
         _scene_kernel(
             np.ascontiguousarray(rotations),
             np.ascontiguousarray(positions),
-            np.ascontiguousarray(manipulator.base_joints),
+            np.ascontiguousarray(base_ends),
             np.ascontiguousarray(manipulator.platform_joints),
             0.5 * manipulator.leg_diameter,
             tool_ends,
@@ -415,6 +423,10 @@ def scene_distances(
     else:
         margin[:] = np.inf
         chosen[:] = -1
+    # As the compiled kernels: a pose with a leg without a solution has no margin and no pair.
+    unsolved = np.isnan(base_ends).any(axis=(1, 2))
+    margin[unsolved] = np.nan
+    chosen[unsolved] = -1
     return SceneDistances(
         margin=margin - scene.clearance,
         pair=chosen,
