@@ -359,41 +359,6 @@ def search_rays(
     (bisection when a secant step fails to halve the bracket), two probes around each guess,
     the second only when the first is feasible.
 
-    Lazy collision margin
-    ---------------------
-    The collision margin costs tens of times the others (a signed distance per pair of bodies)
-    and along most of a ray decides nothing, so it is evaluated only where it could. With fixed
-    base joints it is Lipschitz in the orientation at the search position with rate
-    L_c = ρ_c per rad (:func:`_lazy_rate`): from its value m₀ at an *anchor* orientation R₀ (an
-    evaluated probe: itself a lower bound of the true margin),
-
-        m_c(R) ≥ m₀ − L_c·∠(R₀ᵀR)                                                  (1)
-
-    for every orientation R, ∠ the rotation angle (:func:`_turn_between`). The anchors are the
-    ray's own last evaluated probe, the most recently evaluated probe of the round and those of
-    the rays on either side (two each way; the rays of a workspace come in order, so
-    neighbours are a fraction of a degree apart); the best bound (1) minus
-    :data:`LAZY_SLACK` is the candidate. With moving base joints (pus/rus) the rate depends on
-    the transmission, which is only known along certified steps: the bound is
-    m₀ − L_c(τ_lim)·|s − s₀| from the ray's own anchor s₀ in the march, dropped after a step
-    floored at ``min_step``, and the secant/bisection phase evaluates every probe.
-
-    Each round evaluates all probes without the collision margin (the block kernel on the
-    model with its scene off), then walks them in order: where :func:`_lazy_collision`
-    accepts the candidate bound it stands in for the margin, else the probe is evaluated with
-    the scene on (the block kernel on that pose: the margin of a search without laziness) and
-    becomes an anchor. **Why nothing is missed**: a probe whose bound is > 0 is collision-free
-    (the bound is below the true margin), and a march step taken from the bound is certified
-    for the collision margin exactly as one taken from the margin itself (a smaller lower bound
-    only shortens it), so the march's guarantee (no violated band wider than ``min_step``
-    stepped over) is unchanged. Violated probes and the secant/bisection phase are decided
-    exactly as with the margin evaluated (same verdict, estimate and limiting constraint).
-    The march may take a few more, shorter steps than without laziness (at least
-    :data:`LAZY_STEP` of the others' step), so a ray's probes can differ from a search with
-    ``lazy=False``; both answers are certified, and agree to the tolerance where the boundary
-    crosses once (``test/test_collision_lazy.py`` compares them and checks both against dense
-    sampling).
-
     Parameters
     ----------
     model : ndarray, shape (MODEL_SIZE,)
@@ -419,6 +384,41 @@ def search_rays(
     collision_evaluations : int
         Poses at which the collision margin was evaluated (``evaluations`` with a scene and
         ``lazy=False``, 0 without a scene).
+
+    Notes
+    -----
+    *Lazy collision margin.* The collision margin costs tens of times the others (a signed
+    distance per pair of bodies) and along most of a ray decides nothing, so it is evaluated
+    only where it could. With fixed base joints it is Lipschitz in the orientation at the
+    search position with rate L_c = ρ_c per rad (``_lazy_rate``): from its value m₀ at an
+    *anchor* orientation R₀ (an evaluated probe: itself a lower bound of the true margin),
+
+        m_c(R) ≥ m₀ − L_c·∠(R₀ᵀR)                                                  (1)
+
+    for every orientation R, ∠ the rotation angle (``_turn_between``); along a ray
+    ∠ ≤ |s − s₀| (ω ≤ 1). The bound tried first is the ray's own anchor, m₀ − L_c·|s − s₀| (no
+    trigonometry); a lower bound accepted at s is itself an anchor of (1) for the later probes.
+    Then the last evaluated poses of the rays on either side (two each way; a workspace's rays
+    come in order, a fraction of a degree apart) and of the most recently evaluated ray, by
+    their rotation angle. Each bound is lowered by ``LAZY_SLACK``. With moving base joints
+    (pus/rus) the rate depends on the transmission, which is only known along certified steps:
+    only the ray's own anchor is used, with L_c(τ_lim), in the march, dropped after a step
+    floored at ``min_step``; the secant/bisection phase evaluates every probe.
+
+    Each round evaluates all probes without the collision margin (the block kernel on the
+    model with its scene off), then walks them in order: where ``_lazy_collision`` accepts a
+    bound it stands in for the margin, else the probe is evaluated with the scene on (the block
+    kernel on that pose: the margin of a search without laziness) and becomes an anchor.
+    **Why nothing is missed**: a probe whose bound is > 0 is collision-free (the bound is below
+    the true margin), and a march step taken from the bound is certified for the collision
+    margin exactly as one taken from the margin itself (a smaller lower bound only shortens
+    it), so the march's guarantee (no violated band wider than ``min_step`` stepped over) is
+    unchanged. Violated probes and the secant/bisection phase are decided exactly as with the
+    margin evaluated (same verdict, estimate and limiting constraint). The march may take a few
+    more, shorter steps (each at least ``LAZY_STEP`` of the step from the evaluated margin the
+    bound comes from), so a ray's probes can differ from a search with ``lazy=False``; both
+    answers are certified, and agree to the tolerance where the boundary crosses once
+    (``test/test_collision_lazy.py`` compares them and checks both against dense sampling).
     """
     count = origins.shape[0]
     phase = np.zeros(count, dtype=np.int64)
