@@ -555,6 +555,11 @@ class PoseCheck(NamedTuple):
     limiting_leg: int
 
 
+#: Builds a PoseCheck from the kernel's tuple of its fields without the keyword handling of
+#: ``PoseCheck(...)`` (a NamedTuple is a tuple: what ``PoseCheck._make`` does, minus a call).
+_POSE_CHECK = tuple.__new__
+
+
 def check_pose(
     manipulator: Manipulator,
     phi: float,
@@ -597,18 +602,8 @@ def check_pose(
             or math.sqrt(x * x + y * y + z * z) > MAX_POSITION_NORM
         ):
             validate_position(manipulator, values)  # raises, with the same reason as check()
-    result = np.empty(kernels.ONE_SIZE)
-    kernels.check_one(kernels.model_vector(manipulator), *angles, x, y, z, result)
-    numbers = result.tolist()
-    p_i, p_j, worst, leg, reachable = numbers[2 * N_CONSTRAINTS :]
-    return PoseCheck(
-        reachable != 0.0,
-        tuple(numbers[:N_CONSTRAINTS]),
-        tuple(map(int, numbers[N_CONSTRAINTS : 2 * N_CONSTRAINTS])),
-        (int(p_i), int(p_j)),
-        int(worst),
-        int(leg),
-    )
+    fields = kernels.check_one(kernels.model_vector(manipulator), *angles, x, y, z)
+    return _POSE_CHECK(PoseCheck, fields)
 
 
 def _require_finite_angles(angles: NDArray[np.float64]) -> None:
