@@ -111,6 +111,7 @@ else counts constraints.
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -492,11 +493,36 @@ def rate_bounds(
         speed if ends is None else ends,
     )
     bounds = np.zeros((N_CONSTRAINTS, np.shape(speed)[0]))
-    for k, row in enumerate(CONSTRAINTS):
-        for coefficient, value in zip(row.coefficients(manipulator), quantities, strict=True):
-            if coefficient != 0.0:
-                bounds[k] = bounds[k] + coefficient * value
+    for k, terms in enumerate(_rate_terms(manipulator)):
+        for quantity, coefficient in terms:
+            bounds[k] = bounds[k] + coefficient * quantities[quantity]
     return bounds
+
+
+#: Non-zero rate coefficients of each row by ``id`` of their manipulator (see _rate_terms).
+_RATE_TERMS: dict[int, tuple[tuple[tuple[int, float], ...], ...]] = {}
+
+
+def _rate_terms(manipulator: Manipulator) -> tuple[tuple[tuple[int, float], ...], ...]:
+    """Per row of the table, its (quantity, coefficient) pairs with a non-zero coefficient
+    (quantities in the order V, N, Ω, Q, K, E), for ``manipulator``: evaluated once per
+    manipulator object and kept for its lifetime (it is frozen), as the packed model is; the
+    move certificate asks for them at every round of its bisection."""
+    key = id(manipulator)
+    terms = _RATE_TERMS.get(key)
+    if terms is None:
+        terms = tuple(
+            tuple(
+                (quantity, coefficient)
+                for quantity, coefficient in enumerate(row.coefficients(manipulator))
+                if coefficient != 0.0
+            )
+            for row in CONSTRAINTS
+        )
+        _RATE_TERMS[key] = terms
+        # The id is not reused before the finalizer has removed the entry.
+        weakref.finalize(manipulator, _RATE_TERMS.pop, key, None)
+    return terms
 
 
 def applicable(manipulator: Manipulator) -> tuple[int, ...]:
