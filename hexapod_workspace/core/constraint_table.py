@@ -474,9 +474,11 @@ def rate_bounds(
     actuate: NDArray[np.float64] | None = None,
     crank: NDArray[np.float64] | None = None,
     ends: NDArray[np.float64] | None = None,
+    rows: int | None = None,
 ) -> NDArray[np.float64]:
     """Bounds on how much each margin changes, shape (N_CONSTRAINTS, n), from the rates V, N, Ω,
     Q, K, E of the module documentation (or their integrals over an interval), each shape (n,).
+    With ``rows``, only the first ``rows`` rows of the table (shape (rows, n)).
 
     ``speed·V + turn·N + spin·Ω + actuate·Q + crank·K + ends·E`` per row of the table; a term
     whose coefficient is 0 is left out (so an infinite N, no leg floor, only affects the rows
@@ -492,8 +494,9 @@ def rate_bounds(
         np.zeros_like(speed) if crank is None else crank,
         speed if ends is None else ends,
     )
-    bounds = np.zeros((N_CONSTRAINTS, np.shape(speed)[0]))
-    for k, terms in enumerate(_rate_terms(manipulator)):
+    terms_of_rows = _rate_terms(manipulator)[:rows]
+    bounds = np.zeros((len(terms_of_rows), np.shape(speed)[0]))
+    for k, terms in enumerate(terms_of_rows):
         for quantity, coefficient in terms:
             bounds[k] = bounds[k] + coefficient * quantities[quantity]
     return bounds

@@ -422,7 +422,7 @@ def relative_margins(manipulator: Manipulator, margins: NDArray[np.float64]) -> 
     ----------
     manipulator : Manipulator
     margins : ndarray, shape (C, N)
-        Margins in :data:`CONSTRAINT_NAMES` order.
+        Margins in :data:`CONSTRAINT_NAMES` order: every row of the table, or its first C rows.
 
     Returns
     -------
@@ -431,7 +431,8 @@ def relative_margins(manipulator: Manipulator, margins: NDArray[np.float64]) -> 
         the mean stroke, joint angles over the mean maximum angle, interference over D).
         Dimensionless.
     """
-    scale = kernels.model_vector(manipulator)[kernels.SCALE : kernels.SCALE + N_CONSTRAINTS]
+    rows = min(margins.shape[0], N_CONSTRAINTS)
+    scale = kernels.model_vector(manipulator)[kernels.SCALE : kernels.SCALE + rows]
     return margins / scale[:, None]
 
 
