@@ -491,14 +491,23 @@ def rate_bounds(
         turn,
         spin,
         speed if actuate is None else actuate,
-        np.zeros_like(speed) if crank is None else crank,
+        crank,  # None: K = 0, the term adds nothing
         speed if ends is None else ends,
     )
     terms_of_rows = _rate_terms(manipulator)[:rows]
     bounds = np.zeros((len(terms_of_rows), np.shape(speed)[0]))
+    # The move certificate asks at every round of its bisection: in place, no temporary where
+    # a coefficient is 1. The same sums in the same order (0 + x = x, 1·x = x exactly).
     for k, terms in enumerate(terms_of_rows):
+        row = bounds[k]
         for quantity, coefficient in terms:
-            bounds[k] = bounds[k] + coefficient * quantities[quantity]
+            value = quantities[quantity]
+            if value is None:
+                continue
+            if coefficient == 1.0:
+                row += value
+            else:
+                row += coefficient * value
     return bounds
 
 
