@@ -186,6 +186,20 @@ def test_violated_names_and_limiting_leg(example):
     assert np.all(result.limiting_pair[:, 0] < result.limiting_pair[:, 1])
 
 
+def test_violated_is_computed_once_and_equals_the_margins(example, rng):
+    """Per-pose lists are kept after the first access (O(1) per pose when read pose by pose)
+    and name exactly the negative (or NaN) margins, in table order."""
+    result = check(example, random_angles(rng, 500))
+    violated = result.violated
+    assert result.violated is violated and result.collision_pair is result.collision_pair
+    names = list(result.margins)
+    for k in range(len(result)):
+        expected = [name for name in names if not result.margins[name][k] >= 0.0]
+        assert violated[k] == expected
+        assert (violated[k] == []) == bool(result.reachable[k])
+    assert result.collision_pair == [""] * len(result)  # no scene
+
+
 def test_limiting_leg_is_the_leg_of_the_smallest_margin(example, rng):
     angles = random_angles(rng, 200)
     result = check(example, angles)

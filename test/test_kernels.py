@@ -208,6 +208,25 @@ def test_check_pose_equals_check(example, rng):
     )
 
 
+def test_check_pose_gives_plain_python_fields_equal_to_check(example, rng):
+    """check_pose's fields come straight from the kernel's tuple: plain bool, float and int
+    (what messages and JSON take), legs and pair 1-based as in check()."""
+    angles = _random_poses(rng, 300)
+    batch = check(example, angles)
+    for index in range(angles.shape[0]):
+        one = check_pose(example, *angles[index])
+        assert type(one.reachable) is bool
+        assert len(one.margins) == len(one.limiting_legs) == len(TABLE_NAMES)
+        assert all(type(value) is float for value in one.margins)
+        assert all(type(value) is int for value in one.limiting_legs)
+        assert all(type(value) is int for value in one.limiting_pair)
+        assert type(one.limiting_constraint) is int and type(one.limiting_leg) is int
+        for name, legs in batch.limiting_legs.items():
+            assert one.limiting_legs[TABLE_NAMES.index(name)] == legs[index], name
+        assert one.limiting_pair == tuple(batch.limiting_pair[index].tolist())
+        assert one.limiting_leg == batch.limiting_leg[index]
+
+
 def test_check_pose_rejects_bad_input_like_check(example):
     with pytest.raises(InputError, match="angles: expected finite values, pose 0"):
         check_pose(example, 0.0, math.nan, 0.0)

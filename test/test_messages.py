@@ -256,3 +256,18 @@ def test_pose_check_constants_are_the_constraint_table() -> None:
     constants = re.findall(r'^string ([A-Z_]+)="([a-z_]+)"', text, flags=re.MULTILINE)
     assert [value for _, value in constants] == list(CONSTRAINT_NAMES)
     assert all(name == value.upper() for name, value in constants)
+
+
+def test_segment_check_fields_after_the_result_was_read(manipulator: Manipulator) -> None:
+    """The PathSegmentCheck of one move is built from the dataclass fields only, also after
+    the per-move lists the result keeps (``violated``) have been read."""
+    from hexapod_workspace import check_path
+    from hexapod_workspace.logs import paths as path_fields
+
+    waypoints = manipulator.position + np.array([[0.0, 0.0, 0.0], [0.01, 0.0, 0.0]])
+    angles = np.array([[0.0, 0.0, 0.0], [0.0, 1.2, 0.0]])  # the move ends out of reach
+    segments = check_path(manipulator, waypoints, angles=angles).segments
+    violated = segments.violated  # read first: kept on the result
+    fields = path_fields.segment_check_fields(segments, 0)
+    assert fields["violated"] == violated[0] != []
+    assert fields["ok"] is False

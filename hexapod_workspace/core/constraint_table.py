@@ -111,6 +111,7 @@ else counts constraints.
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -473,9 +474,11 @@ def rate_bounds(
     actuate: NDArray[np.float64] | None = None,
     crank: NDArray[np.float64] | None = None,
     ends: NDArray[np.float64] | None = None,
+    rows: int | None = None,
 ) -> NDArray[np.float64]:
     """Bounds on how much each margin changes, shape (N_CONSTRAINTS, n), from the rates V, N, Ω,
     Q, K, E of the module documentation (or their integrals over an interval), each shape (n,).
+    With ``rows``, only the first ``rows`` rows of the table (shape (rows, n)).
 
     ``speed·V + turn·N + spin·Ω + actuate·Q + crank·K + ends·E`` per row of the table; a term
     whose coefficient is 0 is left out (so an infinite N, no leg floor, only affects the rows
@@ -488,15 +491,50 @@ def rate_bounds(
         turn,
         spin,
         speed if actuate is None else actuate,
-        np.zeros_like(speed) if crank is None else crank,
+        crank,  # None: K = 0, the term adds nothing
         speed if ends is None else ends,
     )
-    bounds = np.zeros((N_CONSTRAINTS, np.shape(speed)[0]))
-    for k, row in enumerate(CONSTRAINTS):
-        for coefficient, value in zip(row.coefficients(manipulator), quantities, strict=True):
-            if coefficient != 0.0:
-                bounds[k] = bounds[k] + coefficient * value
+    terms_of_rows = _rate_terms(manipulator)[:rows]
+    bounds = np.zeros((len(terms_of_rows), np.shape(speed)[0]))
+    # The move certificate asks at every round of its bisection: in place, no temporary where
+    # a coefficient is 1. The same sums in the same order (0 + x = x, 1·x = x exactly).
+    for k, terms in enumerate(terms_of_rows):
+        row = bounds[k]
+        for quantity, coefficient in terms:
+            value = quantities[quantity]
+            if value is None:
+                continue
+            if coefficient == 1.0:
+                row += value
+            else:
+                row += coefficient * value
     return bounds
+
+
+#: Non-zero rate coefficients of each row by ``id`` of their manipulator (see _rate_terms).
+_RATE_TERMS: dict[int, tuple[tuple[tuple[int, float], ...], ...]] = {}
+
+
+def _rate_terms(manipulator: Manipulator) -> tuple[tuple[tuple[int, float], ...], ...]:
+    """Per row of the table, its (quantity, coefficient) pairs with a non-zero coefficient
+    (quantities in the order V, N, Ω, Q, K, E), for ``manipulator``: evaluated once per
+    manipulator object and kept for its lifetime (it is frozen), as the packed model is; the
+    move certificate asks for them at every round of its bisection."""
+    key = id(manipulator)
+    terms = _RATE_TERMS.get(key)
+    if terms is None:
+        terms = tuple(
+            tuple(
+                (quantity, coefficient)
+                for quantity, coefficient in enumerate(row.coefficients(manipulator))
+                if coefficient != 0.0
+            )
+            for row in CONSTRAINTS
+        )
+        _RATE_TERMS[key] = terms
+        # The id is not reused before the finalizer has removed the entry.
+        weakref.finalize(manipulator, _RATE_TERMS.pop, key, None)
+    return terms
 
 
 def applicable(manipulator: Manipulator) -> tuple[int, ...]:

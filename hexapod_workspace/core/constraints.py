@@ -16,9 +16,11 @@ large batches of :func:`check` are split over the available cores.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 import os
+from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, NamedTuple
@@ -48,6 +50,7 @@ __all__ = [
     "pose_margins",
     "relative_margins",
     "segment_distance",
+    "violated_by_name",
     "violated_names",
 ]
 
@@ -347,7 +350,10 @@ class CheckResult:
     def __len__(self) -> int:
         return int(self.reachable.shape[0])
 
-    @property
+    # The per-pose lists below are computed on first access and kept (the result is frozen
+    # and its arrays are the check's answer, not to be written), so that reading them pose by
+    # pose, ``result.violated[k]`` in a loop, costs O(1) per pose and not O(N).
+    @functools.cached_property
     def collision_pair(self) -> list[str]:
         """Per pose, the closest pair of the collision scene ("" without a scene)."""
         if "collision" not in self.limiting_legs:  # no scene: the row does not apply
@@ -355,30 +361,57 @@ class CheckResult:
         names = ("", *self.collision_pairs)
         return [names[k] for k in self.limiting_legs["collision"].tolist()]
 
-    @property
+    @functools.cached_property
     def violated(self) -> list[list[str]]:
         """Per pose, the names of the violated constraints (in :data:`CONSTRAINT_NAMES` order)."""
-        count = len(self)
-        absent = np.full(count, np.inf)
-        return violated_names(
-            np.stack([self.margins.get(name, absent) for name in CONSTRAINT_NAMES])
-        )
+        return violated_by_name(self.margins, len(self))
 
 
-def violated_names(margins: NDArray[np.float64]) -> list[list[str]]:
+def violated_by_name(margins: Mapping[str, NDArray[np.float64]], count: int) -> list[list[str]]:
+    """Names of the negative margins per pose, from margins keyed by constraint name (each
+    shape (N,), N = ``count``; rows of the table that are absent are not violated); NaN is
+    violated. In :data:`CONSTRAINT_NAMES` order."""
+    names = sorted(margins, key=CONSTRAINT_NAMES.index)  # table order
+    if not names:
+        return [[] for _ in range(count)]
+    return violated_names(
+        np.stack([margins[name] for name in names]),
+        [CONSTRAINT_NAMES.index(name) for name in names],
+    )
+
+
+@functools.cache
+def _name_lists(rows: tuple[int, ...]) -> tuple[tuple[str, ...], ...]:
+    """For each bit mask over ``rows`` (bit k: row ``rows[k]`` violated), the names of the
+    violated constraints in table order (built once per set of rows)."""
+    return tuple(
+        tuple(CONSTRAINT_NAMES[row] for k, row in enumerate(rows) if mask >> k & 1)
+        for mask in range(1 << len(rows))
+    )
+
+
+def violated_names(
+    margins: NDArray[np.float64], rows: Sequence[int] | None = None
+) -> list[list[str]]:
     """Names of the negative margins per column of ``margins``, shape (C, N); NaN is violated.
+
+    Parameters
+    ----------
+    margins : ndarray, shape (C, N)
+        Margins in :data:`CONSTRAINT_NAMES` order (C = N_CONSTRAINTS), or only the rows
+        ``rows`` of that order.
+    rows : sequence of int, optional
+        Increasing rows of the table that ``margins`` holds (default: all of them).
 
     Returns
     -------
     list of N lists of str
         In :data:`CONSTRAINT_NAMES` order.
     """
+    rows = tuple(range(len(CONSTRAINT_NAMES))) if rows is None else tuple(rows)
+    names = _name_lists(rows)
     negative = ~(np.asarray(margins) >= 0.0)
-    masks = (negative.T.astype(np.int64) @ (1 << np.arange(len(CONSTRAINT_NAMES)))).tolist()
-    names = [
-        [name for k, name in enumerate(CONSTRAINT_NAMES) if mask >> k & 1]
-        for mask in range(1 << len(CONSTRAINT_NAMES))
-    ]
+    masks = (negative.T.astype(np.int64) @ (1 << np.arange(len(rows)))).tolist()
     return [list(names[mask]) for mask in masks]
 
 
@@ -389,7 +422,7 @@ def relative_margins(manipulator: Manipulator, margins: NDArray[np.float64]) -> 
     ----------
     manipulator : Manipulator
     margins : ndarray, shape (C, N)
-        Margins in :data:`CONSTRAINT_NAMES` order.
+        Margins in :data:`CONSTRAINT_NAMES` order: every row of the table, or its first C rows.
 
     Returns
     -------
@@ -398,7 +431,8 @@ def relative_margins(manipulator: Manipulator, margins: NDArray[np.float64]) -> 
         the mean stroke, joint angles over the mean maximum angle, interference over D).
         Dimensionless.
     """
-    scale = kernels.model_vector(manipulator)[kernels.SCALE : kernels.SCALE + N_CONSTRAINTS]
+    rows = min(margins.shape[0], N_CONSTRAINTS)
+    scale = kernels.model_vector(manipulator)[kernels.SCALE : kernels.SCALE + rows]
     return margins / scale[:, None]
 
 
@@ -555,6 +589,11 @@ class PoseCheck(NamedTuple):
     limiting_leg: int
 
 
+#: Builds a PoseCheck from the kernel's tuple of its fields without the keyword handling of
+#: ``PoseCheck(...)`` (a NamedTuple is a tuple: what ``PoseCheck._make`` does, minus a call).
+_POSE_CHECK = tuple.__new__
+
+
 def check_pose(
     manipulator: Manipulator,
     phi: float,
@@ -597,18 +636,8 @@ def check_pose(
             or math.sqrt(x * x + y * y + z * z) > MAX_POSITION_NORM
         ):
             validate_position(manipulator, values)  # raises, with the same reason as check()
-    result = np.empty(kernels.ONE_SIZE)
-    kernels.check_one(kernels.model_vector(manipulator), *angles, x, y, z, result)
-    numbers = result.tolist()
-    p_i, p_j, worst, leg, reachable = numbers[2 * N_CONSTRAINTS :]
-    return PoseCheck(
-        reachable != 0.0,
-        tuple(numbers[:N_CONSTRAINTS]),
-        tuple(map(int, numbers[N_CONSTRAINTS : 2 * N_CONSTRAINTS])),
-        (int(p_i), int(p_j)),
-        int(worst),
-        int(leg),
-    )
+    fields = kernels.check_one(kernels.model_vector(manipulator), *angles, x, y, z)
+    return _POSE_CHECK(PoseCheck, fields)
 
 
 def _require_finite_angles(angles: NDArray[np.float64]) -> None:

@@ -20,7 +20,7 @@ from .jit import CACHE_DIRECTORY, compile_notice
 import numpy as np
 
 from .constraint_table import N_CONSTRAINTS
-from .margin_kernels import FAST_TRIG_LIMIT, ONE_SIZE, check_angles, check_one, margins_rotations
+from .margin_kernels import FAST_TRIG_LIMIT, check_angles, check_one, margins_rotations
 from .model_layout import (
     COLLISION_ON,
     ESTIMATE_FLOOR,
@@ -44,7 +44,6 @@ __all__ = [
     "KIND_CYLINDRICAL",
     "KIND_TT",
     "MAX_STEP",
-    "ONE_SIZE",
     "ROWS_USED",
     "SAFETY",
     "SCALE",
@@ -115,7 +114,7 @@ def warm_up() -> float:
         pairs,
         np.empty(1, dtype=np.bool_),
     )
-    check_one(model, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, np.empty(ONE_SIZE))
+    check_one(model, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)
     margins_rotations(model, np.eye(3)[None], position[None], True, margins, legs, pairs)
     ones = np.ones(1)
     search_rays(

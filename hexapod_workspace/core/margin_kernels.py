@@ -18,6 +18,7 @@ from .jit import jit as _jit
 
 # isort: split
 import numpy as np
+from numba.np.unsafe.ndarray import to_fixed_tuple
 from numpy.typing import NDArray
 
 from .collision_kernels import SCRATCH_FLOATS, collision_margin
@@ -58,8 +59,10 @@ from .model_layout import (
     PAIR_I,
     PAIR_J,
     QCENTRE,
+    QCOS,
     QMAX,
     QMIN,
+    QSIN,
     RAIL,
     RHO,
     ROWS_USED,
@@ -74,7 +77,7 @@ from .model_layout import (
     B,
 )
 
-__all__ = ["ONE_SIZE", "SCRATCH_ROWS", "check_angles", "check_one", "margins_rotations"]
+__all__ = ["SCRATCH_ROWS", "check_angles", "check_one", "margins_rotations"]
 
 # ------------------------------------------------------------------------------ one pose
 # Slots of the per-pose result vector ``out``.
@@ -84,9 +87,6 @@ OUT_PAIR = 2 * N_CONSTRAINTS  # closest pair (2 slots)
 OUT_SHORTEST = OUT_PAIR + 2  # shortest leg length, m
 OUT_GAP = OUT_SHORTEST + 1  # the collision margin's gap to its upper bound, m (collision_kernels)
 OUT_SIZE = OUT_GAP + 1
-#: Size of :func:`check_one`'s result: margins, legs, pair (2), limiting constraint and leg,
-#: reachable (1.0 or 0.0).
-ONE_SIZE = 2 * N_CONSTRAINTS + 5
 #: First row of the collision margin's working memory in the per-pose scratch.
 _COLLISION_SCRATCH = 8
 #: Rows of the per-pose scratch (6 legs each): leg vector planes, squared length, 1/ℓ², the
@@ -206,9 +206,14 @@ def _pose(
     out[OUT_LEG + BASE_JOINT] = leg_a
     out[OUT_LEG + PLATFORM_JOINT] = leg_b
     out[OUT_SHORTEST] = shortest
-    _pose_collision(model, r, px, py, pz, scratch, out)
+    # The collision and singularity kernels are called only when they are on: passing the
+    # arrays to a call costs about a fifth of a 6-UPS pose, even when it returns at once.
+    if model[COLLISION_ON] != 0.0:
+        _pose_collision(model, r, px, py, pz, scratch, out)
+    else:
+        _no_collision(out)
     out[OUT_LEG + SINGULARITY] = 0
-    out[SINGULARITY] = _pose_singularity(model, r, scratch)
+    out[SINGULARITY] = _pose_singularity(model, r, scratch) if model[SINGULARITY_ON] else np.inf
     if not want_pair or model[INTERFERENCE] == 0.0:
         out[LEG_INTERFERENCE] = np.inf
         out[OUT_LEG + LEG_INTERFERENCE] = 0
@@ -301,6 +306,62 @@ def _pose_singularity(
 
 
 # ------------------------------------------------------------------------------ moving base joints
+@_inline
+def _crank_ik(along: float, across: float, crank: float, length: float) -> float:
+    """The ``ik`` margin of a crank leg, m: min(L − d_min, d_max − L), d_min and d_max the
+    distances from B to the crank circle (``along`` and ``across`` the axial and radial
+    coordinates of B about the crank axis, ``crank`` = r, ``length`` = L); as
+    :mod:`~hexapod_workspace.core.architectures.rus` (√(x² + y²) for its hypot: the same value
+    to an ulp, and no libm call)."""
+    inside = across - crank
+    outside = across + crank
+    return min(
+        length - math.sqrt(along * along + inside * inside),
+        math.sqrt(along * along + outside * outside) - length,
+    )
+
+
+@_inline
+def _crank_angle(
+    a: float,
+    b: float,
+    c: float,
+    branch: float,
+    centre: float,
+    cos_centre: float,
+    sin_centre: float,
+) -> tuple[float, float, float]:
+    """The crank angle q of ``a·cos q + b·sin q = c`` on ``branch`` (±1), rad, in the 2π window
+    centred on ``centre``, with cos q and sin q: one atan2, no other trigonometric call.
+
+    The closed form of :mod:`~hexapod_workspace.core.architectures.rus` is
+    q = φ + branch·γ with φ = atan2(b, a), γ = arccos(c/ρ), ρ = √(a² + b²) (c/ρ clamped to
+    [−1, 1]). With cos φ = a/ρ, sin φ = b/ρ, cos γ = c/ρ and sin γ = √(1 − (c/ρ)²) ≥ 0 (γ in
+    [0, π]), the angle-sum formulas give exactly
+
+        cos q = (a·cos γ − branch·b·sin γ)/ρ,   sin q = (b·cos γ + branch·a·sin γ)/ρ.
+
+    The offset from the centre of the range, δ = q − centre, has cos δ = cos q·cos c +
+    sin q·sin c and sin δ = sin q·cos c − cos q·sin c, so q = centre + atan2(sin δ, cos δ) is the
+    solution in (centre − π, centre + π]. The reference takes [centre − π, centre + π); the two
+    differ only at δ = ±π exactly, where the range margin min(q − q_min, q_max − q) =
+    (q_max − q_min)/2 − π is the same for both. ρ = 0 (B on the crank axis) gives cos q = 1,
+    sin q = 0, as atan2(+0, +0) + arccos(1) = 0 does. Rounding differs from the trigonometric
+    route by a few ulps (ρ-relative products instead of arccos, cos and sin of an angle)."""
+    norm = math.sqrt(a * a + b * b)
+    if norm == 0.0:
+        cos_q, sin_q = 1.0, 0.0
+    else:
+        ratio = min(max(c / norm, -1.0), 1.0)
+        sine = math.sqrt(max(1.0 - ratio * ratio, 0.0))
+        cos_q = (a * ratio - branch * b * sine) / norm
+        sin_q = (b * ratio + branch * a * sine) / norm
+    offset = math.atan2(
+        sin_q * cos_centre - cos_q * sin_centre, cos_q * cos_centre + sin_q * sin_centre
+    )
+    return centre + offset, cos_q, sin_q
+
+
 @_helper
 def _pose_moving(
     model: NDArray[np.float64],
@@ -389,22 +450,13 @@ def _pose_moving(
             hy = dy - along * uy
             hz = dz - along * uz
             across = math.sqrt(hx * hx + hy * hy + hz * hz)
-            ik = min(
-                length - math.hypot(along, across - crank),
-                math.hypot(along, across + crank) - length,
-            )
+            ik = _crank_ik(along, across, crank, length)
             if ik >= 0.0:
-                norm = math.hypot(a, b)
-                ratio = min(max(c / norm, -1.0), 1.0) if norm > 0.0 else 1.0
-                raw = math.atan2(b, a) + branch * math.acos(ratio)
-                centre = model[QCENTRE + k]
-                shifted = raw - centre + math.pi
-                wrapped = shifted - 2.0 * math.pi * math.floor(shifted / (2.0 * math.pi))
-                q = centre + wrapped - math.pi
+                q, cq, sq_ = _crank_angle(
+                    a, b, c, branch, model[QCENTRE + k], model[QCOS + k], model[QSIN + k]
+                )
             else:
-                q = np.nan
-            cq = math.cos(q)
-            sq_ = math.sin(q)
+                q, cq, sq_ = np.nan, np.nan, np.nan
             base_x = model[A + 3 * k] + crank * (cq * ex + sq_ * fx)
             base_y = model[A + 3 * k + 1] + crank * (cq * ey + sq_ * fy)
             base_z = model[A + 3 * k + 2] + crank * (cq * ez + sq_ * fz)
@@ -477,7 +529,10 @@ def _pose_moving(
     out[PLATFORM_JOINT] = m_b
     out[OUT_LEG + PLATFORM_JOINT] = leg_b
     out[OUT_SHORTEST] = model[LENGTH_FLOOR]
-    _pose_collision(model, r, px, py, pz, scratch, out)
+    if model[COLLISION_ON] != 0.0:  # called only when on, as in _pose
+        _pose_collision(model, r, px, py, pz, scratch, out)
+    else:
+        _no_collision(out)
     out[OUT_LEG + SINGULARITY] = 0
     out[OUT_LEG + LEG_INTERFERENCE] = 0
     out[OUT_PAIR] = 0
@@ -494,7 +549,7 @@ def _pose_moving(
             out[COLLISION] = np.nan  # a leg body of an unsolved leg is nowhere
             out[OUT_LEG + COLLISION] = -1.0
         return
-    out[SINGULARITY] = _pose_singularity(model, r, scratch)
+    out[SINGULARITY] = _pose_singularity(model, r, scratch) if model[SINGULARITY_ON] else np.inf
     if not want_pair or model[INTERFERENCE] == 0.0:
         out[LEG_INTERFERENCE] = np.inf
         return
@@ -533,6 +588,14 @@ def _pose_moving(
     out[OUT_LEG + LEG_INTERFERENCE] = PAIR_I[best_pair]
     out[OUT_PAIR] = PAIR_I[best_pair]
     out[OUT_PAIR + 1] = PAIR_J[best_pair]
+
+
+@_inline
+def _no_collision(out: NDArray[np.float64]) -> None:
+    """The collision outputs of a model without a scene: +inf, no pair (−1), no gap."""
+    out[COLLISION] = np.inf
+    out[OUT_LEG + COLLISION] = -1.0
+    out[OUT_GAP] = 0.0
 
 
 @_helper
@@ -868,7 +931,7 @@ def _tt_matrix(phi: float, theta: float, psi: float, r: NDArray[np.float64]) -> 
     r[8] = cb
 
 
-@_helper
+@_inline
 def _limiting_constraint(model: NDArray[np.float64], out: NDArray[np.float64]) -> int:
     """Index of the smallest relative margin (first on ties; NaN wins). Only the rows in use
     (``model[ROWS_USED]``) are read: the others are +inf with a finite positive scale, so they
@@ -883,7 +946,7 @@ def _limiting_constraint(model: NDArray[np.float64], out: NDArray[np.float64]) -
     return index
 
 
-@_helper
+@_inline
 def _feasible(out: NDArray[np.float64]) -> bool:
     """Every margin ≥ 0 (NaN counts as violated)."""
     for c in range(N_CONSTRAINTS):  # noqa: SIM110 - a loop numba compiles, not a generator
@@ -1141,6 +1204,7 @@ def _leg_planes_moving(
     jbx, jby, jbz = model[JB + 3 * k], model[JB + 3 * k + 1], model[JB + 3 * k + 2]
     length, branch, crank = model[LEG + k], model[BRANCH + k], model[CRANK + k]
     qmin, qmax, centre = model[QMIN + k], model[QMAX + k], model[QCENTRE + k]
+    cos_centre, sin_centre = model[QCOS + k], model[QSIN + k]
     tau_min, kf = model[TAU_MIN], float(k)
     rus = model[ARCH] == 2.0
     for n in range(count):
@@ -1158,12 +1222,8 @@ def _leg_planes_moving(
             a = 2.0 * crank * (dx * ex + dy * ey + dz * ez)
             b = 2.0 * crank * (dx * fx + dy * fy + dz * fz)
             c = (dx * dx + dy * dy + dz * dz) + crank * crank - length * length
-            ik = min(length - math.hypot(along, h - crank), math.hypot(along, h + crank) - length)
-            norm = math.hypot(a, b)
-            ratio = min(max(c / norm, -1.0), 1.0) if norm > 0.0 else 1.0
-            shifted = math.atan2(b, a) + branch * math.acos(ratio) - centre + math.pi
-            q = centre + (shifted - 2.0 * math.pi * math.floor(shifted / (2.0 * math.pi))) - math.pi
-            cq, sq_ = math.cos(q), math.sin(q)
+            ik = _crank_ik(along, h, crank, length)
+            q, cq, sq_ = _crank_angle(a, b, c, branch, centre, cos_centre, sin_centre)
             base_x = ox + crank * (cq * ex + sq_ * fx)
             base_y = oy + crank * (cq * ey + sq_ * fy)
             base_z = oz + crank * (cq * ez + sq_ * fz)
@@ -1511,32 +1571,35 @@ def check_one(
     px: float,
     py: float,
     pz: float,
-    result: NDArray[np.float64],
-) -> None:
+) -> tuple[bool, tuple[float, ...], tuple[int, ...], tuple[int, int], int, int]:
     """One pose (φ, θ, ψ) rad at (px, py, pz) m, finite; the fast path of constraints.check_pose.
 
-    Writes ``result`` (ONE_SIZE,): margins (N_CONSTRAINTS), 1-based limiting legs
-    (N_CONSTRAINTS; the interference leg 0 when the check is disabled), closest pair (2, 1-based;
-    0 when disabled), the limiting constraint and its leg, and 1.0 when reachable (else 0.0).
+    Returns the fields of ``constraints.PoseCheck`` as one tuple of plain numbers (numba boxes
+    it in C: cheaper than an output array read back and converted in Python): reachable,
+    margins (N_CONSTRAINTS), 1-based limiting legs (N_CONSTRAINTS; the interference leg 0 when
+    the check is disabled), closest pair (2, 1-based; 0 when disabled), the limiting constraint
+    and its leg.
     """
     scratch = np.empty((SCRATCH_ROWS, 6))
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
     _tt_matrix(phi, theta, psi, r)
     _pose(model, r, px, py, pz, scratch, out, True)
-    enabled = 1.0 if model[INTERFERENCE] != 0.0 else 0.0
-    count = N_CONSTRAINTS
-    for c in range(count):
-        result[c] = out[c]
-        result[count + c] = out[OUT_LEG + c] + 1.0
-    result[count + LEG_INTERFERENCE] *= enabled
-    result[count + SINGULARITY] = 0.0
-    result[2 * count] = (out[OUT_PAIR] + 1.0) * enabled
-    result[2 * count + 1] = (out[OUT_PAIR + 1] + 1.0) * enabled
+    enabled = 1 if model[INTERFERENCE] != 0.0 else 0
+    legs = np.empty(N_CONSTRAINTS, dtype=np.int64)
+    for c in range(N_CONSTRAINTS):
+        legs[c] = int(out[OUT_LEG + c]) + 1
+    legs[LEG_INTERFERENCE] *= enabled
+    legs[SINGULARITY] = 0
     worst = _limiting_constraint(model, out)
-    result[2 * count + 2] = worst
-    result[2 * count + 3] = result[count + worst]
-    result[2 * count + 4] = 1.0 if _feasible(out) else 0.0
+    return (
+        _feasible(out),
+        to_fixed_tuple(out[:N_CONSTRAINTS], N_CONSTRAINTS),
+        to_fixed_tuple(legs, N_CONSTRAINTS),
+        ((int(out[OUT_PAIR]) + 1) * enabled, (int(out[OUT_PAIR + 1]) + 1) * enabled),
+        worst,
+        legs[worst],
+    )
 
 
 @_jit
@@ -1558,6 +1621,7 @@ def margins_rotations(
     out = np.empty(OUT_SIZE)
     r = np.empty(9)
     shared = positions.shape[0] == 1
+    used = int(model[ROWS_USED])
     for n in range(rotations.shape[0]):
         for i in range(3):
             for j in range(3):
@@ -1566,8 +1630,14 @@ def margins_rotations(
         _pose(
             model, r, positions[p, 0], positions[p, 1], positions[p, 2], scratch, out, interference
         )
-        for c in range(N_CONSTRAINTS):
+        for c in range(used):
             margins[c, n] = out[c]
             legs[c, n] = int(out[OUT_LEG + c])
+        if n == 0:
+            # The rows past the last one that applies are the same for every pose (+inf and a
+            # fixed leg): written whole, once, instead of pose by pose.
+            for c in range(used, N_CONSTRAINTS):
+                margins[c, :] = out[c]
+                legs[c, :] = int(out[OUT_LEG + c])
         pairs[n, 0] = int(out[OUT_PAIR])
         pairs[n, 1] = int(out[OUT_PAIR + 1])

@@ -65,7 +65,9 @@ CRANK = BRANCH + 6  # crank lengths r_i, m (rus) (6)
 QMIN = CRANK + 6  # actuator_min, m or rad (6)
 QMAX = QMIN + 6  # actuator_max (6)
 QCENTRE = QMAX + 6  # centre of the crank range (rus), rad (6)
-TAU_MIN = QCENTRE + 6  # limits.transmission_min
+QCOS = QCENTRE + 6  # cos of that centre (rus) (6)
+QSIN = QCOS + 6  # sin of that centre (rus) (6)
+TAU_MIN = QSIN + 6  # limits.transmission_min
 # Rates along the rays for pus/rus (constraint_table): with τ_f a lower bound of |τ_i|,
 # rate = RAY_CONSTANT + RAY_TURN·(1 + 1/τ_f)/LENGTH_FLOOR + RAY_DRIVE/τ_f.
 RAY_DRIVE = TAU_MIN + 1  # (actuate·g + crank/r_min + ends)·ρ, g = 1 (pus) or 1/r_min (rus)
@@ -190,6 +192,8 @@ def _pack_architecture(model: NDArray[np.float64], manipulator: Manipulator, cod
     model[QMIN : QMIN + 6] = manipulator.actuator_min
     model[QMAX : QMAX + 6] = manipulator.actuator_max
     model[QCENTRE : QCENTRE + 6] = 0.5 * (manipulator.actuator_min + manipulator.actuator_max)
+    model[QCOS : QCOS + 6] = np.cos(model[QCENTRE : QCENTRE + 6])
+    model[QSIN : QSIN + 6] = np.sin(model[QCENTRE : QCENTRE + 6])
     model[TAU_MIN] = manipulator.transmission_min
     if code == 1:
         assert manipulator.rail_directions is not None

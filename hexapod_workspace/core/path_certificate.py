@@ -75,7 +75,14 @@ from typing import TypedDict
 import numpy as np
 from numpy.typing import NDArray
 
-from .constraint_table import IK, LEG_LENGTH, N_CONSTRAINTS, TRANSMISSION, rate_bounds
+from .constraint_table import (
+    IK,
+    LEG_LENGTH,
+    N_CONSTRAINTS,
+    TRANSMISSION,
+    applicable,
+    rate_bounds,
+)
 from .constraints import (
     PoseMargins,
     pose_margins,
@@ -103,6 +110,10 @@ class _Certifier:
         self.rho = float(np.max(np.linalg.norm(manipulator.platform_joints, axis=1)))
         self.length_min = float(np.min(manipulator.leg_length_min))
         self.moving = manipulator.architecture != "ups"
+        # Rows past the last one that applies are +inf at every pose: their lower bound is +inf
+        # and they never hold the smallest relative margin, so the fixed-base bounds and the
+        # relative margins are computed on the rows in use only.
+        self.rows = max(applicable(manipulator)) + 1
         self.crank_inverse = (
             1.0 / float(np.min(manipulator.crank_lengths))
             if manipulator.crank_lengths is not None
@@ -128,6 +139,8 @@ class _Certifier:
         of the constraint table (:func:`~hexapod_workspace.core.constraint_table.rate_bounds`)."""
         if self.moving:
             return self._lower_bounds_moving(start, end, width, speed, omega)
+        low = np.full_like(start, np.inf)
+        start, end = start[: self.rows], end[: self.rows]
         travel = speed * width
         length_start, length_end = start[LEG_LENGTH], end[LEG_LENGTH]
         with np.errstate(invalid="ignore", over="ignore"):
@@ -137,9 +150,11 @@ class _Certifier:
             floor = 0.5 * (2.0 * self.length_min + length_start + length_end - travel)
             floor = np.where(low_length >= 0.0, np.maximum(floor, self.length_min), floor)
             turn = np.where(floor > 0.0, travel / np.where(floor > 0.0, floor, 1.0), np.inf)
-            lipschitz_travel = rate_bounds(self.manipulator, travel, turn, omega * width)
-            low: NDArray[np.float64] = np.minimum(
-                np.minimum(start, end), 0.5 * (start + end - lipschitz_travel)
+            lipschitz_travel = rate_bounds(
+                self.manipulator, travel, turn, omega * width, rows=self.rows
+            )
+            np.minimum(
+                np.minimum(start, end), 0.5 * (start + end - lipschitz_travel), out=low[: self.rows]
             )
         low[LEG_LENGTH] = low_length
         return low
@@ -198,7 +213,7 @@ class _Certifier:
         """Smallest relative margin per column of ``margins`` (C, n); NaN → −inf."""
         if margins.shape[1] == 0:
             return np.zeros(0)
-        values = relative_margins(self.manipulator, margins).min(axis=0)
+        values = relative_margins(self.manipulator, margins[: self.rows]).min(axis=0)
         smallest: NDArray[np.float64] = np.where(np.isnan(values), -np.inf, values)
         return smallest
 

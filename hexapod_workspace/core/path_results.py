@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
-from .constraints import CONSTRAINT_NAMES, violated_names
+from .constraints import CONSTRAINT_NAMES, violated_by_name, violated_names
 
 __all__ = [
     "BreakPoint",
@@ -69,10 +70,11 @@ class WaypointChecks:
         absent = np.full(len(self), np.inf)  # rows that do not apply to the architecture
         return np.stack([self.margins.get(name, absent) for name in CONSTRAINT_NAMES])
 
-    @property
+    @functools.cached_property
     def violated(self) -> list[list[str]]:
-        """Per waypoint, the names of the violated constraints."""
-        return violated_names(self.margin_array)
+        """Per waypoint, the names of the violated constraints (computed on first access and
+        kept: the result is frozen, so reading it pose by pose costs O(1) per pose)."""
+        return violated_by_name(self.margins, len(self))
 
 
 @dataclass(frozen=True)
@@ -134,9 +136,10 @@ class SegmentChecks:
     def __len__(self) -> int:
         return int(self.ok.shape[0])
 
-    @property
+    @functools.cached_property
     def violated(self) -> list[list[str]]:
-        """Per move, the constraints violated at its first violation (empty when ok)."""
+        """Per move, the constraints violated at its first violation (empty when ok; computed on
+        first access and kept)."""
         return violated_names(
             np.where(np.isnan(self.violation_margins), 0.0, self.violation_margins)
         )

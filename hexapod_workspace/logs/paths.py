@@ -8,6 +8,7 @@ Units: m, rad; positions and quaternions in the base frame; quaternions ``(x, y,
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
@@ -147,11 +148,14 @@ def segment_checks_fields(segments: SegmentChecks, *, pairs: bool = True) -> lis
 def segment_check_fields(segments: SegmentChecks, index: int = 0) -> dict[str, Any]:
     """PathSegmentCheck of move ``index`` (e.g. the single move of a commanded motion)."""
     window = slice(index, index + 1)
+    # The dataclass fields only: vars() would also hold the per-move lists the result keeps
+    # once they have been read (``violated``), which are not constructor arguments.
+    values = {field.name: getattr(segments, field.name) for field in dataclasses.fields(segments)}
     fields: dict[str, Any] = {
         name: value
         if not isinstance(value, np.ndarray)
         else (value[:, window] if name == "violation_margins" else value[window])
-        for name, value in vars(segments).items()
+        for name, value in values.items()
     }
     single = SegmentChecks(**fields)
     return segment_checks_fields(single)[0]
