@@ -16,6 +16,7 @@ large batches of :func:`check` are split over the available cores.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 import os
@@ -375,11 +376,19 @@ def violated_names(margins: NDArray[np.float64]) -> list[list[str]]:
     """
     negative = ~(np.asarray(margins) >= 0.0)
     masks = (negative.T.astype(np.int64) @ (1 << np.arange(len(CONSTRAINT_NAMES)))).tolist()
-    names = [
-        [name for k, name in enumerate(CONSTRAINT_NAMES) if mask >> k & 1]
-        for mask in range(1 << len(CONSTRAINT_NAMES))
-    ]
+    names = _names_by_mask()
     return [list(names[mask]) for mask in masks]
+
+
+@functools.cache
+def _names_by_mask() -> tuple[tuple[str, ...], ...]:
+    """The violated names of every bit mask over :data:`CONSTRAINT_NAMES` (bit k: row k),
+    built once: 2**C entries, about 0.3 ms, which a node answering a check per command would
+    otherwise pay at each call."""
+    return tuple(
+        tuple(name for k, name in enumerate(CONSTRAINT_NAMES) if mask >> k & 1)
+        for mask in range(1 << len(CONSTRAINT_NAMES))
+    )
 
 
 def relative_margins(manipulator: Manipulator, margins: NDArray[np.float64]) -> NDArray[np.float64]:
