@@ -309,14 +309,20 @@ def priority_prefix(args: argparse.Namespace, role: str = "node") -> list[str]:
     return ["chrt", "--fifo", str(priority)]
 
 
-def role_result(process: subprocess.Popen, timeout: float) -> dict:
-    """What a role process printed (its JSON line); its stderr when it printed none."""
+def role_result(process: subprocess.Popen, timeout: float, required: bool = True) -> dict:
+    """What a role process printed (its JSON line). One that printed none: an error with its
+    stderr, or (not ``required``: a client, which is only load) a result saying it crashed,
+    printed with the run's figures."""
     output = process.communicate(timeout=timeout)[0]
     try:
         return json.loads(output)
     except json.JSONDecodeError:
         errors = process.errors.read_text(errors="replace")  # type: ignore[attr-defined]
-        raise RuntimeError(f"a load process failed: {output!r}\n{errors[-3000:]}") from None
+        if required:
+            raise RuntimeError(f"a load process failed: {output!r}\n{errors[-3000:]}") from None
+        crashed = f"CRASHED (exit {process.returncode}): {errors.strip()[-300:]!r}"
+        nothing = {"n": 0, "p50": math.nan, "p99": math.nan, "max": math.nan}
+        return {"calls": 0, "failures": 0, "reasons": [crashed], "latency_ms": nothing, "cpu_s": 0}
 
 
 def wait_ready(process: subprocess.Popen) -> None:
@@ -492,7 +498,7 @@ def loaded_phase(
     command = role_result(commander_process, args.duration + 120)
     elapsed = time.perf_counter() - start
     after = {k: sum(cpu_seconds(p) for p in v) for k, v in pids.items()}
-    clients = [role_result(p, args.duration + 120) for p in roles]
+    clients = [role_result(p, args.duration + 120, required=False) for p in roles]
     computations.close()
     # the roles report their own CPU time (whole life, setup included)
     before["commander"], after["commander"] = 0.0, command["cpu_s"]
