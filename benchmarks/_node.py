@@ -57,6 +57,8 @@ def start_node(
     ros_args: Sequence[str] = (),
     source: Path | None = None,
     log: Path | None = None,
+    prefix: Sequence[str] = (),
+    options: Sequence[str] = (),
 ) -> subprocess.Popen:
     """Start the node with the example parameters, recording into ``folder``.
 
@@ -70,6 +72,10 @@ def start_node(
         A source tree whose ``hexapod_workspace`` package runs instead of the install space's.
     log : Path, optional
         File for the node's stdout and stderr (default ``folder / "node.log"``).
+    prefix : sequence of str
+        A command that runs the node (``chrt --fifo 50``: a real-time scheduling policy).
+    options : sequence of str
+        The node's own options, before ``--ros-args`` (``--realtime-priority=50``).
     """
     env = dict(os.environ)
     command = [str(NODE_EXECUTABLE)]
@@ -80,7 +86,9 @@ def start_node(
     with (log or folder / "node.log").open("wb") as out:
         return subprocess.Popen(
             [
+                *prefix,
                 *command,
+                *options,
                 "--ros-args",
                 "--params-file",
                 str(PARAMS_FILE),
@@ -95,11 +103,12 @@ def start_node(
         )
 
 
-def start_python(source: str, log: Path) -> subprocess.Popen:
-    """Run ``python -c source`` (a floor server), output appended to ``log``."""
+def start_python(source: str, log: Path, prefix: Sequence[str] = ()) -> subprocess.Popen:
+    """Run ``python -c source`` (a floor server), output appended to ``log``, through the
+    command ``prefix`` (as :func:`start_node`)."""
     with log.open("ab") as out:
         return subprocess.Popen(
-            [sys.executable, "-c", source], stdout=out, stderr=subprocess.STDOUT
+            [*prefix, sys.executable, "-c", source], stdout=out, stderr=subprocess.STDOUT
         )
 
 

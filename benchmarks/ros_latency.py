@@ -43,7 +43,7 @@ NODE = "/hexapod_workspace"
 FLOOR = "/latency_floor/check_poses"
 
 
-def _server_source(node_name: str, setup: str) -> str:
+def server_source(node_name: str, setup: str) -> str:
     """``python -c`` source of an rclpy node ``node_name`` spun by a single-threaded executor
     until SIGINT; ``setup`` (source text) creates its service on ``node``."""
     return f"""
@@ -67,7 +67,7 @@ finally:
 def floor_server_source(service: str, node_name: str) -> str:
     """The reference measured in the same run: the cheapest rclpy server of the same service
     type (single-threaded executor, constant answer, no check), run as ``python -c SOURCE``."""
-    return _server_source(
+    return server_source(
         node_name,
         f"""
 from hexapod_workspace_msgs.srv import CheckPoses
@@ -86,7 +86,7 @@ def flat_floor_server_source(service: str, node_name: str, poses: int = 1000) ->
     request with the same prebuilt answer of ``poses`` poses (every array as large as the
     node's, no check), run as ``python -c SOURCE``: what moving those bytes through rclpy and
     DDS costs."""
-    return _server_source(
+    return server_source(
         node_name,
         f"""
 import array

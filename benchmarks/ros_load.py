@@ -12,10 +12,17 @@ Starts workspace_node from the colcon install space (``make ros``) in a DDS doma
    back to back; this process keeps a 3-D orientation workspace computing (the
    ``~/compute_workspace`` action, or the old service when the node has no action).
 
+3. the floor of the command stream, under the same load: the same commander, clients and goals
+   again, but the commander's stream goes to the cheapest rclpy node that answers each
+   ``CommandedPose`` with a prebuilt ``ReachabilityResult`` of the node's size (its own
+   process, single-threaded executor, same QoS, taking the commands queued behind one in the
+   same callback as the node does): what the machine, rclpy and DDS cost a command at that
+   moment, with no check and no recording (``--no-floor`` leaves it out).
+
 Prints the commands published, answered, missing (loss) and refused as overloaded, the
-publish-to-result latency percentiles (goal: zero loss, p99 <= 10 ms at 1000/s), the clients'
-call latencies, and the CPU seconds of each process over the loaded phase (node, its worker,
-commander, clients). Run it in the ROS environment::
+publish-to-result latency percentiles (goal: zero loss, p99 <= 10 ms at 1000/s) and those of the
+floor, the clients' call latencies, and the CPU seconds of each process over the loaded phase
+(node, its worker, commander, clients). Run it in the ROS environment::
 
     tools/with_ros_env.sh python benchmarks/ros_load.py [--rate 1000] [--duration 10]
 """
@@ -23,6 +30,7 @@ commander, clients). Run it in the ROS environment::
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import math
 import os
@@ -43,11 +51,55 @@ from _node import (
     start_python,
     stop,
 )
-from ros_latency import check_requests, floor_server_source, timed_call  # same folder
+from ros_latency import (  # same folder
+    check_requests,
+    floor_server_source,
+    server_source,
+    timed_call,
+)
 
 NODE = "/hexapod_workspace"
 FLOOR = "/load_floor/check_poses"
 FLOOR_SERVER = floor_server_source(FLOOR, "load_floor")
+_ROLE_NUMBERS = itertools.count()
+#: Namespace of the command stream's floor (a node that echoes a prebuilt result).
+COMMAND_FLOOR = "/load_command_floor"
+COMMAND_FLOOR_SERVER = server_source(
+    "command_floor",
+    f"""
+from hexapod_workspace_msgs.msg import CommandedPose, ReachabilityResult
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+# a result of the size the node sends for the example machine (6-UPS, five constraints)
+answer = ReachabilityResult(success=True, message="reachable")
+answer.header.frame_id = "base"
+answer.check.reachable = True
+answer.check.constraint_names = [
+    "leg_length", "base_joint", "platform_joint", "leg_interference", "singularity"]
+answer.check.margins = [0.01, 0.2, 0.3, 0.04, 0.5]
+answer.check.limiting_leg = 3
+publisher = node.create_publisher(ReachabilityResult, "{COMMAND_FLOOR}/reachability", QoSProfile(
+    history=HistoryPolicy.KEEP_LAST, depth=1000, reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.TRANSIENT_LOCAL))
+
+def echo(command):  # and those queued behind it, as the node takes them (one executor pass)
+    batch = [command]
+    with subscription.handle:
+        while len(batch) < 256:
+            taken = subscription.handle.take_message(CommandedPose, False)
+            if taken is None:
+                break
+            batch.append(taken[0])
+    for command in batch:
+        answer.request_id = command.request_id
+        answer.header.stamp = command.header.stamp
+        answer.position, answer.orientation = command.position, command.orientation
+        publisher.publish(answer)
+
+subscription = node.create_subscription(
+    CommandedPose, "{COMMAND_FLOOR}/commanded_pose", echo,
+    QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE))
+""",
+)
 #: The node's goals under load (zero loss, latency, check_poses against the floor).
 GOAL_P99_MS = 10.0
 GOAL_FLOOR_RATIO = 1.3
@@ -86,8 +138,9 @@ def percentiles_ms(samples_s: list[float] | np.ndarray) -> dict[str, float]:
 # ----------------------------------------------------------------------------- roles
 
 
-def commander(rate: float, duration: float) -> dict:
-    """Publish CommandedPose at ``rate`` Hz for ``duration`` s; time each result."""
+def commander(rate: float, duration: float, target: str = NODE) -> dict:
+    """Publish CommandedPose at ``rate`` Hz for ``duration`` s to the node ``target`` (its
+    namespace and name); time each result."""
     import rclpy
     from hexapod_workspace_msgs.msg import CommandedPose, ReachabilityResult, TiltTorsion
     from rclpy.executors import SingleThreadedExecutor
@@ -115,8 +168,8 @@ def commander(rate: float, duration: float) -> dict:
         received[index] = now
         overloaded[index] = not message.success and "overloaded" in message.message
 
-    node.create_subscription(ReachabilityResult, f"{NODE}/reachability", on_result, qos)
-    publisher = node.create_publisher(CommandedPose, f"{NODE}/commanded_pose", qos)
+    node.create_subscription(ReachabilityResult, f"{target}/reachability", on_result, qos)
+    publisher = node.create_publisher(CommandedPose, f"{target}/commanded_pose", qos)
     executor = SingleThreadedExecutor()
     executor.add_node(node)
     spinner = threading.Thread(target=executor.spin, daemon=True)
@@ -161,12 +214,9 @@ def commander(rate: float, duration: float) -> dict:
         elif time.monotonic() - last[1] > 2.0:  # nothing more is coming
             break
     cpu = time.process_time()
-    executor.shutdown()
-    node.destroy_node()
-    rclpy.try_shutdown()
     answered = ~np.isnan(received)
     latencies = (received - sent)[answered & ~overloaded]
-    return {
+    result = {
         "published": count,
         "publish_rate": count / publish_span,
         "answered": int(answered.sum()),
@@ -180,6 +230,7 @@ def commander(rate: float, duration: float) -> dict:
         "sent": sent.tolist(),
         "latency": np.where(answered & ~overloaded, received - sent, np.nan).tolist(),
     }
+    return report_and_shut_down(result, executor, node)
 
 
 def checker(duration: float) -> dict:
@@ -211,28 +262,67 @@ def checker(duration: float) -> dict:
         if response is None or not response.success:
             failures += 1
             reasons.add("no answer in 30 s" if response is None else response.message)
-    cpu = time.process_time()
-    executor.shutdown()
-    node.destroy_node()
-    rclpy.try_shutdown()
-    return {
+    result = {
         "calls": len(samples),
         "failures": failures,
         "reasons": sorted(reasons),
         "latency_ms": percentiles_ms(samples),
-        "cpu_s": cpu,
+        "cpu_s": time.process_time(),
     }
+    return report_and_shut_down(result, executor, node)
+
+
+def report_and_shut_down(result: dict, executor: object, node: object) -> dict:
+    """Print a role's ``result`` (its JSON line), then shut rclpy down: a crash while rclpy
+    shuts down (seen under load: "terminate called without an active exception") must not
+    lose the figures."""
+    import rclpy
+
+    print(json.dumps(result), flush=True)
+    executor.shutdown()  # type: ignore[attr-defined]
+    node.destroy_node()  # type: ignore[attr-defined]
+    rclpy.try_shutdown()
+    return result
 
 
 # ----------------------------------------------------------------------------- orchestration
 
 
-def spawn_role(role: str, args: argparse.Namespace, out_dir: Path) -> subprocess.Popen:
-    command = [sys.executable, __file__, "--role", role]
+def spawn_role(
+    role: str, args: argparse.Namespace, out_dir: Path, target: str = NODE
+) -> subprocess.Popen:
+    command = [*priority_prefix(args, role), sys.executable, __file__, "--role", role]
+    command += ["--target", target]
     command += ["--rate", str(args.rate), "--duration", str(args.duration)]
-    return subprocess.Popen(
-        command, stdout=subprocess.PIPE, stderr=(out_dir / f"{role}.err").open("wb"), text=True
-    )
+    errors = out_dir / f"{role}-{next(_ROLE_NUMBERS)}.err"
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=errors.open("wb"), text=True)
+    process.errors = errors  # type: ignore[attr-defined]
+    return process
+
+
+def priority_prefix(args: argparse.Namespace, role: str = "node") -> list[str]:
+    """``chrt --fifo N`` for the node and the floor that stands in for it (``--priority N``)
+    and for the commander (``--commander-priority N``); nothing for the other roles."""
+    priority = args.commander_priority if role == "commander" else args.priority
+    if not priority or role not in ("node", "commander"):
+        return []
+    return ["chrt", "--fifo", str(priority)]
+
+
+def role_result(process: subprocess.Popen, timeout: float, required: bool = True) -> dict:
+    """What a role process printed (its JSON line). One that printed none: an error with its
+    stderr, or (not ``required``: a client, which is only load) a result saying it crashed,
+    printed with the run's figures."""
+    output = process.communicate(timeout=timeout)[0]
+    try:
+        return json.loads(output)
+    except json.JSONDecodeError:
+        errors = process.errors.read_text(errors="replace")  # type: ignore[attr-defined]
+        if required:
+            raise RuntimeError(f"a load process failed: {output!r}\n{errors[-3000:]}") from None
+        crashed = f"CRASHED (exit {process.returncode}): {errors.strip()[-300:]!r}"
+        nothing = {"n": 0, "p50": math.nan, "p99": math.nan, "max": math.nan}
+        return {"calls": 0, "failures": 0, "reasons": [crashed], "latency_ms": nothing, "cpu_s": 0}
 
 
 def wait_ready(process: subprocess.Popen) -> None:
@@ -298,7 +388,7 @@ class Computations:
         from rclpy.executors import SingleThreadedExecutor
 
         self.every = every  # s between goal starts (0: back to back)
-        self.node = rclpy.create_node(f"load_compute_{os.getpid()}")
+        self.node = rclpy.create_node(f"load_compute_{os.getpid()}_{next(_ROLE_NUMBERS)}")
         self.executor = SingleThreadedExecutor()
         self.executor.add_node(self.node)
         self.spinner = threading.Thread(target=self.executor.spin, daemon=True)
@@ -388,6 +478,41 @@ class Computations:
         self.node.destroy_node()
 
 
+def loaded_phase(
+    args: argparse.Namespace, node: subprocess.Popen, out_dir: Path, target: str = NODE
+) -> dict:
+    """The commander's stream to ``target`` while the clients call the node's check_poses and
+    3-D goals compute in the node; what each process measured and the CPU split."""
+    computations = Computations(args.compute_every)
+    computations.start()
+    time.sleep(1.0)  # the first computation is under way
+    roles = [spawn_role("checker", args, out_dir) for _ in range(args.clients)]
+    for process in roles:
+        wait_ready(process)
+    commander_process = spawn_role("commander", args, out_dir, target)
+    wait_ready(commander_process)
+    pids = {"node": [node.pid], "worker": children(node.pid)}
+    before = {k: sum(cpu_seconds(p) for p in v) for k, v in pids.items()}
+    load_before = os.getloadavg()[0]
+    start = time.perf_counter()
+    command = role_result(commander_process, args.duration + 120)
+    elapsed = time.perf_counter() - start
+    after = {k: sum(cpu_seconds(p) for p in v) for k, v in pids.items()}
+    clients = [role_result(p, args.duration + 120, required=False) for p in roles]
+    computations.close()
+    # the roles report their own CPU time (whole life, setup included)
+    before["commander"], after["commander"] = 0.0, command["cpu_s"]
+    before["clients"], after["clients"] = 0.0, sum(c["cpu_s"] for c in clients)
+    return {
+        "command": command,
+        "clients": clients,
+        "computations": computations,
+        "elapsed": elapsed,
+        "cpu": {k: after[k] - before[k] for k in after},
+        "load": (load_before, os.getloadavg()[0]),
+    }
+
+
 def run(args: argparse.Namespace, node: subprocess.Popen, out_dir: Path) -> int:
     import rclpy
 
@@ -395,42 +520,32 @@ def run(args: argparse.Namespace, node: subprocess.Popen, out_dir: Path) -> int:
     rclpy.init()
     try:
         idle = idle_phase(args.samples)
-        computations = Computations(args.compute_every)
-        computations.start()
-        time.sleep(1.0)  # the first computation is under way
-        roles = [spawn_role("checker", args, out_dir) for _ in range(args.clients)]
-        for process in roles:
-            wait_ready(process)
-        commander_process = spawn_role("commander", args, out_dir)
-        wait_ready(commander_process)
-        pids = {"node": [node.pid], "worker": children(node.pid)}
-        before = {k: sum(cpu_seconds(p) for p in v) for k, v in pids.items()}
-        start = time.perf_counter()
-        command = json.loads(commander_process.communicate(timeout=args.duration + 120)[0])
-        elapsed = time.perf_counter() - start
-        after = {k: sum(cpu_seconds(p) for p in v) for k, v in pids.items()}
-        clients = [json.loads(p.communicate(timeout=args.duration + 120)[0]) for p in roles]
-        computations.close()
-        if args.timeline is not None:
-            args.timeline.write_text(
-                json.dumps(
-                    {
-                        "sent": command.pop("sent"),
-                        "latency": command.pop("latency"),
-                        "goal_results": computations.finished_at,
-                    }
-                )
-            )
-        # the roles report their own CPU time (whole life, setup included)
-        before["commander"], after["commander"] = 0.0, command["cpu_s"]
-        before["clients"], after["clients"] = 0.0, sum(c["cpu_s"] for c in clients)
+        loaded = loaded_phase(args, node, out_dir)
+        floored = loaded_phase(args, node, out_dir, COMMAND_FLOOR) if args.floor else None
     finally:
         rclpy.try_shutdown()
+    command, clients = loaded["command"], loaded["clients"]
+    computations, elapsed = loaded["computations"], loaded["elapsed"]
+    if args.timeline is not None:
+        timeline = {
+            "sent": command.pop("sent"),
+            "latency": command.pop("latency"),
+            "goal_results": computations.finished_at,
+        }
+        if floored is not None:
+            timeline["floor_sent"] = floored["command"].pop("sent")
+            timeline["floor_latency"] = floored["command"].pop("latency")
+        args.timeline.write_text(json.dumps(timeline))
 
     one, floor, batch, core = idle["one"], idle["floor"], idle["batch"], idle["core"]
     print(f"node: {describe_node(args.node_source)}")
     if args.node_arg:
         print(f"node arguments: {' '.join(args.node_arg)}")
+    if args.priority or args.commander_priority:
+        print(
+            f"SCHED_FIFO priority: node and floor {args.priority or 'none'}, commander "
+            f"{args.commander_priority or 'none'} (0/none: normal scheduling)"
+        )
     floor_ratio = one["p50"] / floor["p50"]
     core_ratio = batch["p50"] / core["p50"]
     latency = command["latency_ms"]
@@ -464,12 +579,20 @@ def run(args: argparse.Namespace, node: subprocess.Popen, out_dir: Path) -> int:
             f"p50 {lat['p50']:.3f} ms  p99 {lat['p99']:.3f} ms"
             + "".join(f"\n  failed: {reason}" for reason in client["reasons"])
         )
-    total = sum(after[k] - before[k] for k in after)
-    split = ", ".join(
-        f"{k} {after[k] - before[k]:.2f} s ({100 * (after[k] - before[k]) / elapsed:.0f}% core)"
-        for k in after
-    )
-    print(f"CPU over {elapsed:.1f} s (2 cores = 200%): {split}; total {total:.2f} s")
+    cpu = loaded["cpu"]
+    split = ", ".join(f"{k} {v:.2f} s ({100 * v / elapsed:.0f}% core)" for k, v in cpu.items())
+    print(f"CPU over {elapsed:.1f} s (2 cores = 200%): {split}; total {sum(cpu.values()):.2f} s")
+    if floored is not None:
+        floor_command = floored["command"]
+        floor_latency = floor_command["latency_ms"]
+        print(
+            f"floor (the same load, the commands answered by a node that echoes a prebuilt "
+            f"result; {floored['computations'].done} goals finished, load average "
+            f"{floored['load'][0]:.2f}-{floored['load'][1]:.2f}): answered "
+            f"{floor_command['answered']}, missing {floor_command['missing']}; publish -> "
+            f"result p50 {floor_latency['p50']:.3f} ms  p99 {floor_latency['p99']:.3f} ms  "
+            f"max {floor_latency['max']:.3f} ms"
+        )
     ok = (
         command["missing"] == 0
         and command["overloaded"] == 0
@@ -506,6 +629,31 @@ def main(argv: list[str] | None = None) -> int:
         "records its 274k-point cloud)",
     )
     parser.add_argument("--role", choices=("commander", "checker"), help=argparse.SUPPRESS)
+    parser.add_argument("--target", default=NODE, help=argparse.SUPPRESS)
+    parser.add_argument(
+        "--priority",
+        type=int,
+        default=0,
+        metavar="N",
+        help="run the node (its --realtime-priority=N; chrt for --node-source) and the "
+        "command stream's floor with the real-time policy SCHED_FIFO at priority N: the node "
+        "scheduled ahead of every other job on the machine; its worker runs at normal "
+        "priority all the same (default 0: normal scheduling)",
+    )
+    parser.add_argument(
+        "--commander-priority",
+        type=int,
+        default=0,
+        metavar="N",
+        help="run the commander (the controller) under SCHED_FIFO at priority N (chrt)",
+    )
+    parser.add_argument(
+        "--no-floor",
+        dest="floor",
+        action="store_false",
+        help="leave out the command stream's floor (the same load with the commands answered "
+        "by a node that echoes a prebuilt result)",
+    )
     parser.add_argument(
         "--node-arg", action="append", default=[], metavar="ARG", help="extra --ros-args"
     )
@@ -531,11 +679,11 @@ def main(argv: list[str] | None = None) -> int:
         help="DDS domain of the run (default: a free one, picked by domain_coordinator)",
     )
     args = parser.parse_args(argv)
-    if args.role == "commander":
-        print(json.dumps(commander(args.rate, args.duration)), flush=True)
+    if args.role == "commander":  # each role prints its figures itself
+        commander(args.rate, args.duration, args.target)
         return 0
     if args.role == "checker":
-        print(json.dumps(checker(args.duration + 2.0)), flush=True)
+        checker(args.duration + 2.0)
         return 0
     missing = missing_install()
     if missing:
@@ -543,12 +691,19 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     with ros_domain(args.domain_id), tempfile.TemporaryDirectory() as tmp:
         out_dir = Path(tmp)
-        node = start_node(out_dir, args.node_arg, args.node_source)
-        floor = start_python(FLOOR_SERVER, out_dir / "node.log")
+        prefix = priority_prefix(args)
+        if args.node_source is None and args.priority:  # the node's own option
+            options = [f"--realtime-priority={args.priority}"]
+            node = start_node(out_dir, args.node_arg, options=options)
+        else:  # another tree's node (which may not have the option): the same through chrt
+            node = start_node(out_dir, args.node_arg, args.node_source, prefix=prefix)
+        floors = [start_python(FLOOR_SERVER, out_dir / "node.log")]
+        if args.floor:
+            floors.append(start_python(COMMAND_FLOOR_SERVER, out_dir / "node.log", prefix))
         try:
             return run(args, node, out_dir)
         finally:
-            stop((node, floor))
+            stop((node, *floors))
             if print_failures([out_dir / "node.log"]):
                 print("the node's log has a traceback (above): these figures are not valid")
 

@@ -12,6 +12,10 @@ autostart
     ``true`` (default) configures and activates the managed node at once; ``false`` leaves it
     unconfigured until a ``lifecycle_msgs`` ``configure`` and ``activate`` (``ros2 lifecycle
     set /hexapod_workspace configure``).
+realtime_priority
+    ``0`` (default): normal scheduling; 1..99: the node's threads run under SCHED_FIFO at that
+    priority, ahead of other jobs on the machine (its worker stays at normal priority; needs
+    an rtprio limit or CAP_SYS_NICE; see docs/ros.md, "Threads, load and latency").
 rviz
     ``true`` also starts rviz2 with ``share/hexapod_workspace/config/workspace.rviz``.
 
@@ -48,6 +52,11 @@ def generate_launch_description() -> LaunchDescription:
                 description="Configure and activate the lifecycle node at start.",
             ),
             DeclareLaunchArgument(
+                "realtime_priority",
+                default_value="0",
+                description="SCHED_FIFO priority of the node's threads (0: normal scheduling).",
+            ),
+            DeclareLaunchArgument(
                 "rviz", default_value="false", description="Start rviz2 with the layout."
             ),
             Node(
@@ -56,7 +65,10 @@ def generate_launch_description() -> LaunchDescription:
                 name="hexapod_workspace",
                 output="screen",
                 emulate_tty=True,
-                arguments=[["--autostart=", LaunchConfiguration("autostart")]],
+                arguments=[
+                    ["--autostart=", LaunchConfiguration("autostart")],
+                    ["--realtime-priority=", LaunchConfiguration("realtime_priority")],
+                ],
                 parameters=[params_file],
             ),
             Node(

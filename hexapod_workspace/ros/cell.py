@@ -77,6 +77,7 @@ from hexapod_workspace.logs.cell import (
 
 from .conversions import to_message, type_name
 from .parameters import State, dynamic_specs
+from .scheduling import time_sharing
 
 __all__ = [
     "PARAMETER_CHANGES_TOPIC",
@@ -391,8 +392,10 @@ class AxisLimitsPublisher:
     ) -> dict[str, Any]:
         """:func:`~hexapod_workspace.core.reach.axis_limits` in the spawned process."""
         if self._pool is None:
-            self._pool = ProcessPoolExecutor(
-                max_workers=1, mp_context=multiprocessing.get_context("spawn")
+            self._pool = ProcessPoolExecutor(  # at normal priority under a real-time node
+                max_workers=1,
+                mp_context=multiprocessing.get_context("spawn"),
+                initializer=time_sharing,
             )
         future = self._pool.submit(
             axis_limits, manipulator, rotation, position, frame=frame, work=work

@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 from hexapod_workspace_msgs.msg import CommandedPose, ReachabilityResult
 from rclpy.exceptions import InvalidHandle
+from rclpy.serialization import deserialize_message
 
 from hexapod_workspace.core.constraint_table import constraint_names
 from hexapod_workspace.core.constraints import check
@@ -50,24 +51,32 @@ class CommandStream:
         self._subscription = subscription
         self._publisher = publisher
 
-    def on_command(self, command: CommandedPose) -> None:
-        """Subscription callback: answer ``command`` and those queued behind it."""
-        batch = [command]
+    def on_command(self, data: bytes) -> None:
+        """Subscription callback (raw: the CDR bytes of a command): answer it and the commands
+        queued behind it. Each is taken as bytes, recorded as such and deserialised once (a
+        taken message would be serialised again for the log)."""
+        raw = [data]
         handle = self._subscription.handle
         with contextlib.suppress(InvalidHandle), handle:
-            while len(batch) < BATCH:
-                taken = handle.take_message(CommandedPose, False)
+            while len(raw) < BATCH:
+                taken = handle.take_message(CommandedPose, True)
                 if taken is None:
                     break
-                batch.append(taken[0])
-        self.answer(batch)
+                raw.append(taken[0])
+        self.answer([deserialize_message(item, CommandedPose) for item in raw], raw)
 
-    def answer(self, batch: list[CommandedPose]) -> None:
+    def answer(self, batch: list[CommandedPose], raw: list[bytes] | None = None) -> None:
+        """Record and answer ``batch`` (``raw``: the same commands' CDR bytes, recorded as they
+        are; without them the commands are serialised for the log)."""
         node, stats = self._node, self._node.stats
         stats.commands_received += len(batch)
         topic = self._subscription.topic_name
-        for command in batch:
-            node.recorder.write(topic, command)
+        if raw is not None:
+            for data in raw:
+                node.recorder.write_serialized(topic, data)
+        else:
+            for command in batch:
+                node.recorder.write(topic, command)
         state = node.state
         now_ns = node.get_clock().now().nanoseconds
         inactive = node.inactive_reason()

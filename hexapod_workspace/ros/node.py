@@ -78,6 +78,7 @@ from rclpy.lifecycle import LifecycleNode
 from rclpy.logging import get_logger
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.serialization import serialize_message
 
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import kernels, params, planner_kernels
@@ -115,6 +116,7 @@ from .paths import attach as attach_paths
 from .paths import check_poses_from_poses
 from .qos import COMMAND_QOS, SERVICE_QOS_PROFILE
 from .recorder import Recorder
+from .scheduling import realtime_priority_from_argv, set_realtime
 from .worker import WorkspaceWorker
 from .workspaces import WorkspaceServer
 
@@ -236,7 +238,10 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         )
         attach_flat(self, _name("check_poses_flat"))  # the flat form (ros/flat.py)
         self._commanded = self.recorded_subscription(
-            CommandedPose, _name("commanded_pose"), lambda c: self._commands.on_command(c)
+            CommandedPose,
+            _name("commanded_pose"),
+            lambda data: self._commands.on_command(data),
+            raw=True,  # the stream records the bytes it takes (ros/commands.py)
         )
         self._commands = CommandStream(self, self._commanded, self._reachability)
         self.workspaces = WorkspaceServer(self, _name)
@@ -335,11 +340,18 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         )
 
     def recorded_subscription(
-        self, message_class: type, topic: str, callback: Callable, group: Any = None
+        self,
+        message_class: type,
+        topic: str,
+        callback: Callable,
+        group: Any = None,
+        raw: bool = False,
     ) -> Any:
-        """A reliable KEEP_ALL subscription; ``callback`` records what it takes itself."""
+        """A reliable KEEP_ALL subscription; ``callback`` records what it takes itself (with
+        ``raw``, it is given the CDR bytes: it records them as they are and deserialises
+        once)."""
         subscription = self.create_subscription(
-            message_class, topic, callback, COMMAND_QOS, callback_group=group
+            message_class, topic, callback, COMMAND_QOS, callback_group=group, raw=raw
         )
         self.recorder.add_channel(subscription.topic_name, type_name(message_class), REQUEST_QOS)
         return subscription
@@ -347,9 +359,15 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
     def publish(self, publisher: Any, message: Any) -> None:
         """Record and publish ``message`` (any thread). Recorded first: a SIGINT (rclpy raises
         KeyboardInterrupt in the main thread) between the two cannot leave a published message
-        out of the log."""
-        self.recorder.write(publisher.topic_name, message)
-        publisher.publish(message)
+        out of the log. While recording, the message is serialised once, here, and the same
+        bytes are published and recorded (publishing a message serialises it anyway; the
+        recorder thread would serialise it again, in this process)."""
+        if not self.recorder.recording:
+            publisher.publish(message)
+            return
+        data = serialize_message(message)
+        self.recorder.write_serialized(publisher.topic_name, data)
+        publisher.publish(data)
 
     def _now_ns(self) -> int:
         return self.get_clock().now().nanoseconds
@@ -609,11 +627,14 @@ def main(args: list[str] | None = None) -> int:
     Returns
     -------
     int
-        Process exit status: 0 after a clean shutdown, 1 when the parameters are invalid.
+        Process exit status: 0 after a clean shutdown, 1 when the parameters are invalid, 2
+        when an option (``--autostart=``, ``--realtime-priority=``) is invalid or refused.
     """
     sys.setswitchinterval(SWITCH_INTERVAL)
     try:
         autostart, args = autostart_from_argv(sys.argv if args is None else args)
+        priority, args = realtime_priority_from_argv(args)
+        set_realtime(priority)  # before rclpy starts a thread: they all inherit it
     except ConfigError as error:
         get_logger(NODE_NAME).fatal(str(error))
         return 2

@@ -144,6 +144,12 @@ class Recorder:
         """Declare a topic recorded in every log (before the first :meth:`open`)."""
         self._channels[topic] = (msgtype, qos)
 
+    @property
+    def recording(self) -> bool:
+        """True while messages given to :meth:`write` are recorded (a log is open or opening):
+        a caller that has the CDR bytes anyway (it publishes them) hands those instead."""
+        return self._accepting
+
     def write(self, topic: str, message: Any, log_time_ns: int | None = None) -> None:
         """Queue one rclpy message for ``topic`` when recording (never blocks, never raises);
         logged at ``log_time_ns`` (default now, ns since the epoch)."""
@@ -154,9 +160,10 @@ class Recorder:
             return
         self._queue.put((topic, message, time.time_ns() if log_time_ns is None else log_time_ns))
 
-    def write_serialized(self, topic: str, data: bytes, log_time_ns: int) -> None:
-        """Queue CDR bytes already serialised (e.g. by the worker process that published them)
-        for ``topic``; written as they are (never blocks, never raises)."""
+    def write_serialized(self, topic: str, data: bytes, log_time_ns: int | None = None) -> None:
+        """Queue CDR bytes already serialised (by the node that publishes them, the
+        subscription that took them, or the worker process) for ``topic``; written as they are
+        (never blocks, never raises)."""
         self.write(topic, _Serialized(data), log_time_ns)
 
     def open(

@@ -38,6 +38,7 @@ from hexapod_workspace.errors import HexapodWorkspaceError
 from hexapod_workspace.logs import messages
 
 from .clouds import CloudTopics, PublishedCloud, decimated_cloud_fields
+from .scheduling import time_sharing
 
 __all__ = [
     "CANCEL_GRACE",
@@ -204,6 +205,9 @@ def _serve(connection: Connection, cancel: Any, topics: CloudTopics | None = Non
     # The publisher's DDS threads start first, at normal priority (Linux: a thread's niceness
     # is its own and new threads inherit their creator's): discovery and delivery of the clouds
     # do not wait behind the computation on a busy machine.
+    # a node under a real-time policy (ros/scheduling.py) passed it on: back to time-sharing
+    # before the publisher's threads start, as they inherit it
+    time_sharing()
     publisher, broken = _cloud_publisher(topics)
     with contextlib.suppress(OSError):
         os.nice(WORKER_NICENESS)  # throughput work: the node's checks are scheduled first
