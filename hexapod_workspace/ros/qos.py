@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-__all__ = ["COMMAND_QOS", "SERVICE_QOS_PROFILE"]
+__all__ = ["COMMAND_QOS", "FEEDBACK_QOS_PROFILE", "SERVICE_QOS_PROFILE"]
 
 #: The commanded-pose subscription: nothing is dropped on the node's side.
 COMMAND_QOS = QoSProfile(
@@ -22,6 +22,16 @@ COMMAND_QOS = QoSProfile(
 SERVICE_QOS_PROFILE = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
     depth=1000,
+    reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.VOLATILE,
+)
+#: The workspace action's feedback: reliable, volatile, the last 200 kept. A goal reports at
+#: most about 105 feedback messages (the stages and every 1 % of progress); with rmw's default
+#: depth of 10 a client whose executor lags (a loaded machine) loses the first ones, "queued"
+#: among them, because a KEEP_LAST writer replaces samples not yet acknowledged.
+FEEDBACK_QOS_PROFILE = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST,
+    depth=200,
     reliability=ReliabilityPolicy.RELIABLE,
     durability=DurabilityPolicy.VOLATILE,
 )

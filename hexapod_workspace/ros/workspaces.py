@@ -38,6 +38,7 @@ from .clouds import RESULT_MAX_POINTS, CloudTopics
 from .conversions import position_from_point, to_message, type_name
 from .jobs import JobQueue, Ticket, completion
 from .parameters import RAYS_RANGE
+from .qos import FEEDBACK_QOS_PROFILE
 from .worker import CanceledError, WorkspaceJob
 
 __all__ = ["WorkspaceServer"]
@@ -103,6 +104,7 @@ class WorkspaceServer:
             goal_callback=lambda goal: GoalResponse.ACCEPT,
             cancel_callback=self._cancel_goal,
             callback_group=node.job_group,
+            feedback_pub_qos_profile=FEEDBACK_QOS_PROFILE,
         )
 
     def stop(self) -> None:

@@ -260,9 +260,14 @@ class RosClient:
         from hexapod_workspace_msgs.action import ComputeWorkspace
         from rclpy.action import ActionClient
 
+        from hexapod_workspace.ros.qos import FEEDBACK_QOS_PROFILE
+
         key = f"action:{name}"
         if key not in self._clients:
-            client = ActionClient(self.node, ComputeWorkspace, name)
+            # every feedback message of a goal (about 105) fits the history, as the server's
+            client = ActionClient(
+                self.node, ComputeWorkspace, name, feedback_sub_qos_profile=FEEDBACK_QOS_PROFILE
+            )
             if not client.wait_for_server(timeout_sec=DISCOVERY_TIMEOUT):
                 msg = f"action server {name} not discovered within {DISCOVERY_TIMEOUT} s"
                 raise AssertionError(msg)
