@@ -322,46 +322,49 @@ def _crank_ik(along: float, across: float, crank: float, length: float) -> float
     )
 
 
+#: Three floats: a vector of one leg, or three constants read together.
+Vector = tuple[float, float, float]
+
+
 @_inline
 def _crank_angle(
-    a: float,
-    b: float,
-    c: float,
+    along_e: float,
+    along_f: float,
+    across: float,
+    scaled: float,
     branch: float,
-    centre: float,
-    cos_centre: float,
-    sin_centre: float,
+    centre: Vector,
 ) -> tuple[float, float, float]:
     """The crank angle q of ``a·cos q + b·sin q = c`` on ``branch`` (±1), rad, in the 2π window
-    centred on ``centre``, with cos q and sin q: one arctangent, no other trigonometric call,
-    no branch (so that the block path's loop over poses vectorises).
+    centred on ``centre`` = (centre, its cosine, its sine), with cos q and sin q: one
+    arctangent, no other trigonometric call, one division, no branch (so that the block path's
+    loop over poses vectorises).
 
     The closed form of :mod:`~hexapod_workspace.core.architectures.rus` is
     q = φ + branch·γ with φ = atan2(b, a), γ = arccos(c/ρ), ρ = √(a² + b²) (c/ρ clamped to
-    [−1, 1]). With cos φ = a/ρ, sin φ = b/ρ, cos γ = c/ρ and sin γ = √(1 − (c/ρ)²) ≥ 0 (γ in
-    [0, π]), the angle-sum formulas give exactly
+    [−1, 1]), a = 2r·d·e, b = 2r·d·f. So ρ = 2r·ρ' with ρ' = √((d·e)² + (d·f)²) (``across``:
+    the distance of B from the crank axis when e ⟂ w), cos φ = d·e/ρ', sin φ = d·f/ρ'
+    (``along_e``, ``along_f``), cos γ = c/(2r·ρ') (``scaled`` = c/(2r), clamped after the
+    division) and sin γ = √(1 − cos²γ) ≥ 0 (γ in [0, π]); the angle-sum formulas give exactly
 
-        cos q = (a·cos γ − branch·b·sin γ)/ρ,   sin q = (b·cos γ + branch·a·sin γ)/ρ.
+        cos q = (d·e·cos γ − branch·d·f·sin γ)/ρ',   sin q = (d·f·cos γ + branch·d·e·sin γ)/ρ'.
 
     The offset from the centre of the range, δ = q − centre, has cos δ = cos q·cos c +
     sin q·sin c and sin δ = sin q·cos c − cos q·sin c, so q = centre + atan2(sin δ, cos δ) is the
     solution in (centre − π, centre + π] (:func:`_atan2`, within 2 ulp of libm's). The reference
     takes [centre − π, centre + π); the two differ only at δ = ±π exactly, where the range margin
-    min(q − q_min, q_max − q) = (q_max − q_min)/2 − π is the same for both. ρ = 0 (B on the crank
-    axis) gives cos q = 1, sin q = 0, as atan2(+0, +0) + arccos(1) = 0 does. Rounding differs
-    from the trigonometric route by a few ulps (ρ-relative products instead of arccos, cos and
-    sin of an angle)."""
-    norm = math.sqrt(a * a + b * b)
-    degenerate = norm == 0.0
-    norm = 1.0 if degenerate else norm
-    ratio = min(max(c / norm, -1.0), 1.0)
+    min(q − q_min, q_max − q) = (q_max − q_min)/2 − π is the same for both. ρ' = 0 (B on the
+    crank axis) gives cos q = 1, sin q = 0, as atan2(+0, +0) + arccos(1) = 0 does. Rounding
+    differs from the trigonometric route by a few ulps (products relative to ρ' instead of
+    arccos, cos and sin of an angle)."""
+    degenerate = across == 0.0
+    inverse = 1.0 / (1.0 if degenerate else across)
+    ratio = min(max(scaled * inverse, -1.0), 1.0)
     sine = math.sqrt(max(1.0 - ratio * ratio, 0.0))
-    cos_q = 1.0 if degenerate else (a * ratio - branch * b * sine) / norm
-    sin_q = 0.0 if degenerate else (b * ratio + branch * a * sine) / norm
-    offset = _atan2(
-        sin_q * cos_centre - cos_q * sin_centre, cos_q * cos_centre + sin_q * sin_centre
-    )
-    return centre + offset, cos_q, sin_q
+    cos_q = 1.0 if degenerate else (along_e * ratio - branch * along_f * sine) * inverse
+    sin_q = 0.0 if degenerate else (along_f * ratio + branch * along_e * sine) * inverse
+    offset = _atan2(sin_q * centre[1] - cos_q * centre[2], cos_q * centre[1] + sin_q * centre[2])
+    return centre[0] + offset, cos_q, sin_q
 
 
 @_inline
@@ -378,54 +381,85 @@ def _slide_leg(
 
 
 @_inline
-def _crank_leg(
-    model: NDArray[np.float64], k: int, dx: float, dy: float, dz: float
-) -> tuple[float, float, float, float]:
-    """(ik, q, cos q, sin q) of crank leg k (rus) with d = B_k − A0_k (the closed form of
-    :func:`_crank_angle`; its value where ik < 0 has no meaning: the caller decides)."""
-    crank, length = model[CRANK + k], model[LEG + k]
-    ex, ey, ez = model[ZERO + 3 * k], model[ZERO + 3 * k + 1], model[ZERO + 3 * k + 2]
-    fx, fy, fz = model[CROSS + 3 * k], model[CROSS + 3 * k + 1], model[CROSS + 3 * k + 2]
-    ux, uy, uz = model[RAIL + 3 * k], model[RAIL + 3 * k + 1], model[RAIL + 3 * k + 2]
-    a = 2.0 * crank * (dx * ex + dy * ey + dz * ez)
-    b = 2.0 * crank * (dx * fx + dy * fy + dz * fz)
-    c = (dx * dx + dy * dy + dz * dz) + crank * crank - length * length
-    along = ux * dx + uy * dy + uz * dz
-    hx, hy, hz = dx - along * ux, dy - along * uy, dz - along * uz
-    ik = _crank_ik(along, math.sqrt(hx * hx + hy * hy + hz * hz), crank, length)
-    q, cos_q, sin_q = _crank_angle(
-        a, b, c, model[BRANCH + k], model[QCENTRE + k], model[QCOS + k], model[QSIN + k]
+def _crank(
+    model: NDArray[np.float64], k: int
+) -> tuple[Vector, Vector, Vector, tuple[float, float, float, float], Vector]:
+    """The constants of crank leg k: (e_k, f_k, w_k), (r_k, L_k, branch_k, 1/(2r_k)), and the
+    centre of its range with the centre's cosine and sine (read once per leg, outside the loops
+    over poses)."""
+    return (
+        (model[ZERO + 3 * k], model[ZERO + 3 * k + 1], model[ZERO + 3 * k + 2]),
+        (model[CROSS + 3 * k], model[CROSS + 3 * k + 1], model[CROSS + 3 * k + 2]),
+        (model[RAIL + 3 * k], model[RAIL + 3 * k + 1], model[RAIL + 3 * k + 2]),
+        (model[CRANK + k], model[LEG + k], model[BRANCH + k], 0.5 / model[CRANK + k]),
+        (model[QCENTRE + k], model[QCOS + k], model[QSIN + k]),
     )
+
+
+@_inline
+def _crank_leg(
+    dx: float,
+    dy: float,
+    dz: float,
+    e: Vector,
+    f: Vector,
+    w: Vector,
+    sizes: tuple[float, float, float, float],
+    centre: Vector,
+) -> tuple[float, float, float, float]:
+    """(ik, q, cos q, sin q) of a crank leg with d = B − A0 and the constants of :func:`_crank`
+    (``sizes`` = (r, L, branch, 1/(2r))): the ``ik`` margin from the axial and radial
+    coordinates of B about the crank axis (:func:`_crank_ik`), the angle by
+    :func:`_crank_angle` (its value where ik < 0 has no meaning: the caller decides)."""
+    crank, length = sizes[0], sizes[1]
+    along_e = dx * e[0] + dy * e[1] + dz * e[2]
+    along_f = dx * f[0] + dy * f[1] + dz * f[2]
+    along = dx * w[0] + dy * w[1] + dz * w[2]
+    # The radial coordinate as the reference takes it (|d − (d·w)w|: the loader accepts an e
+    # up to 1e-6 off ⟂ w, where √((d·e)² + (d·f)²) would differ from it by as much).
+    hx, hy, hz = dx - along * w[0], dy - along * w[1], dz - along * w[2]
+    ik = _crank_ik(along, math.sqrt(hx * hx + hy * hy + hz * hz), crank, length)
+    # c/(2r), c = |d|² + r² − L² (a/(2r) and b/(2r) are d·e and d·f).
+    scaled = ((dx * dx + dy * dy + dz * dz) + crank * crank - length * length) * sizes[3]
+    norm = math.sqrt(along_e * along_e + along_f * along_f)
+    q, cos_q, sin_q = _crank_angle(along_e, along_f, norm, scaled, sizes[2], centre)
     return ik, q, cos_q, sin_q
 
 
 @_inline
 def _crank_end(
-    model: NDArray[np.float64], k: int, cos_q: float, sin_q: float
+    origin: Vector,
+    e: Vector,
+    f: Vector,
+    axis: Vector,
+    axis_cross: Vector,
+    axis_along: Vector,
+    crank: float,
+    cos_q: float,
+    sin_q: float,
 ) -> tuple[float, float, float, float, float, float, float, float, float]:
-    """Crank end C_k(q) (m, base frame), its unit velocity w_k × (C_k − A0_k)/r_k and the
-    crank-end joint axis turned by q about w_k (Rodrigues), from cos q and sin q."""
-    crank = model[CRANK + k]
-    ex, ey, ez = model[ZERO + 3 * k], model[ZERO + 3 * k + 1], model[ZERO + 3 * k + 2]
-    fx, fy, fz = model[CROSS + 3 * k], model[CROSS + 3 * k + 1], model[CROSS + 3 * k + 2]
+    """Crank end C(q) = A0 + r(cos q·e + sin q·f) (m, base frame), its unit velocity
+    w × (C − A0)/r = cos q·f − sin q·e and the crank-end joint axis ``axis`` (at q = 0) turned
+    by q about w (Rodrigues: cos q·j + sin q·(w × j) + (1 − cos q)(w·j)w), from cos q and
+    sin q."""
     one_minus = 1.0 - cos_q
     return (
-        model[A + 3 * k] + crank * (cos_q * ex + sin_q * fx),
-        model[A + 3 * k + 1] + crank * (cos_q * ey + sin_q * fy),
-        model[A + 3 * k + 2] + crank * (cos_q * ez + sin_q * fz),
-        cos_q * fx - sin_q * ex,
-        cos_q * fy - sin_q * ey,
-        cos_q * fz - sin_q * ez,
-        cos_q * model[JA + 3 * k]
-        + sin_q * model[AXIS_CROSS + 3 * k]
-        + one_minus * model[AXIS_ALONG + 3 * k],
-        cos_q * model[JA + 3 * k + 1]
-        + sin_q * model[AXIS_CROSS + 3 * k + 1]
-        + one_minus * model[AXIS_ALONG + 3 * k + 1],
-        cos_q * model[JA + 3 * k + 2]
-        + sin_q * model[AXIS_CROSS + 3 * k + 2]
-        + one_minus * model[AXIS_ALONG + 3 * k + 2],
+        origin[0] + crank * (cos_q * e[0] + sin_q * f[0]),
+        origin[1] + crank * (cos_q * e[1] + sin_q * f[1]),
+        origin[2] + crank * (cos_q * e[2] + sin_q * f[2]),
+        cos_q * f[0] - sin_q * e[0],
+        cos_q * f[1] - sin_q * e[1],
+        cos_q * f[2] - sin_q * e[2],
+        cos_q * axis[0] + sin_q * axis_cross[0] + one_minus * axis_along[0],
+        cos_q * axis[1] + sin_q * axis_cross[1] + one_minus * axis_along[1],
+        cos_q * axis[2] + sin_q * axis_cross[2] + one_minus * axis_along[2],
     )
+
+
+@_inline
+def _vector(model: NDArray[np.float64], offset: int, k: int) -> Vector:
+    """The 3-vector of leg k at ``offset`` of the model (leg-major layout)."""
+    return (model[offset + 3 * k], model[offset + 3 * k + 1], model[offset + 3 * k + 2])
 
 
 @_helper
@@ -492,10 +526,21 @@ def _pose_moving(
             tx, ty, tz = ux, uy, uz
             jx, jy, jz = model[JA + 3 * k], model[JA + 3 * k + 1], model[JA + 3 * k + 2]
         else:
-            ik, q, cq, sq_ = _crank_leg(model, k, dx, dy, dz)
+            e, f, w, sizes, centre = _crank(model, k)
+            ik, q, cq, sq_ = _crank_leg(dx, dy, dz, e, f, w, sizes, centre)
             if not ik >= 0.0:
                 q, cq, sq_ = np.nan, np.nan, np.nan
-            base_x, base_y, base_z, tx, ty, tz, jx, jy, jz = _crank_end(model, k, cq, sq_)
+            base_x, base_y, base_z, tx, ty, tz, jx, jy, jz = _crank_end(
+                _vector(model, A, k),
+                e,
+                f,
+                _vector(model, JA, k),
+                _vector(model, AXIS_CROSS, k),
+                _vector(model, AXIS_ALONG, k),
+                sizes[0],
+                cq,
+                sq_,
+            )
         if not ik >= 0.0:
             solved = False
         if ik < m_ik or (ik != ik and m_ik == m_ik):
@@ -924,7 +969,7 @@ def _sincos(x: float) -> tuple[float, float]:
 
 
 # atan2 for the crank angle of 6-RUS legs: Cephes' atan (rational approximation on
-# [0, 0.66], the reduction atan t = π/4 + atan((t − 1)/(t + 1)) above; the π/2 and π terms with
+# [−0.21, 0.66], the reduction atan t = π/4 + atan((t − 1)/(t + 1)) above; the π/2 and π terms with
 # their rounding residue MOREBITS), on t = min(|x|, |y|)/max(|x|, |y|) ∈ [0, 1], and the octant
 # by selects: within 2 ulp of libm for finite arguments and branch-free, so that the 6-RUS leg
 # loop vectorises (libm's atan2 is a call per pose that keeps a loop scalar).
@@ -957,9 +1002,10 @@ def _atan2(y: float, x: float) -> float:
     swap = ay > ax
     big = ay if swap else ax
     small = ax if swap else ay
-    t = small / (big if big > 0.0 else 1.0)
-    reduce = t > 0.66
-    u = (t - 1.0) / (t + 1.0) if reduce else t
+    # t = small/big; above 0.66 the argument (t − 1)/(t + 1) = (small − big)/(small + big):
+    # one division either way.
+    reduce = small > 0.66 * big
+    u = (small - big if reduce else small) / (small + big if reduce else max(big, 1e-300))
     z = u * u
     p = (
         z
@@ -1335,6 +1381,8 @@ def _moving_leg_planes(rus: bool) -> Callable[..., None]:
         j0x, j0y, j0z = model[JA + 3 * k], model[JA + 3 * k + 1], model[JA + 3 * k + 2]
         jbx, jby, jbz = model[JB + 3 * k], model[JB + 3 * k + 1], model[JB + 3 * k + 2]
         length, branch = model[LEG + k], model[BRANCH + k]
+        e, f, w, sizes, centre = _crank(model, k)
+        axis_cross, axis_along = _vector(model, AXIS_CROSS, k), _vector(model, AXIS_ALONG, k)
         limits = (model[QMIN + k], model[QMAX + k], model[TAU_MIN])
         kf = float(k)
         for n in range(count):
@@ -1354,8 +1402,18 @@ def _moving_leg_planes(rus: bool) -> Callable[..., None]:
             platform_z = (r20 * bx + r21 * by + r22 * bz) + pz
             dx, dy, dz = platform_x - ox, platform_y - oy, platform_z - oz
             if rus:
-                ik, q, cos_q, sin_q = _crank_leg(model, k, dx, dy, dz)
-                end_x, end_y, end_z, tx, ty, tz, jx, jy, jz = _crank_end(model, k, cos_q, sin_q)
+                ik, q, cos_q, sin_q = _crank_leg(dx, dy, dz, e, f, w, sizes, centre)
+                end_x, end_y, end_z, tx, ty, tz, jx, jy, jz = _crank_end(
+                    (ox, oy, oz),
+                    e,
+                    f,
+                    (j0x, j0y, j0z),
+                    axis_cross,
+                    axis_along,
+                    sizes[0],
+                    cos_q,
+                    sin_q,
+                )
             else:
                 ik, q = _slide_leg(dx, dy, dz, ux, uy, uz, length, branch)
                 end_x, end_y, end_z = ox + q * ux, oy + q * uy, oz + q * uz
