@@ -10,6 +10,7 @@ vector of :mod:`hexapod_workspace.core.model_layout`.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 # Imported first: it points numba's cache directory somewhere writable before numba loads.
 from .jit import helper as _helper
@@ -321,45 +322,144 @@ def _crank_ik(along: float, across: float, crank: float, length: float) -> float
     )
 
 
+#: Three floats: a vector of one leg, or three constants read together.
+Vector = tuple[float, float, float]
+
+
 @_inline
 def _crank_angle(
-    a: float,
-    b: float,
-    c: float,
+    along_e: float,
+    along_f: float,
+    across: float,
+    scaled: float,
     branch: float,
-    centre: float,
-    cos_centre: float,
-    sin_centre: float,
+    centre: Vector,
 ) -> tuple[float, float, float]:
     """The crank angle q of ``a·cos q + b·sin q = c`` on ``branch`` (±1), rad, in the 2π window
-    centred on ``centre``, with cos q and sin q: one atan2, no other trigonometric call.
+    centred on ``centre`` = (centre, its cosine, its sine), with cos q and sin q: one
+    arctangent, no other trigonometric call, one division, no branch (so that the block path's
+    loop over poses vectorises).
 
     The closed form of :mod:`~hexapod_workspace.core.architectures.rus` is
     q = φ + branch·γ with φ = atan2(b, a), γ = arccos(c/ρ), ρ = √(a² + b²) (c/ρ clamped to
-    [−1, 1]). With cos φ = a/ρ, sin φ = b/ρ, cos γ = c/ρ and sin γ = √(1 − (c/ρ)²) ≥ 0 (γ in
-    [0, π]), the angle-sum formulas give exactly
+    [−1, 1]), a = 2r·d·e, b = 2r·d·f. So ρ = 2r·ρ' with ρ' = √((d·e)² + (d·f)²) (``across``:
+    the distance of B from the crank axis when e ⟂ w), cos φ = d·e/ρ', sin φ = d·f/ρ'
+    (``along_e``, ``along_f``), cos γ = c/(2r·ρ') (``scaled`` = c/(2r), clamped after the
+    division) and sin γ = √(1 − cos²γ) ≥ 0 (γ in [0, π]); the angle-sum formulas give exactly
 
-        cos q = (a·cos γ − branch·b·sin γ)/ρ,   sin q = (b·cos γ + branch·a·sin γ)/ρ.
+        cos q = (d·e·cos γ − branch·d·f·sin γ)/ρ',   sin q = (d·f·cos γ + branch·d·e·sin γ)/ρ'.
 
     The offset from the centre of the range, δ = q − centre, has cos δ = cos q·cos c +
     sin q·sin c and sin δ = sin q·cos c − cos q·sin c, so q = centre + atan2(sin δ, cos δ) is the
-    solution in (centre − π, centre + π]. The reference takes [centre − π, centre + π); the two
-    differ only at δ = ±π exactly, where the range margin min(q − q_min, q_max − q) =
-    (q_max − q_min)/2 − π is the same for both. ρ = 0 (B on the crank axis) gives cos q = 1,
-    sin q = 0, as atan2(+0, +0) + arccos(1) = 0 does. Rounding differs from the trigonometric
-    route by a few ulps (ρ-relative products instead of arccos, cos and sin of an angle)."""
-    norm = math.sqrt(a * a + b * b)
-    if norm == 0.0:
-        cos_q, sin_q = 1.0, 0.0
-    else:
-        ratio = min(max(c / norm, -1.0), 1.0)
-        sine = math.sqrt(max(1.0 - ratio * ratio, 0.0))
-        cos_q = (a * ratio - branch * b * sine) / norm
-        sin_q = (b * ratio + branch * a * sine) / norm
-    offset = math.atan2(
-        sin_q * cos_centre - cos_q * sin_centre, cos_q * cos_centre + sin_q * sin_centre
+    solution in (centre − π, centre + π] (:func:`_atan2`, within 2 ulp of libm's). The reference
+    takes [centre − π, centre + π); the two differ only at δ = ±π exactly, where the range margin
+    min(q − q_min, q_max − q) = (q_max − q_min)/2 − π is the same for both. ρ' = 0 (B on the
+    crank axis) gives cos q = 1, sin q = 0, as atan2(+0, +0) + arccos(1) = 0 does. Rounding
+    differs from the trigonometric route by a few ulps (products relative to ρ' instead of
+    arccos, cos and sin of an angle)."""
+    degenerate = across == 0.0
+    inverse = 1.0 / (1.0 if degenerate else across)
+    ratio = min(max(scaled * inverse, -1.0), 1.0)
+    sine = math.sqrt(max(1.0 - ratio * ratio, 0.0))
+    cos_q = 1.0 if degenerate else (along_e * ratio - branch * along_f * sine) * inverse
+    sin_q = 0.0 if degenerate else (along_f * ratio + branch * along_e * sine) * inverse
+    offset = _atan2(sin_q * centre[1] - cos_q * centre[2], cos_q * centre[1] + sin_q * centre[2])
+    return centre[0] + offset, cos_q, sin_q
+
+
+@_inline
+def _slide_leg(
+    dx: float, dy: float, dz: float, ux: float, uy: float, uz: float, length: float, branch: float
+) -> tuple[float, float]:
+    """(ik, q) of a slide leg (pus) with d = B − A0 and rail u: ik = L − h, h the distance from
+    B to the rail line, q = u·d + branch·√(L² − h²) (√0 where ik < 0: the caller decides)."""
+    along = ux * dx + uy * dy + uz * dz
+    hx, hy, hz = dx - along * ux, dy - along * uy, dz - along * uz
+    h = math.sqrt(hx * hx + hy * hy + hz * hz)
+    ik = length - h
+    return ik, along + branch * math.sqrt(max(ik * (length + h), 0.0))
+
+
+@_inline
+def _crank(
+    model: NDArray[np.float64], k: int
+) -> tuple[Vector, Vector, Vector, tuple[float, float, float, float], Vector]:
+    """The constants of crank leg k: (e_k, f_k, w_k), (r_k, L_k, branch_k, 1/(2r_k)), and the
+    centre of its range with the centre's cosine and sine (read once per leg, outside the loops
+    over poses)."""
+    return (
+        (model[ZERO + 3 * k], model[ZERO + 3 * k + 1], model[ZERO + 3 * k + 2]),
+        (model[CROSS + 3 * k], model[CROSS + 3 * k + 1], model[CROSS + 3 * k + 2]),
+        (model[RAIL + 3 * k], model[RAIL + 3 * k + 1], model[RAIL + 3 * k + 2]),
+        (model[CRANK + k], model[LEG + k], model[BRANCH + k], 0.5 / model[CRANK + k]),
+        (model[QCENTRE + k], model[QCOS + k], model[QSIN + k]),
     )
-    return centre + offset, cos_q, sin_q
+
+
+@_inline
+def _crank_leg(
+    dx: float,
+    dy: float,
+    dz: float,
+    e: Vector,
+    f: Vector,
+    w: Vector,
+    sizes: tuple[float, float, float, float],
+    centre: Vector,
+) -> tuple[float, float, float, float]:
+    """(ik, q, cos q, sin q) of a crank leg with d = B − A0 and the constants of :func:`_crank`
+    (``sizes`` = (r, L, branch, 1/(2r))): the ``ik`` margin from the axial and radial
+    coordinates of B about the crank axis (:func:`_crank_ik`), the angle by
+    :func:`_crank_angle` (its value where ik < 0 has no meaning: the caller decides)."""
+    crank, length = sizes[0], sizes[1]
+    along_e = dx * e[0] + dy * e[1] + dz * e[2]
+    along_f = dx * f[0] + dy * f[1] + dz * f[2]
+    along = dx * w[0] + dy * w[1] + dz * w[2]
+    # The radial coordinate as the reference takes it (|d − (d·w)w|: the loader accepts an e
+    # up to 1e-6 off ⟂ w, where √((d·e)² + (d·f)²) would differ from it by as much).
+    hx, hy, hz = dx - along * w[0], dy - along * w[1], dz - along * w[2]
+    ik = _crank_ik(along, math.sqrt(hx * hx + hy * hy + hz * hz), crank, length)
+    # c/(2r), c = |d|² + r² − L² (a/(2r) and b/(2r) are d·e and d·f).
+    scaled = ((dx * dx + dy * dy + dz * dz) + crank * crank - length * length) * sizes[3]
+    norm = math.sqrt(along_e * along_e + along_f * along_f)
+    q, cos_q, sin_q = _crank_angle(along_e, along_f, norm, scaled, sizes[2], centre)
+    return ik, q, cos_q, sin_q
+
+
+@_inline
+def _crank_end(
+    origin: Vector,
+    e: Vector,
+    f: Vector,
+    axis: Vector,
+    axis_cross: Vector,
+    axis_along: Vector,
+    crank: float,
+    cos_q: float,
+    sin_q: float,
+) -> tuple[float, float, float, float, float, float, float, float, float]:
+    """Crank end C(q) = A0 + r(cos q·e + sin q·f) (m, base frame), its unit velocity
+    w × (C − A0)/r = cos q·f − sin q·e and the crank-end joint axis ``axis`` (at q = 0) turned
+    by q about w (Rodrigues: cos q·j + sin q·(w × j) + (1 − cos q)(w·j)w), from cos q and
+    sin q."""
+    one_minus = 1.0 - cos_q
+    return (
+        origin[0] + crank * (cos_q * e[0] + sin_q * f[0]),
+        origin[1] + crank * (cos_q * e[1] + sin_q * f[1]),
+        origin[2] + crank * (cos_q * e[2] + sin_q * f[2]),
+        cos_q * f[0] - sin_q * e[0],
+        cos_q * f[1] - sin_q * e[1],
+        cos_q * f[2] - sin_q * e[2],
+        cos_q * axis[0] + sin_q * axis_cross[0] + one_minus * axis_along[0],
+        cos_q * axis[1] + sin_q * axis_cross[1] + one_minus * axis_along[1],
+        cos_q * axis[2] + sin_q * axis_cross[2] + one_minus * axis_along[2],
+    )
+
+
+@_inline
+def _vector(model: NDArray[np.float64], offset: int, k: int) -> Vector:
+    """The 3-vector of leg k at ``offset`` of the model (leg-major layout)."""
+    return (model[offset + 3 * k], model[offset + 3 * k + 1], model[offset + 3 * k + 2])
 
 
 @_helper
@@ -416,62 +516,30 @@ def _pose_moving(
         dx = platform_x - model[A + 3 * k]
         dy = platform_y - model[A + 3 * k + 1]
         dz = platform_z - model[A + 3 * k + 2]
-        length = model[LEG + k]
-        branch = model[BRANCH + k]
-        ux = model[RAIL + 3 * k]
-        uy = model[RAIL + 3 * k + 1]
-        uz = model[RAIL + 3 * k + 2]
-        jx = model[JA + 3 * k]
-        jy = model[JA + 3 * k + 1]
-        jz = model[JA + 3 * k + 2]
         if not rus:
-            # Slide: q = u·d + branch·sqrt(L² − h²), h the distance from B_k to the rail line.
-            along = ux * dx + uy * dy + uz * dz
-            hx = dx - along * ux
-            hy = dy - along * uy
-            hz = dz - along * uz
-            h = math.sqrt(hx * hx + hy * hy + hz * hz)
-            ik = length - h
-            q = along + branch * math.sqrt(max(ik * (length + h), 0.0)) if ik >= 0.0 else np.nan
+            ux, uy, uz = model[RAIL + 3 * k], model[RAIL + 3 * k + 1], model[RAIL + 3 * k + 2]
+            ik, q = _slide_leg(dx, dy, dz, ux, uy, uz, model[LEG + k], model[BRANCH + k])
+            q = q if ik >= 0.0 else np.nan
             base_x = model[A + 3 * k] + q * ux
             base_y = model[A + 3 * k + 1] + q * uy
             base_z = model[A + 3 * k + 2] + q * uz
             tx, ty, tz = ux, uy, uz
+            jx, jy, jz = model[JA + 3 * k], model[JA + 3 * k + 1], model[JA + 3 * k + 2]
         else:
-            # Crank: a cos q + b sin q = c; u holds the crank axis w.
-            crank = model[CRANK + k]
-            ex, ey, ez = model[ZERO + 3 * k], model[ZERO + 3 * k + 1], model[ZERO + 3 * k + 2]
-            fx, fy, fz = model[CROSS + 3 * k], model[CROSS + 3 * k + 1], model[CROSS + 3 * k + 2]
-            a = 2.0 * crank * (dx * ex + dy * ey + dz * ez)
-            b = 2.0 * crank * (dx * fx + dy * fy + dz * fz)
-            c = (dx * dx + dy * dy + dz * dz) + crank * crank - length * length
-            along = ux * dx + uy * dy + uz * dz
-            hx = dx - along * ux
-            hy = dy - along * uy
-            hz = dz - along * uz
-            across = math.sqrt(hx * hx + hy * hy + hz * hz)
-            ik = _crank_ik(along, across, crank, length)
-            if ik >= 0.0:
-                q, cq, sq_ = _crank_angle(
-                    a, b, c, branch, model[QCENTRE + k], model[QCOS + k], model[QSIN + k]
-                )
-            else:
+            e, f, w, sizes, centre = _crank(model, k)
+            ik, q, cq, sq_ = _crank_leg(dx, dy, dz, e, f, w, sizes, centre)
+            if not ik >= 0.0:
                 q, cq, sq_ = np.nan, np.nan, np.nan
-            base_x = model[A + 3 * k] + crank * (cq * ex + sq_ * fx)
-            base_y = model[A + 3 * k + 1] + crank * (cq * ey + sq_ * fy)
-            base_z = model[A + 3 * k + 2] + crank * (cq * ez + sq_ * fz)
-            # The crank end's unit velocity, and the joint axis turned by q about w (Rodrigues).
-            tx, ty, tz = cq * fx - sq_ * ex, cq * fy - sq_ * ey, cq * fz - sq_ * ez
-            jx = cq * jx + sq_ * model[AXIS_CROSS + 3 * k] + (1.0 - cq) * model[AXIS_ALONG + 3 * k]
-            jy = (
-                cq * jy
-                + sq_ * model[AXIS_CROSS + 3 * k + 1]
-                + (1.0 - cq) * model[AXIS_ALONG + 3 * k + 1]
-            )
-            jz = (
-                cq * jz
-                + sq_ * model[AXIS_CROSS + 3 * k + 2]
-                + (1.0 - cq) * model[AXIS_ALONG + 3 * k + 2]
+            base_x, base_y, base_z, tx, ty, tz, jx, jy, jz = _crank_end(
+                _vector(model, A, k),
+                e,
+                f,
+                _vector(model, JA, k),
+                _vector(model, AXIS_CROSS, k),
+                _vector(model, AXIS_ALONG, k),
+                sizes[0],
+                cq,
+                sq_,
             )
         if not ik >= 0.0:
             solved = False
@@ -900,6 +968,62 @@ def _sincos(x: float) -> tuple[float, float]:
     return sin_value, cos_value
 
 
+# atan2 for the crank angle of 6-RUS legs: Cephes' atan (rational approximation on
+# [−0.21, 0.66], the reduction atan t = π/4 + atan((t − 1)/(t + 1)) above; the π/2 and π terms with
+# their rounding residue MOREBITS), on t = min(|x|, |y|)/max(|x|, |y|) ∈ [0, 1], and the octant
+# by selects: within 2 ulp of libm for finite arguments and branch-free, so that the 6-RUS leg
+# loop vectorises (libm's atan2 is a call per pose that keeps a loop scalar).
+ATAN_P0, ATAN_P1, ATAN_P2, ATAN_P3, ATAN_P4 = (
+    -8.750608600031904122785e-1,
+    -1.615753718733365076637e1,
+    -7.500855792314704667340e1,
+    -1.228866684490136173410e2,
+    -6.485021904942025371773e1,
+)
+ATAN_Q0, ATAN_Q1, ATAN_Q2, ATAN_Q3, ATAN_Q4 = (
+    2.485846490142306297962e1,
+    1.650270098316988542046e2,
+    4.328810604912902668951e2,
+    4.853903996359136964868e2,
+    1.945506571482613964425e2,
+)
+PIO4 = 7.85398163397448309616e-1
+PIO2 = 1.57079632679489661923e0
+PI = 3.14159265358979323846e0
+MOREBITS = 6.123233995736765886130e-17  # π/2 − PIO2
+
+
+@_inline
+def _atan2(y: float, x: float) -> float:
+    """atan2(y, x) in [−π, π] for finite x, y (NaN in, NaN out), branch-free; the signs of
+    zeros as libm's (atan2(±0, −0) = ±π)."""
+    ax = abs(x)
+    ay = abs(y)
+    swap = ay > ax
+    big = ay if swap else ax
+    small = ax if swap else ay
+    # t = small/big; above 0.66 the argument (t − 1)/(t + 1) = (small − big)/(small + big):
+    # one division either way.
+    reduce = small > 0.66 * big
+    u = (small - big if reduce else small) / (small + big if reduce else max(big, 1e-300))
+    z = u * u
+    p = (
+        z
+        * ((((ATAN_P0 * z + ATAN_P1) * z + ATAN_P2) * z + ATAN_P3) * z + ATAN_P4)
+        / (((((z + ATAN_Q0) * z + ATAN_Q1) * z + ATAN_Q2) * z + ATAN_Q3) * z + ATAN_Q4)
+    )
+    v = u * p + u
+    v = v + 0.5 * MOREBITS if reduce else v
+    # atan2 = hi ± atan t: t itself (hi 0), π/2 ∓ atan t (swap), π − atan t (x < 0).
+    left = math.copysign(1.0, x) < 0.0
+    minus = swap != left
+    hi = PIO2 if swap else (PI if left else 0.0)
+    lo = MOREBITS if swap else (2.0 * MOREBITS if left else 0.0)
+    hi = (hi - PIO4 if minus else hi + PIO4) if reduce else hi
+    value = math.copysign(hi + ((-v if minus else v) + lo), y)
+    return value if (x == x) & (y == y) else np.nan
+
+
 @_helper
 def _tt_matrix(phi: float, theta: float, psi: float, r: NDArray[np.float64]) -> None:
     """R(φ, θ, ψ) = Rz(φ)·Ry(θ)·Rz(ψ − φ) into r (9,), row-major (as rotations.tt_to_matrix).
@@ -1166,115 +1290,161 @@ def _pair_plane_moving(
         _pair_at(leg_i, leg_j, minima, n, rx, ry, rz, rx * rx + ry * ry + rz * rz, pf)
 
 
-@_helper
-def _leg_planes_moving(
-    model: NDArray[np.float64],
-    rotation: NDArray[np.float64],
+@_inline
+def _moving_leg_at(
     leg: NDArray[np.float64],
     base: NDArray[np.float64],
     minima: NDArray[np.float64],
     moves: NDArray[np.float64],
-    count: int,
-    k: int,
-    px: float,
-    py: float,
-    pz: float,
+    n: int,
+    kf: float,
+    platform: tuple[float, float, float],
+    end: tuple[float, float, float],
+    drive: tuple[float, float, float],
+    axis: tuple[float, float, float],
+    platform_axis: tuple[float, float, float],
+    q: float,
+    ik: float,
+    limits: tuple[float, float, float],
 ) -> None:
-    """Leg k of a pus or rus model over a block: the inverse kinematics of
-    :func:`_pose_moving` (the same closed forms), the base-side end into ``base`` (x, y, z
-    rows), the leg vector, squared length, 1/ℓ² and joint cosines into ``leg``, the running
-    minima of both cosines, of ``actuator``, ``ik`` and ``transmission`` with their legs (first
-    leg on ties); a leg without a solution flags the pose for the exact path (NaN margins)."""
-    bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
-    ox, oy, oz = model[A + 3 * k], model[A + 3 * k + 1], model[A + 3 * k + 2]
-    ux, uy, uz = model[RAIL + 3 * k], model[RAIL + 3 * k + 1], model[RAIL + 3 * k + 2]
-    ex, ey, ez = model[ZERO + 3 * k], model[ZERO + 3 * k + 1], model[ZERO + 3 * k + 2]
-    fx, fy, fz = model[CROSS + 3 * k], model[CROSS + 3 * k + 1], model[CROSS + 3 * k + 2]
-    j0x, j0y, j0z = model[JA + 3 * k], model[JA + 3 * k + 1], model[JA + 3 * k + 2]
-    cx, cy, cz = (
-        model[AXIS_CROSS + 3 * k],
-        model[AXIS_CROSS + 3 * k + 1],
-        model[AXIS_CROSS + 3 * k + 2],
+    """Pose n of leg k's planes for moving base joints (pus, rus; ``kf`` = k): the base-side end
+    ``end`` into ``base``, the leg vector platform − end, squared length, 1/ℓ² and joint cosines
+    into ``leg`` (``axis`` the base joint axis, ``platform_axis`` R·jB_k), the running minima of
+    both cosines, of ``actuator`` (q against ``limits`` = (q_min, q_max, τ_min)), ``ik`` and
+    ``transmission`` (|n·drive| − τ_min) with their legs (first leg on ties); a leg without a
+    solution flags the pose (its margins are NaN: :func:`_unsolved_outputs`), a NaN coordinate
+    of a solved leg or a zero-length leg the exact path. One select per statement, no branch,
+    so that the loops over poses vectorise."""
+    x, y, z = platform[0] - end[0], platform[1] - end[1], platform[2] - end[2]
+    base[n] = end[0]
+    base[BLOCK + n] = end[1]
+    base[2 * BLOCK + n] = end[2]
+    leg[_LX * BLOCK + n] = x
+    leg[_LY * BLOCK + n] = y
+    leg[_LZ * BLOCK + n] = z
+    squared = x * x + y * y + z * z
+    leg[_SQ * BLOCK + n] = squared
+    inverse = 1.0 / math.sqrt(squared)
+    leg[_INV * BLOCK + n] = inverse * inverse
+    cos_a = (axis[0] * x + axis[1] * y + axis[2] * z) * inverse
+    cos_b = (platform_axis[0] * x + platform_axis[1] * y + platform_axis[2] * z) * -inverse
+    _store_cosines(leg, minima, n, kf, cos_a, cos_b)
+    value = min(q - limits[0], limits[1] - q)
+    smallest = moves[_M_ACT * BLOCK + n]
+    moves[_LEG_ACT * BLOCK + n] = kf if value < smallest else moves[_LEG_ACT * BLOCK + n]
+    moves[_M_ACT * BLOCK + n] = min(value, smallest)
+    smallest = moves[_M_IK * BLOCK + n]
+    moves[_LEG_IK * BLOCK + n] = kf if ik < smallest else moves[_LEG_IK * BLOCK + n]
+    moves[_M_IK * BLOCK + n] = min(ik, smallest)
+    value = abs(drive[0] * x + drive[1] * y + drive[2] * z) * inverse - limits[2]
+    smallest = moves[_M_TAU * BLOCK + n]
+    moves[_LEG_TAU * BLOCK + n] = kf if value < smallest else moves[_LEG_TAU * BLOCK + n]
+    moves[_M_TAU * BLOCK + n] = min(value, smallest)
+    # Unsolved (ik < 0 or NaN): the first such leg is kept (unsolved > the flag so far only
+    # for the first one).
+    unsolved = 0.0 if ik >= 0.0 else 1.0
+    flagged = moves[_UNSOLVED * BLOCK + n]
+    moves[_UNSOLVED_LEG * BLOCK + n] = (
+        kf if unsolved > flagged else moves[_UNSOLVED_LEG * BLOCK + n]
     )
-    gx, gy, gz = (
-        model[AXIS_ALONG + 3 * k],
-        model[AXIS_ALONG + 3 * k + 1],
-        model[AXIS_ALONG + 3 * k + 2],
-    )
-    jbx, jby, jbz = model[JB + 3 * k], model[JB + 3 * k + 1], model[JB + 3 * k + 2]
-    length, branch, crank = model[LEG + k], model[BRANCH + k], model[CRANK + k]
-    qmin, qmax, centre = model[QMIN + k], model[QMAX + k], model[QCENTRE + k]
-    cos_centre, sin_centre = model[QCOS + k], model[QSIN + k]
-    tau_min, kf = model[TAU_MIN], float(k)
-    rus = model[ARCH] == 2.0
-    for n in range(count):
-        r00, r01, r02 = rotation[n], rotation[BLOCK + n], rotation[2 * BLOCK + n]
-        r10, r11, r12 = rotation[3 * BLOCK + n], rotation[4 * BLOCK + n], rotation[5 * BLOCK + n]
-        r20, r21, r22 = rotation[6 * BLOCK + n], rotation[7 * BLOCK + n], rotation[8 * BLOCK + n]
-        platform_x = (r00 * bx + r01 * by + r02 * bz) + px
-        platform_y = (r10 * bx + r11 * by + r12 * bz) + py
-        platform_z = (r20 * bx + r21 * by + r22 * bz) + pz
-        dx, dy, dz = platform_x - ox, platform_y - oy, platform_z - oz
-        along = ux * dx + uy * dy + uz * dz
-        hx, hy, hz = dx - along * ux, dy - along * uy, dz - along * uz
-        h = math.sqrt(hx * hx + hy * hy + hz * hz)
-        if rus:
-            a = 2.0 * crank * (dx * ex + dy * ey + dz * ez)
-            b = 2.0 * crank * (dx * fx + dy * fy + dz * fz)
-            c = (dx * dx + dy * dy + dz * dz) + crank * crank - length * length
-            ik = _crank_ik(along, h, crank, length)
-            q, cq, sq_ = _crank_angle(a, b, c, branch, centre, cos_centre, sin_centre)
-            base_x = ox + crank * (cq * ex + sq_ * fx)
-            base_y = oy + crank * (cq * ey + sq_ * fy)
-            base_z = oz + crank * (cq * ez + sq_ * fz)
-            tx, ty, tz = cq * fx - sq_ * ex, cq * fy - sq_ * ey, cq * fz - sq_ * ez
-            jx = cq * j0x + sq_ * cx + (1.0 - cq) * gx
-            jy = cq * j0y + sq_ * cy + (1.0 - cq) * gy
-            jz = cq * j0z + sq_ * cz + (1.0 - cq) * gz
-        else:
-            ik = length - h
-            q = along + branch * math.sqrt(max(ik * (length + h), 0.0))
-            base_x, base_y, base_z = ox + q * ux, oy + q * uy, oz + q * uz
-            tx, ty, tz = ux, uy, uz
-            jx, jy, jz = j0x, j0y, j0z
-        x, y, z = platform_x - base_x, platform_y - base_y, platform_z - base_z
-        base[n] = base_x
-        base[BLOCK + n] = base_y
-        base[2 * BLOCK + n] = base_z
-        leg[_LX * BLOCK + n] = x
-        leg[_LY * BLOCK + n] = y
-        leg[_LZ * BLOCK + n] = z
-        squared = x * x + y * y + z * z
-        leg[_SQ * BLOCK + n] = squared
-        inverse = 1.0 / math.sqrt(squared)
-        leg[_INV * BLOCK + n] = inverse * inverse
-        cos_a = (jx * x + jy * y + jz * z) * inverse
-        cos_b = (
-            (r00 * jbx + r01 * jby + r02 * jbz) * x
-            + (r10 * jbx + r11 * jby + r12 * jbz) * y
-            + (r20 * jbx + r21 * jby + r22 * jbz) * z
-        ) * -inverse
-        _store_cosines(leg, minima, n, kf, cos_a, cos_b)
-        value = min(q - qmin, qmax - q)
-        smallest = moves[_M_ACT * BLOCK + n]
-        moves[_LEG_ACT * BLOCK + n] = kf if value < smallest else moves[_LEG_ACT * BLOCK + n]
-        moves[_M_ACT * BLOCK + n] = min(value, smallest)
-        smallest = moves[_M_IK * BLOCK + n]
-        moves[_LEG_IK * BLOCK + n] = kf if ik < smallest else moves[_LEG_IK * BLOCK + n]
-        moves[_M_IK * BLOCK + n] = min(ik, smallest)
-        value = abs(tx * x + ty * y + tz * z) * inverse - tau_min
-        smallest = moves[_M_TAU * BLOCK + n]
-        moves[_LEG_TAU * BLOCK + n] = kf if value < smallest else moves[_LEG_TAU * BLOCK + n]
-        moves[_M_TAU * BLOCK + n] = min(value, smallest)
-        # Unsolved (ik < 0 or NaN), a NaN coordinate or a zero-length leg: the exact path.
-        # A leg without a solution: its margins are NaN (the outputs, below); a NaN coordinate
-        # of a solved leg or a zero-length leg: the exact path.
-        unsolved = 0.0 if ik >= 0.0 else 1.0
-        first = moves[_UNSOLVED * BLOCK + n] == 0.0 and unsolved != 0.0
-        moves[_UNSOLVED_LEG * BLOCK + n] = kf if first else moves[_UNSOLVED_LEG * BLOCK + n]
-        moves[_UNSOLVED * BLOCK + n] = max(moves[_UNSOLVED * BLOCK + n], unsolved)
-        unusable = 0.0 if ((q == q or unsolved != 0.0) and squared > 1e-300) else 1.0
-        minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], unusable)
+    moves[_UNSOLVED * BLOCK + n] = max(flagged, unsolved)
+    usable = ((q == q) | (unsolved != 0.0)) & (squared > 1e-300)
+    minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], 0.0 if usable else 1.0)
+
+
+def _moving_leg_planes(rus: bool) -> Callable[..., None]:
+    """The block stage of one leg for moving base joints, compiled for one architecture
+    (``rus`` is a constant of each compiled function, so each loop keeps one branch, and
+    vectorises)."""
+
+    def leg_planes(
+        model: NDArray[np.float64],
+        rotation: NDArray[np.float64],
+        leg: NDArray[np.float64],
+        base: NDArray[np.float64],
+        minima: NDArray[np.float64],
+        moves: NDArray[np.float64],
+        count: int,
+        k: int,
+        px: float,
+        py: float,
+        pz: float,
+    ) -> None:
+        """Leg k of a pus or rus model over a block: the inverse kinematics of
+        :func:`_pose_moving` (:func:`_slide_leg`: the rail is the slide's drive direction, the
+        base joint axis translates with the slide; or :func:`_crank_leg` and :func:`_crank_end`:
+        the crank end, its unit velocity, the joint axis turned with the crank), then
+        :func:`_moving_leg_at`."""
+        bx, by, bz = model[B + 3 * k], model[B + 3 * k + 1], model[B + 3 * k + 2]
+        ox, oy, oz = model[A + 3 * k], model[A + 3 * k + 1], model[A + 3 * k + 2]
+        ux, uy, uz = model[RAIL + 3 * k], model[RAIL + 3 * k + 1], model[RAIL + 3 * k + 2]
+        j0x, j0y, j0z = model[JA + 3 * k], model[JA + 3 * k + 1], model[JA + 3 * k + 2]
+        jbx, jby, jbz = model[JB + 3 * k], model[JB + 3 * k + 1], model[JB + 3 * k + 2]
+        length, branch = model[LEG + k], model[BRANCH + k]
+        e, f, w, sizes, centre = _crank(model, k)
+        axis_cross, axis_along = _vector(model, AXIS_CROSS, k), _vector(model, AXIS_ALONG, k)
+        limits = (model[QMIN + k], model[QMAX + k], model[TAU_MIN])
+        kf = float(k)
+        for n in range(count):
+            r00, r01, r02 = rotation[n], rotation[BLOCK + n], rotation[2 * BLOCK + n]
+            r10, r11, r12 = (
+                rotation[3 * BLOCK + n],
+                rotation[4 * BLOCK + n],
+                rotation[5 * BLOCK + n],
+            )
+            r20, r21, r22 = (
+                rotation[6 * BLOCK + n],
+                rotation[7 * BLOCK + n],
+                rotation[8 * BLOCK + n],
+            )
+            platform_x = (r00 * bx + r01 * by + r02 * bz) + px
+            platform_y = (r10 * bx + r11 * by + r12 * bz) + py
+            platform_z = (r20 * bx + r21 * by + r22 * bz) + pz
+            dx, dy, dz = platform_x - ox, platform_y - oy, platform_z - oz
+            if rus:
+                ik, q, cos_q, sin_q = _crank_leg(dx, dy, dz, e, f, w, sizes, centre)
+                end_x, end_y, end_z, tx, ty, tz, jx, jy, jz = _crank_end(
+                    (ox, oy, oz),
+                    e,
+                    f,
+                    (j0x, j0y, j0z),
+                    axis_cross,
+                    axis_along,
+                    sizes[0],
+                    cos_q,
+                    sin_q,
+                )
+            else:
+                ik, q = _slide_leg(dx, dy, dz, ux, uy, uz, length, branch)
+                end_x, end_y, end_z = ox + q * ux, oy + q * uy, oz + q * uz
+                tx, ty, tz, jx, jy, jz = ux, uy, uz, j0x, j0y, j0z
+            _moving_leg_at(
+                leg,
+                base,
+                minima,
+                moves,
+                n,
+                kf,
+                (platform_x, platform_y, platform_z),
+                (end_x, end_y, end_z),
+                (tx, ty, tz),
+                (jx, jy, jz),
+                (
+                    r00 * jbx + r01 * jby + r02 * jbz,
+                    r10 * jbx + r11 * jby + r12 * jbz,
+                    r20 * jbx + r21 * jby + r22 * jbz,
+                ),
+                q,
+                ik,
+                limits,
+            )
+
+    leg_planes.__name__ = leg_planes.__qualname__ = "_leg_planes_rus" if rus else "_leg_planes_pus"
+    return _helper(leg_planes)
+
+
+_leg_planes_pus = _moving_leg_planes(rus=False)
+_leg_planes_rus = _moving_leg_planes(rus=True)
 
 
 @_helper
@@ -1328,6 +1498,7 @@ def _check_block(
     """
     px, py, pz = position[0], position[1], position[2]
     moving = model[ARCH] != 0.0
+    rus = model[ARCH] == 2.0
     for n in range(count):  # strided reads: a loop of its own (it does not vectorise)
         work[_PHI * BLOCK + n] = angles[first + n, 0]
         work[_THETA * BLOCK + n] = angles[first + n, 1]
@@ -1372,19 +1543,12 @@ def _check_block(
                 moves[(row + 1) * BLOCK + n] = 0.0
     for k in range(6):
         if moving:
-            _leg_planes_moving(
-                model,
-                rotation,
-                _planes(work, _LEGS + 7 * k, 7),
-                _planes(work, _BASE + 3 * k, 3),
-                minima,
-                moves,
-                count,
-                k,
-                px,
-                py,
-                pz,
-            )
+            leg = _planes(work, _LEGS + 7 * k, 7)
+            base = _planes(work, _BASE + 3 * k, 3)
+            if rus:
+                _leg_planes_rus(model, rotation, leg, base, minima, moves, count, k, px, py, pz)
+            else:
+                _leg_planes_pus(model, rotation, leg, base, minima, moves, count, k, px, py, pz)
         else:
             _leg_planes(
                 model, rotation, _planes(work, _LEGS + 7 * k, 7), minima, count, k, px, py, pz

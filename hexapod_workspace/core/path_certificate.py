@@ -79,6 +79,7 @@ from .constraint_table import (
     IK,
     LEG_LENGTH,
     N_CONSTRAINTS,
+    SINGULARITY,
     TRANSMISSION,
     applicable,
     rate_bounds,
@@ -110,10 +111,17 @@ class _Certifier:
         self.rho = float(np.max(np.linalg.norm(manipulator.platform_joints, axis=1)))
         self.length_min = float(np.min(manipulator.leg_length_min))
         self.moving = manipulator.architecture != "ups"
-        # Rows past the last one that applies are +inf at every pose: their lower bound is +inf
-        # and they never hold the smallest relative margin, so the fixed-base bounds and the
-        # relative margins are computed on the rows in use only.
-        self.rows = max(applicable(manipulator)) + 1
+        # The certificate works on the leading rows up to the last one that applies and is
+        # evaluated by :meth:`margins` (an unenforced singularity margin is not: it is +inf at
+        # every pose, as are the rows past the last one that applies). Those later rows have a
+        # lower bound of +inf and never hold the smallest relative margin: the bounds, the
+        # relative margins and the bisection's arrays leave them out (6-UPS: 4 of 9 rows).
+        evaluated = [
+            row
+            for row in applicable(manipulator)
+            if row != SINGULARITY or manipulator.singularity_min > 0.0
+        ]
+        self.rows = max(evaluated) + 1
         self.crank_inverse = (
             1.0 / float(np.min(manipulator.crank_lengths))
             if manipulator.crank_lengths is not None
@@ -134,13 +142,13 @@ class _Certifier:
         speed: NDArray[np.float64],
         omega: NDArray[np.float64],
     ) -> NDArray[np.float64]:
-        """Certified lower bounds (C, n) of the margins over intervals of ``width`` (n,) in s,
-        from the margins (C, n) at both ends and the move's V and Ω (n,); the rates are those
-        of the constraint table (:func:`~hexapod_workspace.core.constraint_table.rate_bounds`)."""
+        """Certified lower bounds (R, n) of the margins of the first R = ``self.rows`` rows
+        (the others are +inf) over intervals of ``width`` (n,) in s, from the margins (C, n),
+        C ≥ R, at both ends and the move's V and Ω (n,); the rates are those of the constraint
+        table (:func:`~hexapod_workspace.core.constraint_table.rate_bounds`)."""
+        start, end = start[: self.rows], end[: self.rows]
         if self.moving:
             return self._lower_bounds_moving(start, end, width, speed, omega)
-        low = np.full_like(start, np.inf)
-        start, end = start[: self.rows], end[: self.rows]
         travel = speed * width
         length_start, length_end = start[LEG_LENGTH], end[LEG_LENGTH]
         with np.errstate(invalid="ignore", over="ignore"):
@@ -153,8 +161,8 @@ class _Certifier:
             lipschitz_travel = rate_bounds(
                 self.manipulator, travel, turn, omega * width, rows=self.rows
             )
-            np.minimum(
-                np.minimum(start, end), 0.5 * (start + end - lipschitz_travel), out=low[: self.rows]
+            low: NDArray[np.float64] = np.minimum(
+                np.minimum(start, end), 0.5 * (start + end - lipschitz_travel)
             )
         low[LEG_LENGTH] = low_length
         return low
@@ -200,6 +208,7 @@ class _Certifier:
                 actuate=travel * gain * inverse,
                 crank=travel * crank * inverse,
                 ends=travel * inverse,
+                rows=self.rows,
             )
             low: NDArray[np.float64] = np.minimum(
                 np.minimum(start, end), 0.5 * (start + end - lipschitz_travel)
@@ -261,8 +270,12 @@ def _check_moves(
     the sample table so that limiting legs at the ends can be reported. Without
     ``locate_minimum`` (the planner) only the smallest sampled margin is computed, not where it
     is (``min_index`` −1, ``min_s`` NaN): the same values, without sorting the sample table.
+    The bisection carries the margins of the certifier's rows only (the later rows are +inf at
+    every pose: :class:`_Certifier`); the sample table has every row.
     """
     count = start.shape[1]
+    used = certifier.rows
+    start, end = start[:used], end[:used]
     with np.errstate(divide="ignore"):
         h_tol = np.where(moves.rate > 0.0, tolerance / moves.rate, np.inf)
         h_max = np.where(moves.rate > 0.0, max_sample_angle / moves.rate, np.inf)
@@ -317,10 +330,11 @@ def _check_moves(
         next_row += middle.size
         table_s.append(middle)
         table_move.append(move)
-        table_margins.append(found.margins)
+        found_margins = found.margins[:used]
+        table_margins.append(found_margins)
         table_legs.append(found.limiting_legs)
         table_pairs.append(found.limiting_pairs)
-        violated = ~np.all(found.margins >= 0.0, axis=0)
+        violated = ~np.all(found_margins >= 0.0, axis=0)
         if np.any(violated):
             # Earliest violated sample per move (np.minimum.at keeps the smallest s).
             candidate = np.full(count, np.inf)
@@ -332,20 +346,24 @@ def _check_moves(
         move = np.concatenate([move, move])
         lo, hi = np.concatenate([lo, middle]), np.concatenate([middle, hi])
         row_lo, row_hi = np.concatenate([row_lo, rows]), np.concatenate([rows, row_hi])
-        margins_lo = np.concatenate([margins_lo, found.margins], axis=1)
-        margins_hi = np.concatenate([found.margins, margins_hi], axis=1)
+        margins_lo = np.concatenate([margins_lo, found_margins], axis=1)
+        margins_hi = np.concatenate([found_margins, margins_hi], axis=1)
     else:  # pragma: no cover - MAX_ROUNDS halvings reach any tolerance >= 1e-9 first
         msg = "segment check did not converge"
         raise RuntimeError(msg)
+    margins = np.concatenate(table_margins, axis=1)
     samples: _Samples = {
         "s": np.concatenate(table_s),
         "move": np.concatenate(table_move),
-        "margins": np.concatenate(table_margins, axis=1),
+        # Every row again: the rows the bisection left out are +inf.
+        "margins": np.concatenate(
+            [margins, np.full((N_CONSTRAINTS - used, margins.shape[1]), np.inf)]
+        ),
         "legs": np.concatenate(table_legs, axis=1),
         "pairs": np.concatenate(table_pairs, axis=0),
     }
     # Minimum over the samples of [0, first violation] and over the final interval bounds.
-    relative = certifier.relative(samples["margins"])
+    relative = certifier.relative(margins)
     inside = samples["s"] <= np.minimum(first_bad, 1.0)[samples["move"]]
     if locate_minimum:
         # Per move: inside first, smallest (every move has its start, s = 0, inside).
