@@ -122,7 +122,11 @@ OBSTACLES = PLATFORM_RECORD + RECORD_SIZE
 _SPHERE = RECORD_SIZE  # centre (3), radius
 _CAPSULE = _SPHERE + 4  # first end (3), direction end − start (3), radius
 _REFINE = _CAPSULE + 7  # 1.0: a box or cylinder (its exact value: 14 closed forms, or GJK)
-OBSTACLE_STRIDE = _REFINE + 1
+_ELONGATED = _REFINE + 1  # 1.0: the sphere is much wider than the capsule: the capsule first
+OBSTACLE_STRIDE = _ELONGATED + 1
+#: An obstacle whose sphere's radius exceeds its capsule's by this factor (a column, a long
+#: box) is bounded by its capsule from the start: its sphere would prune nothing.
+ELONGATED = 1.5
 # Then the pairs: (moving body, other body) per pair, bodies numbered as in collision.scene
 # (0-5 legs, 6 platform, 7 tool, 8 + k obstacle k).
 _PLATFORM, _TOOL, _FIRST_OBSTACLE = 6, 7, 8
@@ -137,7 +141,8 @@ GJK_KERNEL_TOLERANCE = 1e-7
 #: must never let a bound exceed the value it bounds.
 BOUND_SLACK = 1e-9
 
-#: Pairs whose first broad-phase bound is kept between the two passes (beyond: recomputed).
+#: Pairs whose bounds the working memory keeps (visited best first); beyond, two passes in index
+#: order with the bounds recomputed.
 KEPT_BOUNDS = 64
 
 # Working memory (a flat view of the kernels' scratch after the leg planes).
@@ -145,11 +150,14 @@ _BODIES = 0  # 8 moving-body records, then the obstacle being evaluated (a writa
 _WORK = 9 * RECORD_SIZE  # GJK working memory (WORK_ROWS, 3)
 _AXES = _WORK + 3 * WORK_ROWS  # per moving body: end (3), direction (3), 1/|direction|², radius
 _AXIS_STRIDE = 8
-_TOOL_SPHERE = _AXES + 8 * _AXIS_STRIDE  # centre (3), radius: holds the tool
-_BUILT = _TOOL_SPHERE + 4  # per moving body: 1.0 once its record is filled at this pose
-_KEPT = _BUILT + 8  # the first bounds of the first KEPT_BOUNDS pairs
+_BUILT = _AXES + 8 * _AXIS_STRIDE  # per moving body: 1.0 once its record is filled at this pose
+_KEPT = _BUILT + 8  # per pair (up to KEPT_BOUNDS): its first bound,
+_KEYS = _KEPT + KEPT_BOUNDS  # the best lower bound of its value known (or the value),
+_STATE = _KEYS + KEPT_BOUNDS  # what that key is (_FIRST, _REFINED, _VALUE),
+_GAPS = _STATE + KEPT_BOUNDS  # and the gap of the value
+_FIRST, _REFINED, _VALUE = 0.0, 1.0, 2.0
 #: Floats of working memory :func:`collision_margin` needs.
-SCRATCH_FLOATS = _KEPT + KEPT_BOUNDS
+SCRATCH_FLOATS = _GAPS + KEPT_BOUNDS
 
 
 def pack_scene(manipulator: Manipulator) -> NDArray[np.float64]:
@@ -208,6 +216,7 @@ def _obstacle_entry(body: NDArray[np.float64]) -> NDArray[np.float64]:
     entry[_SPHERE + 3] = reach + body[_INFLATION]
     entry[_CAPSULE : _CAPSULE + 7] = _enclosing(np.ascontiguousarray(body))
     entry[_REFINE] = 1.0 if kind in (BOX, CYLINDER) else 0.0
+    entry[_ELONGATED] = 1.0 if entry[_SPHERE + 3] > ELONGATED * entry[_CAPSULE + 6] else 0.0
     return entry
 
 
@@ -265,25 +274,29 @@ def _set_axis(
 
 
 @_helper
-def _sphere_bound(memory: NDArray[np.float64], body: int, sphere: NDArray[np.float64]) -> float:
+def _sphere_bound(
+    memory: NDArray[np.float64], body: int, sphere: NDArray[np.float64], s: int
+) -> float:
     """Signed distance of the capsule around moving body ``body``'s axis and the sphere
-    (centre, radius) = sphere[0:4], m: a lower bound of the pair's sd (both hold the bodies)."""
+    (centre, radius) = sphere[s : s + 4], m: a lower bound of the pair's sd (both hold the
+    bodies). Offsets, not views, are passed: a view costs reference counting per call."""
     at = _AXES + _AXIS_STRIDE * body
     ax, ay, az = memory[at], memory[at + 1], memory[at + 2]
     dx, dy, dz = memory[at + 3], memory[at + 4], memory[at + 5]
-    wx, wy, wz = sphere[0] - ax, sphere[1] - ay, sphere[2] - az
+    wx, wy, wz = sphere[s] - ax, sphere[s + 1] - ay, sphere[s + 2] - az
     t = (wx * dx + wy * dy + wz * dz) * memory[at + 6]
     t = min(max(t, 0.0), 1.0)
     ex, ey, ez = wx - t * dx, wy - t * dy, wz - t * dz
-    return math.sqrt(ex * ex + ey * ey + ez * ez) - sphere[3] - memory[at + 7]
+    return math.sqrt(ex * ex + ey * ey + ez * ez) - sphere[s + 3] - memory[at + 7]
 
 
 @_helper
 def _capsule_pair_bound(
-    memory: NDArray[np.float64], body: int, capsule: NDArray[np.float64]
+    memory: NDArray[np.float64], body: int, capsule: NDArray[np.float64], c: int, radius: float
 ) -> float:
-    """Signed distance of the capsule around moving body ``body``'s axis and a capsule (first
-    end, direction, radius) = capsule[0:7], m: a lower bound of the pair's sd."""
+    """Signed distance of the capsule around moving body ``body``'s axis and the capsule of
+    ``radius`` around segment (first end, direction) = capsule[c : c + 6], m: a lower bound of
+    the pair's sd."""
     at = _AXES + _AXIS_STRIDE * body
     distance = _segment_segment(
         memory[at],
@@ -292,14 +305,14 @@ def _capsule_pair_bound(
         memory[at + 3],
         memory[at + 4],
         memory[at + 5],
-        capsule[0],
-        capsule[1],
-        capsule[2],
-        capsule[3],
-        capsule[4],
-        capsule[5],
+        capsule[c],
+        capsule[c + 1],
+        capsule[c + 2],
+        capsule[c + 3],
+        capsule[c + 4],
+        capsule[c + 5],
     )
-    return distance - memory[at + 7] - capsule[6]
+    return distance - memory[at + 7] - radius
 
 
 @_helper
@@ -310,13 +323,119 @@ def _first_bound(
     moving: int,
     other: int,
 ) -> float:
-    """The pair's first broad-phase bound (sphere against capsule), lowered by BOUND_SLACK."""
-    if other < _FIRST_OBSTACLE:  # the tool against a leg: the leg's capsule, the tool's sphere
-        bound = _sphere_bound(memory, other, memory[_TOOL_SPHERE : _TOOL_SPHERE + 4])
+    """The pair's first broad-phase bound, lowered by BOUND_SLACK: the obstacle's sphere against
+    the moving body's capsule, or for an elongated obstacle the two capsules; the tool against
+    a leg, the two capsules (their distance, the exact value up to rounding)."""
+    if other < _FIRST_OBSTACLE:
+        at = _AXES + _AXIS_STRIDE * other
+        bound = _capsule_pair_bound(memory, moving, memory, at, memory[at + 7])
     else:
-        at = block + OBSTACLES + OBSTACLE_STRIDE * (other - _FIRST_OBSTACLE) + _SPHERE
-        bound = _sphere_bound(memory, moving, model[at : at + 4])
+        at = block + OBSTACLES + OBSTACLE_STRIDE * (other - _FIRST_OBSTACLE)
+        if model[at + _ELONGATED] != 0.0:
+            bound = _capsule_pair_bound(
+                memory, moving, model, at + _CAPSULE, model[at + _CAPSULE + 6]
+            )
+        else:
+            bound = _sphere_bound(memory, moving, model, at + _SPHERE)
     return bound - BOUND_SLACK
+
+
+@_helper
+def _refined_bound(
+    model: NDArray[np.float64],
+    block: int,
+    memory: NDArray[np.float64],
+    moving: int,
+    other: int,
+) -> float:
+    """The pair's capsule bound (two capsules), lowered by BOUND_SLACK, where the exact value
+    is costly (a box, a cylinder, the platform); −inf elsewhere (the exact value is as cheap)."""
+    if other < _FIRST_OBSTACLE:
+        return -np.inf
+    at = block + OBSTACLES + OBSTACLE_STRIDE * (other - _FIRST_OBSTACLE)
+    if model[at + _ELONGATED] != 0.0 or (model[at + _REFINE] == 0.0 and moving != _PLATFORM):
+        return -np.inf
+    radius = model[at + _CAPSULE + 6]
+    return _capsule_pair_bound(memory, moving, model, at + _CAPSULE, radius) - BOUND_SLACK
+
+
+@_helper
+def _best_first(
+    model: NDArray[np.float64],
+    block: int,
+    r: NDArray[np.float64],
+    px: float,
+    py: float,
+    pz: float,
+    memory: NDArray[np.float64],
+    bodies: NDArray[np.float64],
+    work: NDArray[np.float64],
+    pairs_at: int,
+    n_pairs: int,
+    clearance: float,
+) -> tuple[float, float, float]:
+    """:func:`collision_margin` for at most KEPT_BOUNDS pairs: pairs visited in the order of
+    their bounds (module docstring, "Cost").
+
+    Each pair holds a key, a lower bound of its value: the first bound, raised to the capsule
+    bound once refined, then its value. The pair of the smallest (key, index) is taken: a
+    first bound is refined where a capsule bound exists, a bound is replaced by the value,
+    and a value ends the search (every other pair's value is at least its key: higher, or the
+    same at a higher index, so it loses). GJK may stop once it passes the next smallest key
+    by 2·BOUND_SLACK; its value then stands as the pair's key (a lower bound of its full value,
+    which is never below what an earlier stop returned), marked to be evaluated again if taken.
+    """
+    first = memory[_KEPT : _KEPT + KEPT_BOUNDS]
+    key = memory[_KEYS : _KEYS + KEPT_BOUNDS]
+    state = memory[_STATE : _STATE + KEPT_BOUNDS]
+    gaps = memory[_GAPS : _GAPS + KEPT_BOUNDS]
+    for k in range(n_pairs):
+        bound = _first_bound(
+            model, block, memory, int(model[pairs_at + 2 * k]), int(model[pairs_at + 2 * k + 1])
+        )
+        first[k] = bound
+        key[k] = bound
+        state[k] = _FIRST
+    while True:
+        k = 0
+        second = np.inf
+        for j in range(1, n_pairs):
+            if key[j] < key[k]:
+                second = key[k]
+                k = j
+            elif key[j] < second:
+                second = key[j]
+        if state[k] == _VALUE:
+            return key[k] - clearance, float(k), gaps[k]
+        moving = int(model[pairs_at + 2 * k])
+        other = int(model[pairs_at + 2 * k + 1])
+        if state[k] == _FIRST:
+            state[k] = _REFINED
+            refined = _refined_bound(model, block, memory, moving, other)
+            if refined > key[k]:
+                key[k] = refined
+                continue
+        value, gap = _exact(
+            model,
+            block,
+            r,
+            px,
+            py,
+            pz,
+            memory,
+            bodies,
+            work,
+            moving,
+            other,
+            first[k],
+            second + 2.0 * BOUND_SLACK,
+        )
+        if value != value:  # a NaN value wins (the leg planes were finite: not expected)
+            return value, float(k), gap
+        key[k] = value
+        gaps[k] = gap
+        # At most second + BOUND_SLACK, GJK ran to its tolerance (an early stop returns more).
+        state[k] = _VALUE if value <= second + BOUND_SLACK else _REFINED
 
 
 @_helper
@@ -328,6 +447,8 @@ def _exact(
     py: float,
     pz: float,
     memory: NDArray[np.float64],
+    bodies: NDArray[np.float64],
+    work: NDArray[np.float64],
     moving: int,
     other: int,
     floor: float,
@@ -335,9 +456,8 @@ def _exact(
 ) -> tuple[float, float]:
     """(value, gap) of one pair by :func:`.collision.distance._pair`: the moving body's record
     is filled on first use at this pose; ``floor`` is the pair's first bound (GJK's answer is
-    raised to it), ``cutoff`` GJK's early stop."""
-    bodies = memory[_BODIES : _BODIES + 9 * RECORD_SIZE].reshape(9, RECORD_SIZE)
-    work = memory[_WORK : _WORK + 3 * WORK_ROWS].reshape(WORK_ROWS, 3)
+    raised to it), ``cutoff`` GJK's early stop; ``bodies`` (9, RECORD_SIZE) and ``work``
+    (WORK_ROWS, 3) are views of ``memory``, made once per pose (a reshape costs)."""
     for body in (moving, other):
         if body < _FIRST_OBSTACLE and memory[_BUILT + body] == 0.0:
             memory[_BUILT + body] = 1.0
@@ -441,11 +561,6 @@ def collision_margin(
         z1 = r20 * model[t + 3] + r21 * model[t + 4] + r22 * model[t + 5] + pz
         radius = model[block + TOOL_RADIUS]
         _set_axis(memory, _TOOL, x0, y0, z0, x1, y1, z1, radius)
-        dx, dy, dz = x1 - x0, y1 - y0, z1 - z0
-        memory[_TOOL_SPHERE] = 0.5 * (x0 + x1)
-        memory[_TOOL_SPHERE + 1] = 0.5 * (y0 + y1)
-        memory[_TOOL_SPHERE + 2] = 0.5 * (z0 + z1)
-        memory[_TOOL_SPHERE + 3] = 0.5 * math.sqrt(dx * dx + dy * dy + dz * dz) + radius
     if model[block + PLATFORM_ON] != 0.0:
         # The axis segment of the platform cylinder, and its radius (the capsule holds it).
         at = block + PLATFORM_RECORD
@@ -467,6 +582,8 @@ def collision_margin(
         )
     for body in range(8):
         memory[_BUILT + body] = 0.0
+    bodies = memory[_BODIES : _BODIES + 9 * RECORD_SIZE].reshape(9, RECORD_SIZE)
+    work = memory[_WORK : _WORK + 3 * WORK_ROWS].reshape(WORK_ROWS, 3)
     n_obstacles = int(model[block + N_OBSTACLES])
     n_pairs = int(model[block + N_PAIRS])
     pairs_at = block + OBSTACLES + OBSTACLE_STRIDE * n_obstacles
@@ -480,21 +597,26 @@ def collision_margin(
             moving = int(model[pairs_at + 2 * k])
             other = int(model[pairs_at + 2 * k + 1])
             floor = _first_bound(model, block, memory, moving, other)
-            value, gap = _exact(model, block, r, px, py, pz, memory, moving, other, floor, np.inf)
+            value, gap = _exact(
+                model, block, r, px, py, pz, memory, bodies, work, moving, other, floor, np.inf
+            )
             if value < best or value != value:
                 best, chosen, best_gap = value, k, gap
                 if value != value:
                     break
         return best - clearance, float(chosen), best_gap
-    # First pass: every pair's first bound; the pair of the smallest is evaluated first.
+    if n_pairs <= KEPT_BOUNDS:
+        return _best_first(
+            model, block, r, px, py, pz, memory, bodies, work, pairs_at, n_pairs, clearance
+        )
+    # More pairs than kept bounds: two passes, bounds recomputed. First pass: every pair's first
+    # bound; the pair of the smallest is evaluated first.
     first = 0
     first_bound = np.inf
     for k in range(n_pairs):
         bound = _first_bound(
             model, block, memory, int(model[pairs_at + 2 * k]), int(model[pairs_at + 2 * k + 1])
         )
-        if k < KEPT_BOUNDS:
-            memory[_KEPT + k] = bound
         if bound < first_bound:
             first, first_bound = k, bound
     # Second pass, the first pair then the others in index order: a pair goes on only while
@@ -505,23 +627,28 @@ def collision_margin(
             continue
         moving = int(model[pairs_at + 2 * k])
         other = int(model[pairs_at + 2 * k + 1])
-        if k < KEPT_BOUNDS:
-            floor = memory[_KEPT + k]
-        else:
-            floor = _first_bound(model, block, memory, moving, other)
+        floor = _first_bound(model, block, memory, moving, other)
         if floor > best or (floor == best and k > chosen):
             continue
-        if other >= _FIRST_OBSTACLE:
-            at = block + OBSTACLES + OBSTACLE_STRIDE * (other - _FIRST_OBSTACLE)
-            if model[at + _REFINE] != 0.0 or moving == _PLATFORM:
-                capsule = model[at + _CAPSULE : at + _CAPSULE + 7]
-                bound = _capsule_pair_bound(memory, moving, capsule) - BOUND_SLACK
-                if bound > best or (bound == best and k > chosen):
-                    continue
+        bound = _refined_bound(model, block, memory, moving, other)
+        if bound > best or (bound == best and k > chosen):
+            continue
         # GJK may stop once its bound passes best + BOUND_SLACK: the value it then returns is
         # above best (by more than rounding), so the pair loses, as its full value would.
         value, gap = _exact(
-            model, block, r, px, py, pz, memory, moving, other, floor, best + BOUND_SLACK
+            model,
+            block,
+            r,
+            px,
+            py,
+            pz,
+            memory,
+            bodies,
+            work,
+            moving,
+            other,
+            floor,
+            best + BOUND_SLACK,
         )
         if value < best or (value == best and k < chosen):
             best, chosen, best_gap = value, k, gap
