@@ -287,7 +287,7 @@ def _sphere_bound(
     t = (wx * dx + wy * dy + wz * dz) * memory[at + 6]
     t = min(max(t, 0.0), 1.0)
     ex, ey, ez = wx - t * dx, wy - t * dy, wz - t * dz
-    return math.sqrt(ex * ex + ey * ey + ez * ez) - sphere[s + 3] - memory[at + 7]
+    return float(math.sqrt(ex * ex + ey * ey + ez * ez) - sphere[s + 3] - memory[at + 7])
 
 
 @_helper
@@ -312,7 +312,7 @@ def _capsule_pair_bound(
         capsule[c + 4],
         capsule[c + 5],
     )
-    return distance - memory[at + 7] - radius
+    return float(distance - memory[at + 7] - radius)
 
 
 @_helper
