@@ -682,7 +682,7 @@ def torsion_scan(
 
     Notes
     -----
-    *Lazy collision margin* (fixed base joints only, as the ray searches' :func:`_lazy_rate`).
+    *Lazy collision margin* (fixed base joints only, as the ray searches' ``_lazy_rate``).
     At fixed (φ, θ) and position, R(ψ) = R(ψ₀)·Rz(ψ − ψ₀) (the tilt-and-torsion angles turn
     the platform about the tool axis by Δψ; checked numerically in the tests), so between two
     samples the platform turns by |ψ − ψ₀| rad about the fixed tool centre point, and by the
@@ -697,7 +697,7 @@ def torsion_scan(
     margin (the collision row is satisfied either way); on a violated sample the recovery step
     reads only the negative margins (collision's is positive either way), so it is the same; on
     a feasible sample the certified step from ``bound`` is certified (bound ≤ m) and is taken
-    when it keeps :data:`LAZY_STEP` of the step from m₀ (``_lazy_collision``), otherwise the
+    when it keeps ``LAZY_STEP`` of the step from m₀ (``_lazy_collision``), otherwise the
     margin is evaluated. Bisecting, only the verdict is read: the bound at the middle is the
     larger of (1) from the two ends of the bracket. A NaN margin is always evaluated. The
     transitions found are certified as before (every step is certified from lower bounds of
