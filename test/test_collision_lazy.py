@@ -11,6 +11,7 @@ boundary beyond the first violated dense sample, or disagree with the eager sear
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,10 +21,12 @@ from hexapod_workspace import Manipulator
 from hexapod_workspace.core.collision.scene import _tool_ends
 from hexapod_workspace.core.constraint_table import COLLISION
 from hexapod_workspace.core.constraints import check
+from hexapod_workspace.core.orientation import torsion_range
 from hexapod_workspace.core.params import flatten, load_params_file
 from hexapod_workspace.core.rotations import tt_to_matrix
 from hexapod_workspace.core.search import DEFAULT_MIN_STEP, RaySearch
 
+EXAMPLE = Path(__file__).resolve().parents[1] / "config" / "example_collision.yaml"
 TOLERANCE = 1e-6  # rad
 SPACING = 2.5e-4  # rad: dense sampling step, below half the march's shortest step
 
@@ -174,3 +177,48 @@ def test_a_ray_grazing_a_ball_between_probes_is_caught() -> None:
     found = search.rays("tt", origins, directions, 0.6, TOLERANCE)
     assert start - SPACING - TOLERANCE <= found.feasible[4] <= start
     assert found.limiting[4] == COLLISION
+
+
+def test_torsion_scan_lazy_against_eager_and_dense_sampling() -> None:
+    """The torsion scan bounds the collision margin from its earlier samples (Lipschitz in ψ at
+    rate ρ_c: turning ψ turns the platform by |Δψ| about the tool axis). On the worked example
+    (the spindle meets leg 3 near φ 90°, θ 30°) over 36 tool directions, the lazy scan's
+    torsion intervals equal dense sampling's away from their ends, and equal the eager scan's
+    (every sample evaluated) to the tolerance."""
+    cell = Manipulator.from_params_file(EXAMPLE)
+    home = np.array([0.0, 0.0, -1.3])
+    tolerance = 1e-4
+    psi = np.linspace(-math.pi, math.pi, 20_001)
+    # Turning ψ at fixed (φ, θ) is a rotation by |Δψ|, the fact the lazy bound rests on.
+    a = tt_to_matrix([[1.2, 0.5, -0.4]])[0]
+    b = tt_to_matrix([[1.2, 0.5, 0.3]])[0]
+    assert math.acos((np.trace(a.T @ b) - 1.0) / 2.0) == pytest.approx(0.7, abs=1e-12)
+    with_collision_edge = 0
+    for phi in np.radians(np.arange(0.0, 360.0, 30.0)):
+        for theta in np.radians([20.0, 28.0, 32.0]):
+            ranges = {}
+            for lazy in (True, False):
+                RaySearch.lazy_collision = lazy
+                try:
+                    ranges[lazy] = torsion_range(cell, phi, theta, home, tolerance=tolerance)
+                finally:
+                    RaySearch.lazy_collision = True
+            angles = np.column_stack([np.full_like(psi, phi), np.full_like(psi, theta), psi])
+            result = check(cell, angles, home)
+            dense = result.reachable
+            for found in ranges.values():
+                inside = np.zeros_like(dense)
+                near = np.zeros_like(dense)
+                for low, high in found.intervals:
+                    inside |= (psi >= low) & (psi <= high)
+                    near |= (np.abs(psi - low) < 2e-4) | (np.abs(psi - high) < 2e-4)
+                assert np.all(inside[~near] == dense[~near]), (phi, theta)
+            lazy_ends = np.array(ranges[True].intervals).ravel()
+            eager_ends = np.array(ranges[False].intervals).ravel()
+            assert lazy_ends.shape == eager_ends.shape, (phi, theta)
+            np.testing.assert_allclose(lazy_ends, eager_ends, atol=2 * tolerance)
+            # Count the directions where the collision row decides a transition.
+            collision = result.margins["collision"]
+            if np.any(np.diff(np.sign(collision)) != 0):
+                with_collision_edge += 1
+    assert with_collision_edge >= 3

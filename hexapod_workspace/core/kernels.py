@@ -134,6 +134,15 @@ def warm_up() -> float:
         True,
     )
     torsion_scan(
-        model, position, 0.0, 0.0, 1e-3, 0.25, 1e-3, np.empty(8), np.empty(8, dtype=np.bool_)
+        model,
+        position,
+        0.0,
+        0.0,
+        1e-3,
+        0.25,
+        1e-3,
+        np.empty(8),
+        np.empty(8, dtype=np.bool_),
+        True,
     )
     return time.perf_counter() - started

@@ -463,6 +463,7 @@ def torsion_range(
         tolerance,
         edges,
         rising,
+        search.lazy_collision,
     )
     edges, rising = edges[:count], rising[:count]
     intervals = []

@@ -110,8 +110,9 @@ class RaySearch:
         ``h_min`` of the module documentation, rad.
     """
 
-    #: Evaluate the collision margin along rays only where its Lipschitz bound cannot decide a
-    #: probe (False: at every probe, as a reference; see ``search_kernels.search_rays``).
+    #: Evaluate the collision margin along rays and in the torsion scan only where its Lipschitz
+    #: bound cannot decide a probe (False: at every probe, as a reference; see
+    #: ``search_kernels.search_rays`` and ``search_kernels.torsion_scan``).
     lazy_collision: bool = True
 
     def __init__(

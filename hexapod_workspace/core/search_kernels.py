@@ -607,6 +607,44 @@ def search_rays(
     return evaluations, collisions
 
 
+@_helper
+def _scan_pose(
+    model: NDArray[np.float64],
+    plain: NDArray[np.float64],
+    r: NDArray[np.float64],
+    position: NDArray[np.float64],
+    scratch: NDArray[np.float64],
+    out: NDArray[np.float64],
+    bound: float,
+    reference: float,
+    march: bool,
+) -> float:
+    """One sample of :func:`torsion_scan` into ``out``; returns what the scan knows of the
+    collision margin there, a lower bound of it: ``bound`` where that stands in for the margin
+    (``plain`` is the model with its scene off: every other margin evaluated), the evaluated
+    margin otherwise (``bound`` −inf: always evaluated). Acceptance (derivation in
+    :func:`torsion_scan`): the scan reads from a sample its verdict, its certified step where
+    feasible (marching, ``march``) and its recovery step where violated; bisecting, only the
+    verdict."""
+    if bound > 0.0:
+        _pose(plain, r, position[0], position[1], position[2], scratch, out, True)
+        usable = True
+        feasible = True
+        for c in range(N_CONSTRAINTS):
+            if out[c] != out[c]:
+                usable = False
+            elif out[c] < 0.0:
+                feasible = False
+        if usable:
+            if not (march and feasible):
+                out[COLLISION] = bound
+                return bound
+            if _lazy_collision(model, out, bound, reference, True):
+                return bound
+    _pose(model, r, position[0], position[1], position[2], scratch, out, True)
+    return float(out[COLLISION])
+
+
 @_jit
 def torsion_scan(
     model: NDArray[np.float64],
@@ -618,6 +656,7 @@ def torsion_scan(
     tolerance: float,
     edges: NDArray[np.float64],
     rising: NDArray[np.bool_],
+    lazy: bool = True,
 ) -> tuple[int, bool]:
     """Feasible-torsion transitions over ψ ∈ [−π, π] for one tool direction (φ, θ).
 
@@ -630,6 +669,9 @@ def torsion_scan(
     edges, rising : ndarray, shape (K,)
         Outputs: the feasible end of each transition, and whether it goes infeasible → feasible.
         K must be at least the number of transitions (ceil(2π / min_step) + 1 is enough).
+    lazy : bool
+        Bound the collision margin from the samples before instead of evaluating it where the
+        bound decides the sample as the margin would (below); False evaluates it everywhere.
 
     Returns
     -------
@@ -637,6 +679,30 @@ def torsion_scan(
         Number of transitions written (−1 − count when the outputs were too short).
     start_ok : bool
         Whether ψ = −π is feasible.
+
+    Notes
+    -----
+    *Lazy collision margin* (fixed base joints only, as the ray searches' ``_lazy_rate``).
+    At fixed (φ, θ) and position, R(ψ) = R(ψ₀)·Rz(ψ − ψ₀) (the tilt-and-torsion angles turn
+    the platform about the tool axis by Δψ; checked numerically in the tests), so between two
+    samples the platform turns by |ψ − ψ₀| rad about the fixed tool centre point, and by the
+    collision margin's rate bound at a fixed position (ρ_c per rad, ``_lazy_rate``)
+
+        m(ψ) ≥ m(ψ₀) − ρ_c·|ψ − ψ₀|.                                                    (1)
+
+    With m₀ the kernel's value at ψ₀ (itself ≤ the true margin, within GJK's tolerance) or a
+    bound already derived from (1), ``bound = m₀ − ρ_c·|Δψ| − LAZY_SLACK`` is below the value an
+    evaluation would return at ψ. The scan reads from a sample its verdict, its certified step
+    (feasible) or its recovery step (violated). Where ``bound`` > 0: the verdict is that of the
+    margin (the collision row is satisfied either way); on a violated sample the recovery step
+    reads only the negative margins (collision's is positive either way), so it is the same; on
+    a feasible sample the certified step from ``bound`` is certified (bound ≤ m) and is taken
+    when it keeps ``LAZY_STEP`` of the step from m₀ (``_lazy_collision``), otherwise the
+    margin is evaluated. Bisecting, only the verdict is read: the bound at the middle is the
+    larger of (1) from the two ends of the bracket. A NaN margin is always evaluated. The
+    transitions found are certified as before (every step is certified from lower bounds of
+    the margins); the samples can differ from an eager scan's (shorter steps where the bound
+    is taken), so the edges agree to the tolerance, as the tests check against dense sampling.
     """
     scratch = np.empty((SCRATCH_ROWS, 6))
     out = np.empty(OUT_SIZE)
@@ -644,15 +710,26 @@ def torsion_scan(
     capacity = edges.shape[0]
     low = np.empty(capacity)
     high = np.empty(capacity)
+    # Lower bounds of the collision margin at low and high (the lazy scan's anchors).
+    low_bound = np.empty(capacity)
+    high_bound = np.empty(capacity)
+    rate_c = _lazy_rate(model) if lazy and model[ARCH] == 0.0 else 0.0
+    plain = model.copy()
+    plain[COLLISION_ON] = 0.0
     count = 0
     psi = -math.pi
     previous_ok = False
     start_ok = False
     first = True
     previous = psi
+    known = -np.inf  # a lower bound of the collision margin at `previous`
+    reference = np.inf  # the evaluated margin that bound comes from
     while True:
         _tt_matrix(phi, theta, psi, r)
-        _pose(model, r, position[0], position[1], position[2], scratch, out, True)
+        bound = known - rate_c * (psi - previous) - LAZY_SLACK if rate_c > 0.0 else -np.inf
+        here = _scan_pose(model, plain, r, position, scratch, out, bound, reference, True)
+        if here != bound:
+            reference = here
         ok = _feasible(out)
         if first:
             start_ok = ok
@@ -661,11 +738,14 @@ def torsion_scan(
                 return -1 - count, start_ok
             low[count] = previous
             high[count] = psi
+            low_bound[count] = known
+            high_bound[count] = here
             rising[count] = ok
             count += 1
         first = False
         previous_ok = ok
         previous = psi
+        known = here
         if psi >= math.pi:
             break
         step = certified_step(model, out) if ok else recovery_step(model, out)
@@ -679,12 +759,21 @@ def torsion_scan(
         for k in range(count):
             middle = 0.5 * (low[k] + high[k])
             _tt_matrix(phi, theta, middle, r)
-            _pose(model, r, position[0], position[1], position[2], scratch, out, True)
+            bound = -np.inf
+            if rate_c > 0.0:
+                bound = max(
+                    low_bound[k] - rate_c * (middle - low[k]),
+                    high_bound[k] - rate_c * (high[k] - middle),
+                )
+                bound -= LAZY_SLACK
+            here = _scan_pose(model, plain, r, position, scratch, out, bound, np.inf, False)
             # Keep the transition inside [low, high]: the side matching the start state moves.
             if _feasible(out) != rising[k]:
                 low[k] = middle
+                low_bound[k] = here
             else:
                 high[k] = middle
+                high_bound[k] = here
     for k in range(count):
         edges[k] = high[k] if rising[k] else low[k]
     return count, start_ok

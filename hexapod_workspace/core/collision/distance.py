@@ -48,10 +48,12 @@ points), and inflations add: ``sd(A ⊕ r_A, B ⊕ r_B) = sd(A, B) − r_A − r
   :data:`GJK_GAP_BOUND` (1e-8 m).
 * Overlapping cores (GJK finds the origin in ``M``): the value is the largest of (1) over the
   candidate axes (box face normals, cylinder axes, cross products of edges and axes, the
-  direction between the centres): exact for a segment or point against a box (these are all
-  the face normals of ``M``: the separating-axis theorem), a lower bound otherwise, raised to
-  the signed distance of two capsules that hold the bodies when that is larger; the upper
-  bound of the cores' distance is then 0 (they overlap).
+  direction between the centres) and over the directions the iterations tried: exact for a
+  segment or point against a box (these are all the face normals of ``M``: the
+  separating-axis theorem), a lower bound otherwise, raised to the signed distance of two
+  capsules that hold the bodies when that is larger, and to a bound the caller passes
+  (``floor`` of :func:`_pair`); the upper bound of the cores' distance is then 0 (they
+  overlap).
 """
 
 from __future__ import annotations
@@ -644,8 +646,10 @@ def _gjk(
             break
     if not overlap:
         return lower, upper
-    # The cores overlap: the best of the candidate axes in (1); upper bound 0.
-    best = -np.inf
+    # The cores overlap: the best of the candidate axes in (1) and of the directions the
+    # iterations tried (``lower``: each is (1) for its direction, so the value never drops below
+    # a bound an earlier stop at ``cutoff`` would have returned); upper bound 0.
+    best = lower
     for body in (a, b):
         kind = int(body[_KIND])
         if kind == BOX:
@@ -684,10 +688,14 @@ def _pair(
     work: NDArray[np.float64],
     tolerance: float = GJK_TOLERANCE,
     cutoff: float = np.inf,
+    floor: float = -np.inf,
 ) -> tuple[float, float]:
     """(signed distance lower bound, gap to the upper bound) of two bodies, m; GJK's
     ``tolerance`` and ``cutoff`` (on the cores' distance: stop once it cannot be below it) as
-    in :func:`_gjk`."""
+    in :func:`_gjk`. ``floor`` is a lower bound of sd the caller already holds (a bound from
+    bodies that hold these two): where GJK answers, the value is raised to it (it stays a
+    certified lower bound, and a caller that skipped pairs by that bound skips exactly the
+    pairs whose value could not be the smallest); closed forms ignore it (exact)."""
     ka = int(a[_KIND])
     kb = int(b[_KIND])
     inflation = a[_INFLATION] + b[_INFLATION]
@@ -712,8 +720,8 @@ def _pair(
     lower, upper = _gjk(a, b, work, tolerance, cutoff + inflation)
     # Both are lower bounds of sd; in contact the enclosing capsules' can be the better one
     # (and the scene's pair skipping relies on the value never being below it).
-    value = max(lower - inflation, _capsule_bound(a, b))
-    return value, upper - inflation - value
+    value = max(lower - inflation, _capsule_bound(a, b), floor)
+    return value, max(upper - inflation - value, 0.0)
 
 
 @_jit
