@@ -16,6 +16,10 @@ realtime_priority
     ``0`` (default): normal scheduling; 1..99: the node's threads run under SCHED_FIFO at that
     priority, ahead of other jobs on the machine (its worker stays at normal priority; needs
     an rtprio limit or CAP_SYS_NICE; see docs/ros.md, "Threads, load and latency").
+worker_scheduling
+    ``idle`` (default), ``batch`` or ``normal``: the scheduling policy of the node's long
+    computations (the worker process's workspaces, the axis-limits process), lowered so that
+    the node's answers come first; unprivileged (docs/ros.md, "Threads, load and latency").
 rviz
     ``true`` also starts rviz2 with ``share/hexapod_workspace/config/workspace.rviz``.
 
@@ -57,6 +61,12 @@ def generate_launch_description() -> LaunchDescription:
                 description="SCHED_FIFO priority of the node's threads (0: normal scheduling).",
             ),
             DeclareLaunchArgument(
+                "worker_scheduling",
+                default_value="idle",
+                description="Policy of the long computations: idle (SCHED_IDLE), batch "
+                "(SCHED_BATCH, niceness 19) or normal (niceness 5).",
+            ),
+            DeclareLaunchArgument(
                 "rviz", default_value="false", description="Start rviz2 with the layout."
             ),
             Node(
@@ -68,6 +78,7 @@ def generate_launch_description() -> LaunchDescription:
                 arguments=[
                     ["--autostart=", LaunchConfiguration("autostart")],
                     ["--realtime-priority=", LaunchConfiguration("realtime_priority")],
+                    ["--worker-scheduling=", LaunchConfiguration("worker_scheduling")],
                 ],
                 parameters=[params_file],
             ),
