@@ -15,7 +15,7 @@ the node then starts (DDS, the executor, the recorder, the job queue) inherits i
 path runs ahead of other jobs. The long computations must not: the worker process and
 the axis-limits process put themselves back under the normal time-sharing policy at start
 (:func:`time_sharing`), before they start any thread, so a 3-D workspace of seconds never
-holds a core ahead of the rest of the machine (the worker also lowers its niceness).
+holds a core ahead of the rest of the machine (and then steps aside further, below).
 
 The option needs the privilege (root, ``CAP_SYS_NICE``, or an ``rtprio`` limit such as
 ``@realtime - rtprio 98`` in ``/etc/security/limits.conf``, the usual set-up for ros2_control).
@@ -31,11 +31,14 @@ Raising a thread's priority needs the privilege; lowering one does not. The long
 ``workspace_node --worker-scheduling=POLICY`` (launch argument ``worker_scheduling``):
 
 ``idle`` (default)
-    ``SCHED_IDLE``: the computation gets a core only when no normal thread wants it, and any
-    thread of the node that wakes (a command arriving) preempts it at once.
+    ``SCHED_IDLE``: the computation gets a core only when no normal thread of its group (the
+    session, see autogroup below; the whole machine without autogroup) wants it, and any thread
+    of the node that wakes (a command arriving) preempts it at once. On a core kept busy by
+    such threads a workspace waits until they pause (the action's progress shows it; cancel
+    works as ever).
 ``batch``
-    ``SCHED_BATCH`` at niceness 19: a CPU-bound job that never preempts a waking thread, with
-    the smallest time-sharing weight (15 against 1024 for niceness 0).
+    ``SCHED_BATCH`` at niceness 19: a CPU-bound job whose own wake-ups never preempt another
+    thread, with the smallest time-sharing weight (15 against 1024 for niceness 0).
 ``normal``
     ``SCHED_OTHER`` at niceness 5 (what the node did before the option).
 
