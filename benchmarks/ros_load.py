@@ -663,7 +663,7 @@ def main(argv: list[str] | None = None) -> int:
         default=[],
         metavar="OPTION",
         help="the node's own option, before --ros-args (e.g. --node-option=--worker-scheduling="
-        "normal: the worker at niceness 5 instead of SCHED_IDLE)",
+        "idle: the worker under SCHED_IDLE instead of niceness 5)",
     )
     parser.add_argument(
         "--node-source",

@@ -17,9 +17,11 @@ realtime_priority
     priority, ahead of other jobs on the machine (its worker stays at normal priority; needs
     an rtprio limit or CAP_SYS_NICE; see docs/ros.md, "Threads, load and latency").
 worker_scheduling
-    ``idle`` (default), ``batch`` or ``normal``: the scheduling policy of the node's long
-    computations (the worker process's workspaces, the axis-limits process), lowered so that
-    the node's answers come first; unprivileged (docs/ros.md, "Threads, load and latency").
+    ``normal`` (default: niceness 5), ``idle`` (SCHED_IDLE) or ``batch`` (SCHED_BATCH, niceness
+    19): the scheduling policy of the node's long computations (the worker process's workspaces,
+    the axis-limits process); ``idle`` puts the node's answers first but starves the
+    computations while the session keeps the cores busy; unprivileged (docs/ros.md, "Threads,
+    load and latency").
 rviz
     ``true`` also starts rviz2 with ``share/hexapod_workspace/config/workspace.rviz``.
 
@@ -62,9 +64,9 @@ def generate_launch_description() -> LaunchDescription:
             ),
             DeclareLaunchArgument(
                 "worker_scheduling",
-                default_value="idle",
-                description="Policy of the long computations: idle (SCHED_IDLE), batch "
-                "(SCHED_BATCH, niceness 19) or normal (niceness 5).",
+                default_value="normal",
+                description="Policy of the long computations: normal (niceness 5), idle "
+                "(SCHED_IDLE) or batch (SCHED_BATCH, niceness 19).",
             ),
             DeclareLaunchArgument(
                 "rviz", default_value="false", description="Start rviz2 with the layout."

@@ -30,17 +30,21 @@ Raising a thread's priority needs the privilege; lowering one does not. The long
 (the worker process's workspaces, the axis-limits process) run under the policy chosen with
 ``workspace_node --worker-scheduling=POLICY`` (launch argument ``worker_scheduling``):
 
-``idle`` (default)
+``normal`` (default)
+    ``SCHED_OTHER`` at niceness 5 (weight 335 against 1024 for niceness 0): the computation
+    keeps about a quarter of a core against each busy thread of niceness 0.
+``idle``
     ``SCHED_IDLE``: the computation gets a core only when no normal thread of its group (the
     session, see autogroup below; the whole machine without autogroup) wants it, and any thread
-    of the node that wakes (a command arriving) preempts it at once. On a core kept busy by
-    such threads a workspace waits until they pause (the action's progress shows it; cancel
-    works as ever).
+    of the node that wakes (a command arriving) preempts it at once. On cores kept busy by
+    such threads it starves: a workspace goal or an axis-limits computation then waits until
+    they pause, and so does the node's exit, which waits for the axis-limits process to finish
+    its computation (seen in the test suite on the loaded test machine: no exit within 30 s).
+    For a node whose session leaves the cores idle now and then.
 ``batch``
     ``SCHED_BATCH`` at niceness 19: a CPU-bound job whose own wake-ups never preempt another
-    thread, with the smallest time-sharing weight (15 against 1024 for niceness 0).
-``normal``
-    ``SCHED_OTHER`` at niceness 5 (what the node did before the option).
+    thread, with the smallest time-sharing weight (15 against 1024), so it starves almost as
+    ``idle`` does.
 
 Each is unprivileged on Linux (sched(7): a thread may always move itself to ``SCHED_IDLE`` or
 ``SCHED_BATCH`` and raise its niceness). The worker's DDS threads, which publish the clouds,
@@ -52,8 +56,9 @@ on by default in most distributions) first shares the cores equally between *ses
 terminal, a ``ros2 launch``, a service) and only then between the threads of a session by
 their policy and niceness. So ``idle`` gives the node the worker's share of the node's own
 session (the node, its worker, and whatever else that launch started), not other sessions'
-share: against another user's job only the real-time policy above helps. The figures are in
-docs/ros.md ("Threads, load and latency").
+share: against another user's job only the real-time policy above helps. The figures (``idle``
+lowered the median, not the p99, under other sessions' load) are in docs/ros.md ("Threads, load
+and latency").
 """
 
 from __future__ import annotations
@@ -82,7 +87,7 @@ REALTIME_OPTION = "--realtime-priority"
 #: and axis-limits processes, one of :data:`WORKER_POLICIES`.
 WORKER_SCHEDULING_OPTION = "--worker-scheduling"
 #: Policies of the long computations (module docstring), the default first.
-WORKER_POLICIES = ("idle", "batch", "normal")
+WORKER_POLICIES = ("normal", "idle", "batch")
 #: Niceness of the ``batch`` and ``normal`` policies.
 _NICENESS = {"idle": 0, "batch": 19, "normal": 5}
 _worker_policy = [WORKER_POLICIES[0]]  # this process's choice (set by workspace_node's main)
@@ -112,7 +117,7 @@ def realtime_priority_from_argv(argv: list[str]) -> tuple[int, list[str]]:
 
 
 def worker_policy_from_argv(argv: list[str]) -> tuple[str, list[str]]:
-    """The ``--worker-scheduling=POLICY`` of ``argv`` (``idle`` when absent) and ``argv``
+    """The ``--worker-scheduling=POLICY`` of ``argv`` (``normal`` when absent) and ``argv``
     without it. Only arguments before ``--ros-args`` are looked at.
 
     Raises
@@ -143,7 +148,7 @@ def set_worker_policy(policy: str) -> None:
 
 
 def worker_policy() -> str:
-    """The policy chosen with :func:`set_worker_policy` (default ``idle``)."""
+    """The policy chosen with :func:`set_worker_policy` (default ``normal``)."""
     return _worker_policy[0]
 
 

@@ -194,7 +194,7 @@ def _serve(
     connection: Connection,
     cancel: Any,
     topics: CloudTopics | None = None,
-    policy: str = "idle",
+    policy: str = "normal",
 ) -> None:
     """Worker process main loop: one job in; ``("progress", fraction)`` and ``("published",
     PublishedCloud)`` messages, then ``("ok", result)``, ``("error", exc)`` or
