@@ -539,8 +539,8 @@ def run(args: argparse.Namespace, node: subprocess.Popen, out_dir: Path) -> int:
 
     one, floor, batch, core = idle["one"], idle["floor"], idle["batch"], idle["core"]
     print(f"node: {describe_node(args.node_source)}")
-    if args.node_arg:
-        print(f"node arguments: {' '.join(args.node_arg)}")
+    if args.node_arg or args.node_option:
+        print(f"node arguments: {' '.join([*args.node_option, *args.node_arg])}")
     if args.priority or args.commander_priority:
         print(
             f"SCHED_FIFO priority: node and floor {args.priority or 'none'}, commander "
@@ -658,6 +658,14 @@ def main(argv: list[str] | None = None) -> int:
         "--node-arg", action="append", default=[], metavar="ARG", help="extra --ros-args"
     )
     parser.add_argument(
+        "--node-option",
+        action="append",
+        default=[],
+        metavar="OPTION",
+        help="the node's own option, before --ros-args (e.g. --node-option=--worker-scheduling="
+        "idle: the worker under SCHED_IDLE instead of niceness 5)",
+    )
+    parser.add_argument(
         "--node-source",
         type=Path,
         metavar="DIR",
@@ -693,10 +701,12 @@ def main(argv: list[str] | None = None) -> int:
         out_dir = Path(tmp)
         prefix = priority_prefix(args)
         if args.node_source is None and args.priority:  # the node's own option
-            options = [f"--realtime-priority={args.priority}"]
+            options = [f"--realtime-priority={args.priority}", *args.node_option]
             node = start_node(out_dir, args.node_arg, options=options)
         else:  # another tree's node (which may not have the option): the same through chrt
-            node = start_node(out_dir, args.node_arg, args.node_source, prefix=prefix)
+            node = start_node(
+                out_dir, args.node_arg, args.node_source, prefix=prefix, options=args.node_option
+            )
         floors = [start_python(FLOOR_SERVER, out_dir / "node.log")]
         if args.floor:
             floors.append(start_python(COMMAND_FLOOR_SERVER, out_dir / "node.log", prefix))

@@ -16,6 +16,12 @@ realtime_priority
     ``0`` (default): normal scheduling; 1..99: the node's threads run under SCHED_FIFO at that
     priority, ahead of other jobs on the machine (its worker stays at normal priority; needs
     an rtprio limit or CAP_SYS_NICE; see docs/ros.md, "Threads, load and latency").
+worker_scheduling
+    ``normal`` (default: niceness 5), ``idle`` (SCHED_IDLE) or ``batch`` (SCHED_BATCH, niceness
+    19): the scheduling policy of the node's long computations (the worker process's workspaces,
+    the axis-limits process); ``idle`` puts the node's answers first but starves the
+    computations while the session keeps the cores busy; unprivileged (docs/ros.md, "Threads,
+    load and latency").
 rviz
     ``true`` also starts rviz2 with ``share/hexapod_workspace/config/workspace.rviz``.
 
@@ -57,6 +63,12 @@ def generate_launch_description() -> LaunchDescription:
                 description="SCHED_FIFO priority of the node's threads (0: normal scheduling).",
             ),
             DeclareLaunchArgument(
+                "worker_scheduling",
+                default_value="normal",
+                description="Policy of the long computations: normal (niceness 5), idle "
+                "(SCHED_IDLE) or batch (SCHED_BATCH, niceness 19).",
+            ),
+            DeclareLaunchArgument(
                 "rviz", default_value="false", description="Start rviz2 with the layout."
             ),
             Node(
@@ -68,6 +80,7 @@ def generate_launch_description() -> LaunchDescription:
                 arguments=[
                     ["--autostart=", LaunchConfiguration("autostart")],
                     ["--realtime-priority=", LaunchConfiguration("realtime_priority")],
+                    ["--worker-scheduling=", LaunchConfiguration("worker_scheduling")],
                 ],
                 parameters=[params_file],
             ),

@@ -77,7 +77,7 @@ from hexapod_workspace.logs.cell import (
 
 from .conversions import to_message, type_name
 from .parameters import State, dynamic_specs
-from .scheduling import time_sharing
+from .scheduling import time_sharing, worker_policy
 
 __all__ = [
     "PARAMETER_CHANGES_TOPIC",
@@ -392,10 +392,11 @@ class AxisLimitsPublisher:
     ) -> dict[str, Any]:
         """:func:`~hexapod_workspace.core.reach.axis_limits` in the spawned process."""
         if self._pool is None:
-            self._pool = ProcessPoolExecutor(  # at normal priority under a real-time node
+            self._pool = ProcessPoolExecutor(  # the worker's policy, under a real-time node too
                 max_workers=1,
                 mp_context=multiprocessing.get_context("spawn"),
                 initializer=time_sharing,
+                initargs=(worker_policy(),),
             )
         future = self._pool.submit(
             axis_limits, manipulator, rotation, position, frame=frame, work=work

@@ -116,7 +116,12 @@ from .paths import attach as attach_paths
 from .paths import check_poses_from_poses
 from .qos import COMMAND_QOS, SERVICE_QOS_PROFILE
 from .recorder import Recorder
-from .scheduling import realtime_priority_from_argv, set_realtime
+from .scheduling import (
+    realtime_priority_from_argv,
+    set_realtime,
+    set_worker_policy,
+    worker_policy_from_argv,
+)
 from .worker import WorkspaceWorker
 from .workspaces import WorkspaceServer
 
@@ -628,13 +633,16 @@ def main(args: list[str] | None = None) -> int:
     -------
     int
         Process exit status: 0 after a clean shutdown, 1 when the parameters are invalid, 2
-        when an option (``--autostart=``, ``--realtime-priority=``) is invalid or refused.
+        when an option (``--autostart=``, ``--realtime-priority=``, ``--worker-scheduling=``)
+        is invalid or refused.
     """
     sys.setswitchinterval(SWITCH_INTERVAL)
     try:
         autostart, args = autostart_from_argv(sys.argv if args is None else args)
         priority, args = realtime_priority_from_argv(args)
+        policy, args = worker_policy_from_argv(args)
         set_realtime(priority)  # before rclpy starts a thread: they all inherit it
+        set_worker_policy(policy)  # the worker and axis-limits processes (ros/scheduling.py)
     except ConfigError as error:
         get_logger(NODE_NAME).fatal(str(error))
         return 2

@@ -15,7 +15,7 @@ the node then starts (DDS, the executor, the recorder, the job queue) inherits i
 path runs ahead of other jobs. The long computations must not: the worker process and
 the axis-limits process put themselves back under the normal time-sharing policy at start
 (:func:`time_sharing`), before they start any thread, so a 3-D workspace of seconds never
-holds a core ahead of the rest of the machine (the worker also lowers its niceness).
+holds a core ahead of the rest of the machine (and then steps aside further, below).
 
 The option needs the privilege (root, ``CAP_SYS_NICE``, or an ``rtprio`` limit such as
 ``@realtime - rtprio 98`` in ``/etc/security/limits.conf``, the usual set-up for ros2_control).
@@ -23,6 +23,42 @@ Without it the node refuses to start with the reason rather than run at a priori
 given. Linux only. Real-time threads that never sleep could starve the machine; the kernel's
 real-time throttling (``/proc/sys/kernel/sched_rt_runtime_us``, 95 % by default) bounds them,
 and the node's threads block on DDS between commands.
+
+Without privileges: the heavy work steps aside
+----------------------------------------------
+Raising a thread's priority needs the privilege; lowering one does not. The long computations
+(the worker process's workspaces, the axis-limits process) run under the policy chosen with
+``workspace_node --worker-scheduling=POLICY`` (launch argument ``worker_scheduling``):
+
+``normal`` (default)
+    ``SCHED_OTHER`` at niceness 5 (weight 335 against 1024 for niceness 0): the computation
+    keeps about a quarter of a core against each busy thread of niceness 0.
+``idle``
+    ``SCHED_IDLE``: the computation gets a core only when no normal thread of its group (the
+    session, see autogroup below; the whole machine without autogroup) wants it, and any thread
+    of the node that wakes (a command arriving) preempts it at once. On cores kept busy by
+    such threads it starves: a workspace goal or an axis-limits computation then waits until
+    they pause, and so does the node's exit, which waits for the axis-limits process to finish
+    its computation (seen in the test suite on the loaded test machine: no exit within 30 s).
+    For a node whose session leaves the cores idle now and then.
+``batch``
+    ``SCHED_BATCH`` at niceness 19: a CPU-bound job whose own wake-ups never preempt another
+    thread, with the smallest time-sharing weight (15 against 1024), so it starves almost as
+    ``idle`` does.
+
+Each is unprivileged on Linux (sched(7): a thread may always move itself to ``SCHED_IDLE`` or
+``SCHED_BATCH`` and raise its niceness). The worker's DDS threads, which publish the clouds,
+start before the policy is applied and keep the normal one, so a cloud's delivery does not wait
+behind the next computation.
+
+What it does and does not buy: Linux's autogroup (``/proc/sys/kernel/sched_autogroup_enabled``,
+on by default in most distributions) first shares the cores equally between *sessions* (a
+terminal, a ``ros2 launch``, a service) and only then between the threads of a session by
+their policy and niceness. So ``idle`` gives the node the worker's share of the node's own
+session (the node, its worker, and whatever else that launch started), not other sessions'
+share: against another user's job only the real-time policy above helps. The figures (``idle``
+lowered the median, not the p99, under other sessions' load) are in docs/ros.md ("Threads, load
+and latency").
 """
 
 from __future__ import annotations
@@ -32,10 +68,29 @@ import os
 
 from hexapod_workspace.errors import ConfigError
 
-__all__ = ["REALTIME_OPTION", "realtime_priority_from_argv", "set_realtime", "time_sharing"]
+__all__ = [
+    "REALTIME_OPTION",
+    "WORKER_POLICIES",
+    "WORKER_SCHEDULING_OPTION",
+    "background",
+    "realtime_priority_from_argv",
+    "set_realtime",
+    "set_worker_policy",
+    "time_sharing",
+    "worker_policy",
+    "worker_policy_from_argv",
+]
 
 #: Command-line option of ``workspace_node`` (before ``--ros-args``): SCHED_FIFO priority.
 REALTIME_OPTION = "--realtime-priority"
+#: Command-line option of ``workspace_node`` (before ``--ros-args``): the policy of the worker
+#: and axis-limits processes, one of :data:`WORKER_POLICIES`.
+WORKER_SCHEDULING_OPTION = "--worker-scheduling"
+#: Policies of the long computations (module docstring), the default first.
+WORKER_POLICIES = ("normal", "idle", "batch")
+#: Niceness of the ``batch`` and ``normal`` policies.
+_NICENESS = {"idle": 0, "batch": 19, "normal": 5}
+_worker_policy = [WORKER_POLICIES[0]]  # this process's choice (set by workspace_node's main)
 
 
 def realtime_priority_from_argv(argv: list[str]) -> tuple[int, list[str]]:
@@ -59,6 +114,59 @@ def realtime_priority_from_argv(argv: list[str]) -> tuple[int, list[str]]:
         else:
             kept.append(argument)
     return priority, kept
+
+
+def worker_policy_from_argv(argv: list[str]) -> tuple[str, list[str]]:
+    """The ``--worker-scheduling=POLICY`` of ``argv`` (``normal`` when absent) and ``argv``
+    without it. Only arguments before ``--ros-args`` are looked at.
+
+    Raises
+    ------
+    ConfigError
+        The value is not one of :data:`WORKER_POLICIES`.
+    """
+    end = argv.index("--ros-args") if "--ros-args" in argv else len(argv)
+    policy, kept = WORKER_POLICIES[0], []
+    for index, argument in enumerate(argv):
+        if index < end and argument.startswith(f"{WORKER_SCHEDULING_OPTION}="):
+            policy = argument.split("=", 1)[1].strip().lower()
+            if policy not in WORKER_POLICIES:
+                given = argument.split("=", 1)[1]
+                msg = f"{WORKER_SCHEDULING_OPTION}: expected one of {', '.join(WORKER_POLICIES)}"
+                raise ConfigError(f"{msg}, got {given!r}")
+        else:
+            kept.append(argument)
+    return policy, kept
+
+
+def set_worker_policy(policy: str) -> None:
+    """Choose the policy of the worker and axis-limits processes this process starts later
+    (one of :data:`WORKER_POLICIES`; ``ValueError`` otherwise)."""
+    if policy not in WORKER_POLICIES:
+        raise ValueError(f"worker policy: expected one of {WORKER_POLICIES}, got {policy!r}")
+    _worker_policy[0] = policy
+
+
+def worker_policy() -> str:
+    """The policy chosen with :func:`set_worker_policy` (default ``normal``)."""
+    return _worker_policy[0]
+
+
+def background(policy: str) -> None:
+    """Put the calling thread (and the threads it starts later) under ``policy`` (one of
+    :data:`WORKER_POLICIES`): what a worker process's computing thread calls once its
+    publisher's threads have started. Only ever lowers the priority, so no privilege is needed;
+    where the operating system has no such policy (not Linux) it leaves the thread as it is."""
+    with contextlib.suppress(OSError, AttributeError):
+        if policy == "idle":
+            os.sched_setscheduler(0, os.SCHED_IDLE, os.sched_param(0))
+        elif policy == "batch":
+            os.sched_setscheduler(0, os.SCHED_BATCH, os.sched_param(0))
+    with contextlib.suppress(OSError):
+        # Linux: the niceness of the calling thread (inherited by the threads it starts)
+        raise_by = _NICENESS[policy] - os.getpriority(os.PRIO_PROCESS, 0)
+        if raise_by > 0:
+            os.nice(raise_by)
 
 
 def set_realtime(priority: int) -> None:
@@ -85,15 +193,18 @@ def set_realtime(priority: int) -> None:
         raise ConfigError(msg) from error
 
 
-def time_sharing() -> None:
+def time_sharing(policy: str | None = None) -> None:
     """Put every thread of this process (and those it starts) under the normal time-sharing
     policy where they inherited another one: the worker and axis-limits processes of a node
     started with :data:`REALTIME_OPTION` call it first, so their computations of seconds never
-    hold a core ahead of the rest of the machine."""
+    hold a core ahead of the rest of the machine. With ``policy``, the calling thread then
+    steps aside under it (:func:`background`): the axis-limits process's initializer."""
     with contextlib.suppress(OSError, AttributeError):  # not Linux: nothing was inherited
         for thread in _threads():  # numpy's BLAS pool started at import inherited it too
             if os.sched_getscheduler(thread) != os.SCHED_OTHER:
                 os.sched_setscheduler(thread, os.SCHED_OTHER, os.sched_param(0))
+    if policy is not None:
+        background(policy)
 
 
 def _threads() -> list[int]:

@@ -16,9 +16,7 @@ bytes back for the node's log (``published``), and returns a cloud of at most
 
 from __future__ import annotations
 
-import contextlib
 import multiprocessing
-import os
 import signal
 import threading
 import time
@@ -38,11 +36,10 @@ from hexapod_workspace.errors import HexapodWorkspaceError
 from hexapod_workspace.logs import messages
 
 from .clouds import CloudTopics, PublishedCloud, decimated_cloud_fields
-from .scheduling import time_sharing
+from .scheduling import background, time_sharing, worker_policy
 
 __all__ = [
     "CANCEL_GRACE",
-    "WORKER_NICENESS",
     "CanceledError",
     "WorkerError",
     "WorkspaceJob",
@@ -50,9 +47,6 @@ __all__ = [
     "compute_fields",
 ]
 
-#: Niceness added to the worker process: on a busy machine the operating system runs the node's
-#: latency-critical pose checks before the long computations.
-WORKER_NICENESS = 5
 #: Seconds a canceled computation has to stop by itself (at its next progress report) before
 #: the worker process is terminated (and replaced on next use).
 CANCEL_GRACE = 0.3
@@ -196,21 +190,26 @@ def _cloud_publisher(topics: CloudTopics | None) -> tuple[Any, str]:
         return None, f"the worker cannot publish clouds: {type(error).__name__}: {error}"
 
 
-def _serve(connection: Connection, cancel: Any, topics: CloudTopics | None = None) -> None:
+def _serve(
+    connection: Connection,
+    cancel: Any,
+    topics: CloudTopics | None = None,
+    policy: str = "normal",
+) -> None:
     """Worker process main loop: one job in; ``("progress", fraction)`` and ``("published",
     PublishedCloud)`` messages, then ``("ok", result)``, ``("error", exc)`` or
     ``("canceled", None)`` out. ``cancel`` (an event the node sets) stops the job at its next
-    progress report."""
+    progress report. The computing thread runs under ``policy``
+    (:data:`~hexapod_workspace.ros.scheduling.WORKER_POLICIES`)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the node decides when the worker stops
-    # The publisher's DDS threads start first, at normal priority (Linux: a thread's niceness
-    # is its own and new threads inherit their creator's): discovery and delivery of the clouds
-    # do not wait behind the computation on a busy machine.
+    # The publisher's DDS threads start first, at normal priority (Linux: a thread's policy and
+    # niceness are its own and new threads inherit their creator's): discovery and delivery of
+    # the clouds do not wait behind the computation on a busy machine.
     # a node under a real-time policy (ros/scheduling.py) passed it on: back to time-sharing
     # before the publisher's threads start, as they inherit it
     time_sharing()
     publisher, broken = _cloud_publisher(topics)
-    with contextlib.suppress(OSError):
-        os.nice(WORKER_NICENESS)  # throughput work: the node's checks are scheduled first
+    background(policy)  # throughput work: the node's checks are scheduled first
     kernels.warm_up()  # compiled (or loaded) before the first job arrives
     while True:
         try:
@@ -273,7 +272,7 @@ class WorkspaceWorker:
             parent, child = self._context.Pipe()
             process = self._context.Process(
                 target=_serve,
-                args=(child, self._cancel, self.cloud_topics),
+                args=(child, self._cancel, self.cloud_topics, worker_policy()),
                 name="hexapod_workspace_worker",
                 daemon=True,
             )
