@@ -14,8 +14,10 @@ import os
 import signal
 import subprocess
 import sys
+import time
 from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
+from typing import Any
 
 REPO = Path(__file__).resolve().parents[1]
 NODE_EXECUTABLE = (
@@ -26,6 +28,24 @@ PARAMS_FILE = REPO / "config" / "example_gpm.yaml"
 #: How a node of another source tree is started: ``python -c`` puts the working directory
 #: first on sys.path, before PYTHONPATH, so the node runs in its own folder, not this checkout.
 _FROM_SOURCE = "import sys; from hexapod_workspace.ros import main; sys.exit(main(sys.argv))"
+
+
+def first_answer(client: Any, request: Any, timeout_s: float = 600.0) -> Any:
+    """The first answer of ``client`` to ``request``, asked again every 30 s for ``timeout_s``.
+
+    A node whose numba cache is cold (the first start after ``make ros`` copied the package, or
+    a ``--node-source`` tree) compiles its kernels while configuring, for up to a few minutes
+    on a loaded 2-core machine; its services are discovered before it answers. The benchmarks
+    wait for this answer before timing anything (RuntimeError when none comes).
+    """
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        response = client.call(
+            request, timeout_sec=min(30.0, max(deadline - time.monotonic(), 1.0))
+        )
+        if response is not None:
+            return response
+    raise RuntimeError(f"{client.srv_name}: no answer within {timeout_s:.0f} s")
 
 
 def missing_install() -> str | None:
