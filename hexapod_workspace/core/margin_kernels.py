@@ -1071,9 +1071,10 @@ def _limiting_constraint(model: NDArray[np.float64], out: NDArray[np.float64]) -
 
 
 @_inline
-def _feasible(out: NDArray[np.float64]) -> bool:
-    """Every margin ≥ 0 (NaN counts as violated)."""
-    for c in range(N_CONSTRAINTS):  # noqa: SIM110 - a loop numba compiles, not a generator
+def _feasible(out: NDArray[np.float64], rows: int) -> bool:
+    """Every margin of the first ``rows`` rows ≥ 0 (NaN counts as violated); a caller whose
+    later rows are +inf (``model[ROWS_USED]``: rows that do not apply) may leave them out."""
+    for c in range(rows):  # noqa: SIM110 - a loop numba compiles, not a generator
         if not out[c] >= 0.0:
             return False
     return True
@@ -1493,8 +1494,10 @@ def _check_block(
     Every stage is a loop over the poses of the block without branches, which the compiler
     vectorises; poses that need care (a zero-length leg, parallel or point-like legs, huge
     angles) are flagged in the _FIX row and recomputed one by one by :func:`_pose` (with libm's
-    sin and cos for huge angles). Leaves in ``work``: margins in rows 0..3, legs in 4..7, pair
-    in 8..9 (as floats).
+    sin and cos for huge angles). Leaves in ``work`` (as floats): the margins in rows
+    0..N_CONSTRAINTS − 1, their legs in rows OUT_LEG + c, the closest pair in OUT_PAIR and
+    OUT_PAIR + 1; only the rows in use (``model[ROWS_USED]``) are written for poses the
+    fast path handles, the others are +inf for every pose and left to the reader.
     """
     px, py, pz = position[0], position[1], position[2]
     moving = model[ARCH] != 0.0
@@ -1582,6 +1585,10 @@ def _check_block(
     # Per pose: the joint-angle margins (arccos), the rare poses that need care, the outputs.
     alpha_equal = model[ALPHA_EQUAL] != 0.0
     beta_equal = model[BETA_EQUAL] != 0.0
+    # Rows from ROWS_USED on are +inf for every pose of the model and nobody reads them from
+    # `work` (the batch check and the searches read the rows in use): the 6-UPS model without
+    # a singularity margin or a scene writes its four rows only.
+    rest = int(model[ROWS_USED]) > SINGULARITY
     for n in range(count):
         if work[(_MIN + _FIX) * BLOCK + n] != 0.0:
             _tt_matrix(angles[first + n, 0], angles[first + n, 1], angles[first + n, 2], r)
@@ -1627,6 +1634,8 @@ def _check_block(
             work[(OUT_LEG + LEG_INTERFERENCE) * BLOCK + n] = 0.0
             work[OUT_PAIR * BLOCK + n] = 0.0
             work[(OUT_PAIR + 1) * BLOCK + n] = 0.0
+        if not rest:
+            continue
         work[SINGULARITY * BLOCK + n] = work[_SIGMA * BLOCK + n] if singular else np.inf
         work[(OUT_LEG + SINGULARITY) * BLOCK + n] = 0.0
         work[COLLISION * BLOCK + n] = work[_COLLIDE * BLOCK + n] if collide else np.inf
@@ -1757,7 +1766,7 @@ def check_one(
     legs[SINGULARITY] = 0
     worst = _limiting_constraint(model, out)
     return (
-        _feasible(out),
+        _feasible(out, N_CONSTRAINTS),
         to_fixed_tuple(out[:N_CONSTRAINTS], N_CONSTRAINTS),
         to_fixed_tuple(legs, N_CONSTRAINTS),
         ((int(out[OUT_PAIR]) + 1) * enabled, (int(out[OUT_PAIR + 1]) + 1) * enabled),

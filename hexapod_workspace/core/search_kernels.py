@@ -42,6 +42,7 @@ from .model_layout import (
     RAY_DRIVE,
     RAY_TURN,
     RHO,
+    ROWS_USED,
     TAU_MIN,
 )
 
@@ -118,7 +119,7 @@ def _certified_step_moving(model: NDArray[np.float64], out: NDArray[np.float64])
     tau_now = out[TRANSMISSION] + model[TAU_MIN]
     tau_f = max(model[TAU_MIN], 0.5 * tau_now)
     step = (tau_now - tau_f) / _rate_moving(model, TRANSMISSION, tau_f)
-    for c in range(N_CONSTRAINTS):
+    for c in range(int(model[ROWS_USED])):
         step = _fmin(step, out[c] / _rate_moving(model, c, tau_f))
     step = _fmin(step, MAX_STEP)
     if not step > 0.0:
@@ -153,7 +154,7 @@ def _recovery_step_moving(model: NDArray[np.float64], out: NDArray[np.float64]) 
                 recover = climb
         tau_f = 0.5 * tau_now
         other = 0.0
-        for c in range(N_CONSTRAINTS):
+        for c in range(int(model[ROWS_USED])):
             if c == IK or c == TRANSMISSION:  # noqa: SIM109 - plain comparisons for numba
                 continue
             margin = out[c] + out[OUT_GAP] if c == COLLISION else out[c]
@@ -174,7 +175,7 @@ def _estimate(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
     ESTIMATE_FLOOR (precomputed in the model): a continuous estimate for the secant steps, not
     a certificate."""
     best: float = out[0] / model[ESTIMATE_RATE]
-    for c in range(1, N_CONSTRAINTS):
+    for c in range(1, int(model[ROWS_USED])):
         value = out[c] / model[ESTIMATE_RATE + c]
         if value < best or value != value:
             best = value
@@ -193,7 +194,10 @@ def _fmin(a: float, b: float) -> float:
 
 @_helper
 def certified_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> float:
-    """Length over which no margin can reach zero, from feasible margins (core.search)."""
+    """Length over which no margin can reach zero, from feasible margins (core.search).
+
+    Like every step and estimate here, reads only the rows in use (``model[ROWS_USED]``): the
+    kernels write +inf in the others, which can bound no step."""
     if model[ARCH] != 0.0:
         return _certified_step_moving(model, out)
     rho = model[RHO]
@@ -201,7 +205,7 @@ def certified_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> floa
     length_now = length_min + max(out[LEG_LENGTH], 0.0)
     floor = max(length_min, 0.5 * length_now)
     step = out[0] / _rate(model, 0, floor)
-    for c in range(1, N_CONSTRAINTS):
+    for c in range(1, int(model[ROWS_USED])):
         step = _fmin(step, out[c] / _rate(model, c, floor))
     step = _fmin(step, 0.5 * length_now / rho)
     step = _fmin(step, MAX_STEP)
@@ -222,7 +226,7 @@ def recovery_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> float
     rho: float = model[RHO]
     floor: float = 0.5 * out[OUT_SHORTEST]
     recover = 0.0
-    for c in range(N_CONSTRAINTS):
+    for c in range(int(model[ROWS_USED])):
         margin = out[c] + out[OUT_GAP] if c == COLLISION else out[c]
         value = -margin / _rate(model, c, floor) if margin < 0.0 else 0.0
         if value > recover or value != value:
@@ -464,6 +468,11 @@ def search_rays(
     anchor_r = np.zeros((count, 9))
     rotation = np.empty(9)
     recent = 0
+    # Rows in use: the block kernel writes +inf in the others for every pose, and so do
+    # their slots of `out` here, so reading only these rows decides every probe as before.
+    used = int(model[ROWS_USED])
+    for slot in range(N_CONSTRAINTS):
+        out[slot] = np.inf
     while True:
         # The next probe of every unfinished ray.
         probes = 0
@@ -502,12 +511,12 @@ def search_rays(
             size = min(BLOCK, probes - block)
             _check_block(plain, angles, position, block, size, work, scratch, out, r)
             for m in range(size):
-                for slot in range(N_CONSTRAINTS):
+                for slot in range(used):
                     margins[block + m, slot] = work[slot * BLOCK + m]
         if lazy:
             for n in range(probes):
                 ray = rays[n]
-                for slot in range(N_CONSTRAINTS):
+                for slot in range(used):
                     out[slot] = margins[n, slot]
                 march = phase[ray] == _MARCH
                 # The ray's own anchor first (no trigonometry: the turn is at most |Δs|).
@@ -556,9 +565,9 @@ def search_rays(
             collisions += probes
         for n in range(probes):
             ray = rays[n]
-            for slot in range(N_CONSTRAINTS):
+            for slot in range(used):
                 out[slot] = margins[n, slot]
-            ok = _feasible(out)
+            ok = _feasible(out, used)
             estimate = _estimate(model, out)
             state = phase[ray]
             if state == _MARCH:
@@ -730,7 +739,7 @@ def torsion_scan(
         here = _scan_pose(model, plain, r, position, scratch, out, bound, reference, True)
         if here != bound:
             reference = here
-        ok = _feasible(out)
+        ok = _feasible(out, N_CONSTRAINTS)
         if first:
             start_ok = ok
         elif ok != previous_ok:
@@ -768,7 +777,7 @@ def torsion_scan(
                 bound -= LAZY_SLACK
             here = _scan_pose(model, plain, r, position, scratch, out, bound, np.inf, False)
             # Keep the transition inside [low, high]: the side matching the start state moves.
-            if _feasible(out) != rising[k]:
+            if _feasible(out, N_CONSTRAINTS) != rising[k]:
                 low[k] = middle
                 low_bound[k] = here
             else:
