@@ -3,17 +3,21 @@
 measured in the same run.
 
 The baseline is the package as of commit 3c6da1e (four constraints wired by hand, one leg
-architecture), extracted with ``git archive`` and imported as ``hexapod_workspace_baseline``
-(:func:`speed.load_baseline`), so both run here, on the same machine, in the same minute. Times
-are the best of several runs on one core (the machine is shared). Printed: per-pose time of a
-batch check, one-pose check, the exact projected workspace, the orientation workspace and a
-toolpath check, for the packaged 6-UPS example; the ratio is baseline time / new time (≥ 1:
-not slower). Then the leg architectures: the same figures for the packaged 6-PUS and 6-RUS
-examples against the 6-UPS one (new code, same run; ratio pus or rus time / ups time). Then the
-cost of an enforced singularity margin (new code, limit 0.3 against 0): enforced time / free
-time.
+architecture; ``--baseline REV`` for another revision), extracted with ``git archive`` and
+imported as ``hexapod_workspace_baseline`` (:func:`speed.load_baseline`), so both run here, on
+the same machine, in the same minute. Both are measured in ``--rounds`` rounds, in alternating
+order (new first in even rounds, the baseline first in odd ones), on one core, by this
+process's CPU time (``--clock wall`` for wall time): on a shared machine, wall time also counts
+the time other jobs hold the core, which differs from one run to the next. Printed: per-pose
+time of a batch check, one-pose check, the exact projected workspace, the orientation workspace
+and a toolpath check, for the packaged 6-UPS example, the best of each version; the ratio is
+baseline time / new time (≥ 1: not slower; the goal is ≥ 0.9), of the bests and, per round,
+its range and median. Then the leg architectures: the same figures for the packaged 6-PUS and
+6-RUS examples against the 6-UPS one (new code, same run; ratio pus or rus time / ups time).
+Then the cost of an enforced singularity margin (new code, limit 0.3 against 0): enforced time
+/ free time.
 
-Usage: python benchmarks/model.py [--poses N]
+Usage: python benchmarks/model.py [--poses N] [--rounds R] [--baseline REV] [--clock cpu|wall]
 """
 
 from __future__ import annotations
@@ -23,6 +27,8 @@ import functools
 import os
 import sys
 import tempfile
+import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -40,8 +46,14 @@ MODEL_BASELINE = "3c6da1e"
 POSITION = np.array([0.0, 0.0, -1.3])
 
 
-def figures(package, check_one, poses: np.ndarray) -> dict[str, float]:
-    """Seconds of each figure for one version of the package."""
+#: The goal of every ratio baseline time / new time of the 6-UPS figures.
+GOAL = 0.9
+
+
+def figures(
+    package, check_one, poses: np.ndarray, clock: Callable[[], float] = time.perf_counter
+) -> dict[str, float]:
+    """Seconds of each figure for one version of the package, by ``clock``."""
     # The packaged example, given as parameters the baseline knows (it predates
     # limits.singularity_min, 0 here).
     parameters = new.Manipulator.from_params_file(example_config_path()).to_parameters()
@@ -52,23 +64,28 @@ def figures(package, check_one, poses: np.ndarray) -> dict[str, float]:
     rng = np.random.default_rng(3)
     waypoints = POSITION + rng.normal(scale=0.05, size=(200, 3))
     angles = random_poses(200, seed=4) * np.array([1.0, 0.5, 0.5])
+    best = functools.partial(best_of, clock=clock)
     return {
-        "check, per pose": best_of(7, lambda: package.check(machine, poses, POSITION))
+        "check, per pose": best(7, lambda: package.check(machine, poses, POSITION))
         / poses.shape[0],
-        "check_pose, per call": per_call(lambda: check_one(machine, 0.3, 0.2, 0.1, POSITION)),
-        "projected exact (360 rays)": best_of(
+        "check_pose, per call": per_call(
+            lambda: check_one(machine, 0.3, 0.2, 0.1, POSITION), clock=clock
+        ),
+        "projected exact (360 rays)": best(
             5, lambda: package.projected_workspace(machine, POSITION, method="exact")
         ),
-        "orientation (180 rays, 1 deg)": best_of(
+        "orientation (180 rays, 1 deg)": best(
             3, lambda: package.orientation_workspace(machine, POSITION)
         ),
-        "check_path (199 moves)": best_of(
+        "check_path (199 moves)": best(
             5, lambda: package.check_path(machine, waypoints, angles=angles)
         ),
     }
 
 
-def singularity_figures(poses: np.ndarray) -> list[tuple[str, float, float]]:
+def singularity_figures(
+    poses: np.ndarray, clock: Callable[[], float] = time.perf_counter
+) -> list[tuple[str, float, float]]:
     """(figure, seconds without, seconds with the singularity margin enforced), new code."""
     free = new.Manipulator.from_params_file(example_config_path())
     enforced = new.Manipulator.from_mapping(
@@ -82,14 +99,21 @@ def singularity_figures(poses: np.ndarray) -> list[tuple[str, float, float]]:
             lambda m: new.projected_workspace(m, POSITION, method="exact"),
         ),
     ):
-        without = min(best_of(5, functools.partial(run, free)) for _ in range(2))
-        with_it = min(best_of(5, functools.partial(run, enforced)) for _ in range(2))
+        without = min(best_of(5, functools.partial(run, free), clock=clock) for _ in range(2))
+        with_it = min(best_of(5, functools.partial(run, enforced), clock=clock) for _ in range(2))
         scale = poses.shape[0] if name.endswith("per pose") else 1
         rows.append((name, without / scale, with_it / scale))
+    one = [
+        per_call(lambda m=m: check_pose(m, 0.3, 0.2, 0.1, POSITION), clock=clock)
+        for m in (free, enforced)
+    ]
+    rows.insert(1, ("check_pose, per call", *one))
     return rows
 
 
-def architecture_figures(poses: np.ndarray) -> list[tuple[str, float, float, float]]:
+def architecture_figures(
+    poses: np.ndarray, clock: Callable[[], float] = time.perf_counter
+) -> list[tuple[str, float, float, float]]:
     """(figure, ups, pus, rus seconds), new code, each packaged example at its home position
     (the same random orientations; a different share of them is reachable on each machine)."""
     config = example_config_path().parent
@@ -112,10 +136,10 @@ def architecture_figures(poses: np.ndarray) -> list[tuple[str, float, float, flo
         ),
     ):
         if name.startswith("check_pose"):
-            times = [per_call(functools.partial(run, m)) for m in machines]
+            times = [per_call(functools.partial(run, m), clock=clock) for m in machines]
         else:
             times = [
-                min(best_of(5, functools.partial(run, m)) for _ in range(2)) / scale
+                min(best_of(5, functools.partial(run, m), clock=clock) for _ in range(2)) / scale
                 for m in machines
             ]
         rows.append((name, *times))
@@ -125,36 +149,66 @@ def architecture_figures(poses: np.ndarray) -> list[tuple[str, float, float, flo
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--poses", type=int, default=200_000)
+    parser.add_argument("--rounds", type=int, default=6, help="alternated rounds (default 6)")
+    parser.add_argument(
+        "--baseline",
+        default=MODEL_BASELINE,
+        metavar="REV",
+        help=f"the revision compared with (default {MODEL_BASELINE}, before the open model)",
+    )
+    parser.add_argument(
+        "--clock",
+        choices=("cpu", "wall"),
+        default="cpu",
+        help="this process's CPU time (default) or wall time",
+    )
     options = parser.parse_args()
+    if options.rounds < 1 or options.poses < 1:
+        parser.error(f"--rounds and --poses: expected ≥ 1, got {options.rounds}, {options.poses}")
+    clock = time.process_time if options.clock == "cpu" else time.perf_counter
     os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})  # one core
+    loads = [os.getloadavg()[0]]
     with tempfile.TemporaryDirectory() as directory:
-        old = load_baseline(Path(directory), MODEL_BASELINE)
+        old = load_baseline(Path(directory), options.baseline)
         if old is None:
-            sys.exit(f"cannot extract the baseline {MODEL_BASELINE} (git archive)")
+            sys.exit(f"cannot extract the baseline {options.baseline} (git archive)")
         from hexapod_workspace_baseline.core import kernels as old_kernels
         from hexapod_workspace_baseline.core.constraints import check_pose as old_check_pose
 
         kernels.warm_up()
         old_kernels.warm_up()
         poses = random_poses(options.poses)
-        # Interleaved: new, baseline, new, baseline, ...; the best of each.
-        runs = []
-        for _ in range(3):
-            runs.append(figures(new, check_pose, poses))
-            runs.append(figures(old, old_check_pose, poses))
-    print(f"load average {os.getloadavg()[0]:.2f}, one core, {options.poses} poses per batch")
-    print(f"  {'figure':<32} {'new':>12} {'baseline':>12} {'ratio':>7}")
-    for name in runs[0]:
-        now = min(run[name] for run in runs[0::2])
-        before = min(run[name] for run in runs[1::2])
+        # Alternated: new then baseline in even rounds, baseline then new in odd ones (neither
+        # always runs right after the other's caches and the machine's other jobs).
+        versions = {"new": (new, check_pose), "baseline": (old, old_check_pose)}
+        runs: dict[str, list[dict[str, float]]] = {"new": [], "baseline": []}
+        for k in range(options.rounds):
+            for name in ("new", "baseline") if k % 2 == 0 else ("baseline", "new"):
+                package, check_one = versions[name]
+                runs[name].append(figures(package, check_one, poses, clock))
+            loads.append(os.getloadavg()[0])
+    print(
+        f"6-UPS example against {options.baseline}: load average {min(loads):.2f}-"
+        f"{max(loads):.2f}, one core, {options.clock} time, {options.rounds} alternated "
+        f"rounds, {options.poses} poses per batch"
+    )
+    print(
+        f"  {'figure':<32} {'new':>12} {'baseline':>12} {'ratio':>7}  {'rounds':>11} "
+        f"{'median':>6}  goal ≥ {GOAL}"
+    )
+    for name in runs["new"][0]:
+        now = min(run[name] for run in runs["new"])
+        before = min(run[name] for run in runs["baseline"])
+        per_round = [b[name] / n[name] for n, b in zip(runs["new"], runs["baseline"], strict=True)]
         unit, scale = ("µs", 1e6) if now < 1e-3 else ("ms", 1e3)
         print(
             f"  {name:<32} {now * scale:>9.3f} {unit} {before * scale:>9.3f} {unit}"
-            f" {before / now:>7.3f}"
+            f" {before / now:>7.3f}  {min(per_round):.3f}-{max(per_round):.3f}"
+            f" {float(np.median(per_round)):>6.3f}  {'met' if before / now >= GOAL else 'MISSED'}"
         )
     print("leg architectures, new code, each example at its home position (ratio to ups):")
     print(f"  {'figure':<32} {'ups':>12} {'pus':>12} {'rus':>12} {'pus/ups':>8} {'rus/ups':>8}")
-    for name, ups, pus, rus in architecture_figures(poses):
+    for name, ups, pus, rus in architecture_figures(poses, clock):
         unit, scale = ("µs", 1e6) if ups < 1e-3 else ("ms", 1e3)
         print(
             f"  {name:<32} {ups * scale:>9.3f} {unit} {pus * scale:>9.3f} {unit}"
@@ -162,7 +216,7 @@ def main() -> None:
         )
     print("singularity margin enforced (limit 0.3) against free (limit 0), new code:")
     print(f"  {'figure':<32} {'free':>12} {'enforced':>12} {'ratio':>7}")
-    for name, without, with_it in singularity_figures(poses):
+    for name, without, with_it in singularity_figures(poses, clock):
         unit, scale = ("µs", 1e6) if without < 1e-3 else ("ms", 1e3)
         print(
             f"  {name:<32} {without * scale:>9.3f} {unit} {with_it * scale:>9.3f} {unit}"
