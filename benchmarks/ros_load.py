@@ -304,11 +304,13 @@ def spawn_role(
 
 def priority_prefix(args: argparse.Namespace, role: str = "node") -> list[str]:
     """``chrt --fifo N`` for the node and the floor that stands in for it (``--priority N``)
-    and for the commander (``--commander-priority N``); nothing for the other roles."""
+    and for the commander (``--commander-priority N``); nothing for the other roles. With
+    ``--node-session``, ``setsid`` first for the node and its floor."""
     priority = args.commander_priority if role == "commander" else args.priority
+    session = ["setsid"] if role == "node" and args.node_session else []
     if not priority or role not in ("node", "commander"):
-        return []
-    return ["chrt", "--fifo", str(priority)]
+        return session
+    return [*session, "chrt", "--fifo", str(priority)]
 
 
 def role_result(process: subprocess.Popen, timeout: float, required: bool = True) -> dict:
@@ -645,6 +647,14 @@ def main(argv: list[str] | None = None) -> int:
         "priority all the same (default 0: normal scheduling)",
     )
     parser.add_argument(
+        "--node-session",
+        action="store_true",
+        help="start the node (and the command stream's floor) in a session of its own "
+        "(setsid), as a node started by its own launch or service is: Linux's autogroup then "
+        "shares the cores between that session and the benchmark's clients first, and the "
+        "node's worker competes only with the node",
+    )
+    parser.add_argument(
         "--commander-priority",
         type=int,
         default=0,
@@ -706,7 +716,8 @@ def main(argv: list[str] | None = None) -> int:
         prefix = priority_prefix(args)
         if args.node_source is None and args.priority:  # the node's own option
             options = [f"--realtime-priority={args.priority}", *args.node_option]
-            node = start_node(out_dir, args.node_arg, options=options)
+            session = ["setsid"] if args.node_session else []
+            node = start_node(out_dir, args.node_arg, prefix=session, options=options)
         else:  # another tree's node (which may not have the option): the same through chrt
             node = start_node(
                 out_dir, args.node_arg, args.node_source, prefix=prefix, options=args.node_option
