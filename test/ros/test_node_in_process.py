@@ -332,6 +332,43 @@ def test_commands_in_a_batch_are_answered_one_each_in_order(node):
     assert published[2].check.reachable == bool(expected.reachable[0])
 
 
+@pytest.mark.parametrize("size", [6, 40])  # grouped in a dict (small) and by numpy.unique
+def test_each_command_of_a_batch_is_checked_at_its_own_position(node, rng, size):
+    """Commands at three positions, interleaved in one batch: each result has the margins of
+    the core's check of its own pose at its own position, in the order sent."""
+    published: list = []
+    stream = node._commands
+    publisher = stream._publisher
+    stream._publisher = type("Collect", (), {"publish": published.append, "topic_name": "/x"})()
+    heights = np.array([-1.3, -1.25, -1.35])[rng.permutation(np.arange(size) % 3)]
+    angles = np.column_stack(
+        [
+            rng.uniform(-np.pi, np.pi, size),
+            rng.uniform(0.0, 0.6, size),
+            rng.uniform(-0.5, 0.5, size),
+        ]
+    )
+    try:
+        commands = []
+        for k in range(size):
+            command = CommandedPose(request_id=f"p{k}")
+            command.position.z = float(heights[k])
+            command.orientation.phi, command.orientation.theta, command.orientation.psi = angles[k]
+            commands.append(command)
+        stream.answer(commands)
+    finally:
+        stream._publisher = publisher
+    assert [r.request_id for r in published] == [f"p{k}" for k in range(size)]
+    model = Manipulator.from_params_file(example_config_path())
+    for k, result in enumerate(published):
+        expected = check(model, angles[k : k + 1], (0.0, 0.0, heights[k]))
+        assert result.position.z == heights[k]
+        assert result.check.reachable == bool(expected.reachable[0])
+        margins = dict(zip(result.check.constraint_names, result.check.margins, strict=True))
+        for name, values in expected.margins.items():
+            assert margins[name] == pytest.approx(float(values[0]), abs=1e-12, nan_ok=True)
+
+
 def test_an_extension_attaches_with_one_call(ros_context):
     """What ros/paths.py or ros/atlas_action.py do: ``attach(node)`` wires a recorded service
     with the node's groups and reads the node's state."""
