@@ -34,13 +34,13 @@ if ! PATH="$VENV/bin:$PATH" CMAKE_PREFIX_PATH="$VENV" AMENT_PREFIX_PATH="$VENV" 
 fi
 log "colcon build done in $((SECONDS - start)) s"
 # The install space holds a copy of the package whose numba cache is empty after a build: fill
-# it here, once (the node's own warm-up: the core's and the planner's kernels, about 70 s on a
-# loaded 2-core machine), instead of in the first node, test or benchmark that starts from the
-# install space, where it looked like a node that does not answer. (python -P: the install
-# space's package, not the source tree of the working directory that -c would put first.)
+# it here, once, with the node's own warm-up (about 70 s on a loaded 2-core machine), instead of
+# in the first node, test or benchmark that starts from the install space, where it looked like
+# a node that does not answer. (python -P: the install space's package, not the source tree of
+# the working directory that -c would put first.)
 start=$SECONDS
 log "compiling the install space's kernels (numba cache)"
 "$ROOT/tools/with_ros_env.sh" python -P -c \
-  "from hexapod_workspace.core import kernels, planner_kernels as p; kernels.warm_up(); p.warm_up()"
+  "from hexapod_workspace.ros.node import warm_up_kernels; warm_up_kernels()"
 log "kernels ready in $((SECONDS - start)) s"
 touch "$stamp"

@@ -125,7 +125,7 @@ from .scheduling import (
 from .worker import WorkspaceWorker
 from .workspaces import WorkspaceServer
 
-__all__ = ["EXTENSIONS", "NODE_NAME", "WorkspaceNode", "main"]
+__all__ = ["EXTENSIONS", "NODE_NAME", "WorkspaceNode", "main", "warm_up_kernels"]
 
 NODE_NAME = params.NODE_NAME  # one definition, read by the CLI's parameters files too
 
@@ -171,10 +171,11 @@ def _result_qos(depth: int = 1) -> QoSProfile:
     )
 
 
-def _warm_up() -> float:
+def warm_up_kernels() -> float:
     """Compile (first run) or load the core's kernels before the node reports ready, so that
     the first pose check and the first planned path are as fast as the others; returns the
-    seconds taken."""
+    seconds taken. ``make ros`` calls it once after each build to fill the install space's
+    cache."""
     started = time.perf_counter()
     kernels.warm_up()
     planner_kernels.warm_up()  # ~/check_path with free torsion
@@ -293,7 +294,7 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
     @staticmethod
     def warm_up() -> float:
         """Load the core's kernels; seconds taken (configure calls it)."""
-        return _warm_up()
+        return warm_up_kernels()
 
     # ------------------------------------------------------------------ wiring helpers
     def recorded_publisher(self, message_class: type, topic: str, depth: int = 1) -> Any:
