@@ -307,10 +307,15 @@ def priority_prefix(args: argparse.Namespace, role: str = "node") -> list[str]:
     and for the commander (``--commander-priority N``); nothing for the other roles. With
     ``--node-session``, ``setsid`` first for the node and its floor."""
     priority = args.commander_priority if role == "commander" else args.priority
-    session = ["setsid"] if role == "node" and args.node_session else []
+    session = session_prefix(args) if role == "node" else []
     if not priority or role not in ("node", "commander"):
         return session
     return [*session, "chrt", "--fifo", str(priority)]
+
+
+def session_prefix(args: argparse.Namespace) -> list[str]:
+    """``setsid`` for the node and its floor with ``--node-session``, else nothing."""
+    return ["setsid"] if args.node_session else []
 
 
 def role_result(process: subprocess.Popen, timeout: float, required: bool = True) -> dict:
@@ -716,8 +721,7 @@ def main(argv: list[str] | None = None) -> int:
         prefix = priority_prefix(args)
         if args.node_source is None and args.priority:  # the node's own option
             options = [f"--realtime-priority={args.priority}", *args.node_option]
-            session = ["setsid"] if args.node_session else []
-            node = start_node(out_dir, args.node_arg, prefix=session, options=options)
+            node = start_node(out_dir, args.node_arg, prefix=session_prefix(args), options=options)
         else:  # another tree's node (which may not have the option): the same through chrt
             node = start_node(
                 out_dir, args.node_arg, args.node_source, prefix=prefix, options=args.node_option
