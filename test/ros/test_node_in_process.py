@@ -8,7 +8,9 @@ through the parameter services over DDS are in test_ros_node.py.
 
 from __future__ import annotations
 
+import contextlib
 import math
+from collections.abc import Iterator
 
 import numpy as np
 import pytest
@@ -304,13 +306,22 @@ def test_a_valid_request_gets_the_node_resolution(node):
     assert job.tolerance == node.state.settings.tolerance
 
 
-def test_commands_in_a_batch_are_answered_one_each_in_order(node):
-    """One batch with valid, invalid and stale commands: one result each, in order."""
+@contextlib.contextmanager
+def collected(stream) -> Iterator[list]:
+    """The results ``stream`` publishes while in the block, collected in a list instead."""
     published: list = []
-    stream = node._commands
     publisher = stream._publisher
     stream._publisher = type("Collect", (), {"publish": published.append, "topic_name": "/x"})()
     try:
+        yield published
+    finally:
+        stream._publisher = publisher
+
+
+def test_commands_in_a_batch_are_answered_one_each_in_order(node):
+    """One batch with valid, invalid and stale commands: one result each, in order."""
+    stream = node._commands
+    with collected(stream) as published:
         commands = []
         for k, theta in enumerate([0.1, math.nan, 0.2, 0.3]):
             command = CommandedPose(request_id=f"b{k}")
@@ -321,8 +332,6 @@ def test_commands_in_a_batch_are_answered_one_each_in_order(node):
         stale.position.z = -1.3
         stale.header.stamp.sec = 1  # 1970: far older than check.max_command_age
         stream.answer([*commands, stale])
-    finally:
-        stream._publisher = publisher
     assert [r.request_id for r in published] == ["b0", "b1", "b2", "b3", "stale"]
     assert [r.success for r in published] == [True, False, True, True, False]
     assert "theta" in published[1].message or "finite" in published[1].message
@@ -336,10 +345,7 @@ def test_commands_in_a_batch_are_answered_one_each_in_order(node):
 def test_each_command_of_a_batch_is_checked_at_its_own_position(node, rng, size):
     """Commands at three positions, interleaved in one batch: each result has the margins of
     the core's check of its own pose at its own position, in the order sent."""
-    published: list = []
     stream = node._commands
-    publisher = stream._publisher
-    stream._publisher = type("Collect", (), {"publish": published.append, "topic_name": "/x"})()
     heights = np.array([-1.3, -1.25, -1.35])[rng.permutation(np.arange(size) % 3)]
     angles = np.column_stack(
         [
@@ -348,7 +354,7 @@ def test_each_command_of_a_batch_is_checked_at_its_own_position(node, rng, size)
             rng.uniform(-0.5, 0.5, size),
         ]
     )
-    try:
+    with collected(stream) as published:
         commands = []
         for k in range(size):
             command = CommandedPose(request_id=f"p{k}")
@@ -356,8 +362,6 @@ def test_each_command_of_a_batch_is_checked_at_its_own_position(node, rng, size)
             command.orientation.phi, command.orientation.theta, command.orientation.psi = angles[k]
             commands.append(command)
         stream.answer(commands)
-    finally:
-        stream._publisher = publisher
     assert [r.request_id for r in published] == [f"p{k}" for k in range(size)]
     model = Manipulator.from_params_file(example_config_path())
     for k, result in enumerate(published):
