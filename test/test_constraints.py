@@ -271,3 +271,32 @@ def test_empty_batch(example):
     result = check(example, np.zeros((0, 3)))
     assert len(result) == 0
     assert result.violated == []
+
+
+def test_batch_outputs_share_one_block_without_overlapping(example, rng):
+    """check's output arrays are views of one allocation (see ``_output_arrays``): each is
+    C-contiguous, aligned and writable, none overlaps another, and every pose's answer equals
+    the one-pose check's."""
+    angles = np.column_stack(
+        [rng.uniform(-np.pi, np.pi, 257), rng.uniform(0, 0.6, 257), rng.uniform(-1, 1, 257)]
+    )
+    result = check(example, angles, singularity=True)
+    arrays = [
+        *result.margins.values(),
+        *result.limiting_legs.values(),
+        result.limiting_pair,
+        result.limiting_constraint,
+        result.reachable,
+    ]
+    for array in arrays:
+        assert array.flags.c_contiguous and array.flags.aligned and array.flags.writeable
+    separate = [*result.margins.values(), result.reachable, result.limiting_pair]
+    for i, first in enumerate(separate):
+        for second in separate[i + 1 :]:
+            assert not np.shares_memory(first, second)
+    for n in (0, 128, 256):
+        one = check(example, angles[n], singularity=True)
+        assert one.reachable[0] == result.reachable[n]
+        for name, values in result.margins.items():
+            assert one.margins[name][0] == values[n]
+        np.testing.assert_array_equal(one.limiting_pair[0], result.limiting_pair[n])

@@ -494,10 +494,7 @@ def check(
     # Only the rows up to the last one that applies (6-UPS: 5 of the table's rows): the others
     # are +inf for every pose, and allocating them would cost more than the check itself.
     used = int(model[kernels.ROWS_USED])
-    margins = np.empty((used, count))
-    ints = np.empty((used + 2, count), dtype=np.int64)
-    pairs = np.empty((count, 2), dtype=np.int64)
-    reachable = np.empty(count, dtype=np.bool_)
+    margins, ints, pairs, reachable = _output_arrays(used, count)
     outputs = (margins, ints, pairs, reachable)
     workers = _cores() if count >= PARALLEL_POSES else 1
     if workers == 1:
@@ -638,6 +635,30 @@ def check_pose(
             validate_position(manipulator, values)  # raises, with the same reason as check()
     fields = kernels.check_one(kernels.model_vector(manipulator), *angles, x, y, z)
     return _POSE_CHECK(PoseCheck, fields)
+
+
+def _output_arrays(
+    used: int, count: int
+) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int64], NDArray[np.bool_]]:
+    """The batch check's outputs as views of one allocation: margins (used, N) float64,
+    limiting legs + limiting constraint + limiting leg (used + 2, N) int64, pairs (N, 2)
+    int64, reachable (N,) bool.
+
+    One block instead of four: glibc serves a large block from its heap once a block that size
+    has been freed, and gives the heap's top back to the system when more than twice the
+    largest freed block lies free there. With four arrays, the whole of them (23 MB for 2·10⁵
+    6-UPS poses) exceeded twice the largest (11 MB), so every call returned the memory and
+    page-faulted it in again, about 17 ns per pose on a 100 ns check; one block stays in the
+    heap (``benchmarks/model.py``). The arrays live as long as any one of them is referenced.
+    """
+    floats = used * count
+    words = (used + 2) * count + 2 * count
+    block = np.empty(8 * (floats + words) + count, dtype=np.uint8)
+    margins = block[: 8 * floats].view(np.float64).reshape(used, count)
+    ints = block[8 * floats : 8 * (floats + (used + 2) * count)].view(np.int64)
+    pairs = block[8 * (floats + (used + 2) * count) : 8 * (floats + words)].view(np.int64)
+    reachable = block[8 * (floats + words) :].view(np.bool_)
+    return margins, ints.reshape(used + 2, count), pairs.reshape(count, 2), reachable
 
 
 def _require_finite_angles(angles: NDArray[np.float64]) -> None:
