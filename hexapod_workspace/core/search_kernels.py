@@ -409,10 +409,11 @@ def search_rays(
     only the ray's own anchor is used, with L_c(τ_lim), in the march, dropped after a step
     floored at ``min_step``; the secant/bisection phase evaluates every probe.
 
-    Each round evaluates all probes without the collision margin (the block kernel on the
-    model with its scene off), then walks them in order: where ``_lazy_collision`` accepts a
-    bound it stands in for the margin, else the probe is evaluated with the scene on (the block
-    kernel on that pose: the margin of a search without laziness) and becomes an anchor.
+    Each round evaluates its probes block by block without the collision margin (the block
+    kernel on the model with its scene off), then walks the block's probes in order: where
+    ``_lazy_collision`` accepts a bound it stands in for the margin, else the probe is evaluated
+    with the scene on (the block kernel on that pose, in planes of its own: the margin of a
+    search without laziness) and becomes an anchor; then the probe is decided.
     **Why nothing is missed**: a probe whose bound is > 0 is collision-free (the bound is below
     the true margin), and a march step taken from the bound is certified for the collision
     margin exactly as one taken from the margin itself (a smaller lower bound only shortens
@@ -458,7 +459,7 @@ def search_rays(
     plain = model.copy()  # (a copy of a few hundred floats per call)
     if lazy:
         plain[COLLISION_ON] = 0.0
-    margins = np.empty((count, N_CONSTRAINTS))
+    single = np.empty(_BLOCK_ROWS * BLOCK if lazy else 0)  # the lazy pass's one-pose planes
     at = np.empty(count)
     anchor_s = np.full(count, np.nan)  # per ray: s, a lower bound of the margin there and
     anchor_value = np.zeros(count)  # the evaluated margin that bound comes from
@@ -506,113 +507,116 @@ def search_rays(
         if probes == 0:
             break
         evaluations += probes
-        # Margins of every probe, the collision margin left out where lazy (its own pass).
+        if collide and not lazy:
+            collisions += probes
+        # Margins of every probe (the collision margin left out where lazy: the lazy pass below
+        # puts a bound in its place or evaluates it), each probe decided while its block's
+        # planes are in the cache. A ray has one probe per round, and a probe's lazy bound
+        # reads its own ray's anchor and the evaluated poses of rays, which no decision
+        # changes: probes decided block by block go as if the whole round were evaluated first.
         for block in range(0, probes, BLOCK):
             size = min(BLOCK, probes - block)
             _check_block(plain, angles, position, block, size, work, scratch, out, r)
             for m in range(size):
-                for slot in range(used):
-                    margins[block + m, slot] = work[slot * BLOCK + m]
-        if lazy:
-            for n in range(probes):
+                n = block + m
                 ray = rays[n]
                 for slot in range(used):
-                    out[slot] = margins[n, slot]
-                march = phase[ray] == _MARCH
-                # The ray's own anchor first (no trigonometry: the turn is at most |Δs|).
-                since = anchor_s[ray]
-                if since == since and (everywhere or march):
-                    bound = anchor_value[ray] - rate_c * abs(at[n] - since) - LAZY_SLACK
-                    if _lazy_collision(model, out, bound, anchor_reference[ray], march):
-                        margins[n, COLLISION] = bound
+                    out[slot] = work[slot * BLOCK + m]
+                if lazy:
+                    collision = np.nan
+                    placed = False
+                    march = phase[ray] == _MARCH
+                    # The ray's own anchor first (no trigonometry: the turn is at most |Δs|).
+                    since = anchor_s[ray]
+                    if since == since and (everywhere or march):
+                        bound = anchor_value[ray] - rate_c * abs(at[n] - since) - LAZY_SLACK
+                        if _lazy_collision(model, out, bound, anchor_reference[ray], march):
+                            collision = bound
+                            placed = True
+                    if not placed and everywhere:  # the evaluated poses of nearby rays
+                        _tt_matrix(angles[n, 0], angles[n, 1], angles[n, 2], rotation)
+                        bound = -np.inf
+                        reference = np.inf
+                        for candidate in (ray, recent, ray - 1, ray + 1, ray - 2, ray + 2):
+                            if 0 <= candidate < count and posed[candidate]:
+                                turn = _turn_between(anchor_r, candidate, rotation)
+                                value = posed_value[candidate] - rate_c * turn
+                                if value > bound:
+                                    bound = value
+                                    reference = posed_value[candidate]
+                        bound -= LAZY_SLACK
+                        if _lazy_collision(model, out, bound, reference, march):
+                            collision = bound
+                            placed = True
+                            anchor_s[ray] = at[n]  # a lower bound at s is an anchor of (1) too
+                            anchor_value[ray] = bound
+                            anchor_reference[ray] = reference
+                    if not placed:
+                        # Evaluated: the block kernel on this one pose (the margin of a search
+                        # without laziness) in planes of its own, which becomes the ray's anchor.
+                        _check_block(model, angles, position, n, 1, single, scratch, out, r)
+                        collision = single[COLLISION * BLOCK]
+                        usable = collision == collision
+                        anchor_s[ray] = at[n] if usable else np.nan
+                        anchor_value[ray] = collision
+                        anchor_reference[ray] = collision
+                        if everywhere:
+                            for i in range(9):
+                                anchor_r[ray, i] = rotation[i]
+                            posed[ray] = usable
+                            posed_value[ray] = collision
+                            if usable:
+                                recent = ray
+                        collisions += 1
+                        for slot in range(used):  # the one-pose kernel used `out` as scratch
+                            out[slot] = work[slot * BLOCK + m]
+                    out[COLLISION] = collision
+                ok = _feasible(out, used)
+                estimate = _estimate(model, out)
+                state = phase[ray]
+                if state == _MARCH:
+                    if not ok:
+                        violated[ray] = s[ray]
+                        high_value[ray] = estimate
+                        limiting[ray] = _limiting_constraint(model, out)
+                        if first[ray]:
+                            start_feasible[ray] = False
+                            phase[ray] = _DONE
+                        else:
+                            phase[ray] = _GUESS
                         continue
-                if everywhere:  # then the evaluated poses of nearby rays, by their turn
-                    _tt_matrix(angles[n, 0], angles[n, 1], angles[n, 2], rotation)
-                    bound = -np.inf
-                    reference = np.inf
-                    for candidate in (ray, recent, ray - 1, ray + 1, ray - 2, ray + 2):
-                        if 0 <= candidate < count and posed[candidate]:
-                            turn = _turn_between(anchor_r, candidate, rotation)
-                            value = posed_value[candidate] - rate_c * turn
-                            if value > bound:
-                                bound = value
-                                reference = posed_value[candidate]
-                    bound -= LAZY_SLACK
-                    if _lazy_collision(model, out, bound, reference, march):
-                        margins[n, COLLISION] = bound
-                        anchor_s[ray] = at[n]  # a lower bound at s is an anchor of (1) too
-                        anchor_value[ray] = bound
-                        anchor_reference[ray] = reference
-                        continue
-                # Evaluated: the block kernel on this one pose (the margin of a search without
-                # laziness), which becomes the ray's anchor.
-                _check_block(model, angles, position, n, 1, work, scratch, out, r)
-                value = work[COLLISION * BLOCK]
-                margins[n, COLLISION] = value
-                usable = value == value
-                anchor_s[ray] = at[n] if usable else np.nan
-                anchor_value[ray] = value
-                anchor_reference[ray] = value
-                if everywhere:
-                    for i in range(9):
-                        anchor_r[ray, i] = rotation[i]
-                    posed[ray] = usable
-                    posed_value[ray] = value
-                    if usable:
-                        recent = ray
-                collisions += 1
-        elif collide:
-            collisions += probes
-        for n in range(probes):
-            ray = rays[n]
-            for slot in range(used):
-                out[slot] = margins[n, slot]
-            ok = _feasible(out, used)
-            estimate = _estimate(model, out)
-            state = phase[ray]
-            if state == _MARCH:
-                if not ok:
-                    violated[ray] = s[ray]
-                    high_value[ray] = estimate
-                    limiting[ray] = _limiting_constraint(model, out)
-                    if first[ray]:
-                        start_feasible[ray] = False
+                    first[ray] = False
+                    feasible[ray] = s[ray]
+                    low_value[ray] = estimate
+                    certified = certified_step(model, out)
+                    step = max(certified, min_step)
+                    if step > certified and not everywhere:
+                        anchor_s[ray] = np.nan  # (1) does not reach over an uncertified step
+                    if s[ray] >= s_end[ray]:
                         phase[ray] = _DONE
                     else:
-                        phase[ray] = _GUESS
-                    continue
-                first[ray] = False
-                feasible[ray] = s[ray]
-                low_value[ray] = estimate
-                certified = certified_step(model, out)
-                step = max(certified, min_step)
-                if step > certified and not everywhere:
-                    anchor_s[ray] = np.nan  # (1) does not reach over an uncertified step
-                if s[ray] >= s_end[ray]:
-                    phase[ray] = _DONE
-                else:
-                    s[ray] = min(s[ray] + step, s_end[ray])
-            elif state == _GUESS:  # the probe below the guess
-                if not ok:
-                    violated[ray] = minus[ray]
-                    high_value[ray] = estimate
-                    limiting[ray] = _limiting_constraint(model, out)
+                        s[ray] = min(s[ray] + step, s_end[ray])
+                elif state == _GUESS:  # the probe below the guess
+                    if not ok:
+                        violated[ray] = minus[ray]
+                        high_value[ray] = estimate
+                        limiting[ray] = _limiting_constraint(model, out)
+                        bisect[ray] = (violated[ray] - feasible[ray]) > 0.5 * width[ray]
+                    else:
+                        minus_value[ray] = estimate
+                        phase[ray] = _PLUS
+                else:  # the probe above the guess
+                    if not ok:
+                        feasible[ray] = minus[ray]
+                        low_value[ray] = minus_value[ray]
+                        violated[ray] = plus[ray]
+                        high_value[ray] = estimate
+                        limiting[ray] = _limiting_constraint(model, out)
+                    else:
+                        feasible[ray] = plus[ray]
+                        low_value[ray] = estimate
                     bisect[ray] = (violated[ray] - feasible[ray]) > 0.5 * width[ray]
-                else:
-                    minus_value[ray] = estimate
-                    phase[ray] = _PLUS
-            else:  # the probe above the guess
-                if not ok:
-                    feasible[ray] = minus[ray]
-                    low_value[ray] = minus_value[ray]
-                    violated[ray] = plus[ray]
-                    high_value[ray] = estimate
-                    limiting[ray] = _limiting_constraint(model, out)
-                else:
-                    feasible[ray] = plus[ray]
-                    low_value[ray] = estimate
-                bisect[ray] = (violated[ray] - feasible[ray]) > 0.5 * width[ray]
-                phase[ray] = _GUESS
+                    phase[ray] = _GUESS
     return evaluations, collisions
 
 
