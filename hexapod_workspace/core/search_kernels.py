@@ -511,9 +511,10 @@ def search_rays(
             collisions += probes
         # Margins of every probe (the collision margin left out where lazy: the lazy pass below
         # puts a bound in its place or evaluates it), each probe decided while its block's
-        # planes are in the cache. A ray has one probe per round, and a probe's lazy bound
-        # reads its own ray's anchor and the evaluated poses of rays, which no decision
-        # changes: probes decided block by block go as if the whole round were evaluated first.
+        # planes are in the cache. A ray has one probe per round; a decision changes only its
+        # own ray's state, and a probe's lazy bound reads its own ray's anchor and phase and
+        # the evaluated poses of rays, which decisions leave alone: probes decided block by
+        # block go exactly as if the whole round were evaluated before any was decided.
         for block in range(0, probes, BLOCK):
             size = min(BLOCK, probes - block)
             _check_block(plain, angles, position, block, size, work, scratch, out, r)
