@@ -1114,7 +1114,8 @@ _MOVE = _BASE + 18
 _M_ACT, _LEG_ACT, _M_IK, _LEG_IK, _M_TAU, _LEG_TAU, _UNSOLVED, _UNSOLVED_LEG = range(8)
 _COLLIDE = _MOVE + 8  # 2 rows: collision margin and its pair (when a scene is declared)
 _BLOCK_ROWS = _COLLIDE + 2
-# Rows of the running minima (offsets from _MIN): margins or cosines and their leg or pair.
+# Rows of the running minima (offsets from _MIN): margins or cosines and their leg or pair
+# (_BEST: the smallest squared distance between two legs).
 _M_LEN, _LEG_LEN, _M_A, _LEG_A, _M_B, _LEG_B, _BEST, _PAIR, _FIX = range(9)
 # Rows of one leg (offsets from _LEGS + 7·k): vector, squared length, 1/ℓ², joint cosines.
 _LX, _LY, _LZ, _SQ, _INV, _COS_A, _COS_B = range(7)
@@ -1242,8 +1243,15 @@ def _pair_at(
     rr: float,
     pf: float,
 ) -> None:
-    """Pose n of a pair plane: the segment distance of legs i and j (r = A_i − A_j) into the
-    running minimum and its pair (first pair on ties), parallel or point-like legs flagged."""
+    """Pose n of a pair plane: the squared segment distance of legs i and j (r = A_i − A_j,
+    clamped at 0) into the running minimum and its pair (first pair on ties), parallel or
+    point-like legs flagged.
+
+    The minimum is kept squared and its square root taken once per pose, after the 15 pairs:
+    sqrt is correctly rounded and non-decreasing, so the root of the smallest square is the
+    smallest root, bit for bit (the distance each pair would give). The pair is the first with
+    the smallest square; where two squares differ but round to the same root it is the closer
+    pair, where a root per pair named the first of the two."""
     squared, regular = _pair_squared(
         rx,
         ry,
@@ -1260,7 +1268,7 @@ def _pair_at(
         leg_i[_INV * BLOCK + n],
         leg_j[_INV * BLOCK + n],
     )
-    distance = math.sqrt(max(squared, 0.0))
+    distance = max(squared, 0.0)
     smallest = minima[_BEST * BLOCK + n]
     minima[_PAIR * BLOCK + n] = pf if distance < smallest else minima[_PAIR * BLOCK + n]
     minima[_BEST * BLOCK + n] = min(distance, smallest)
@@ -1641,7 +1649,8 @@ def _check_block(
             )
         if interference:
             pair = int(work[(_MIN + _PAIR) * BLOCK + n])
-            work[LEG_INTERFERENCE * BLOCK + n] = work[(_MIN + _BEST) * BLOCK + n] - model[DIAMETER]
+            distance = math.sqrt(work[(_MIN + _BEST) * BLOCK + n])  # kept squared (_pair_at)
+            work[LEG_INTERFERENCE * BLOCK + n] = distance - model[DIAMETER]
             work[(OUT_LEG + LEG_INTERFERENCE) * BLOCK + n] = PAIR_I[pair]
             work[OUT_PAIR * BLOCK + n] = PAIR_I[pair]
             work[(OUT_PAIR + 1) * BLOCK + n] = PAIR_J[pair]
