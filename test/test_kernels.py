@@ -295,6 +295,54 @@ def test_lockstep_search_equals_rays_searched_alone(example):
     assert not np.any(check(example, beyond).reachable)
 
 
+@pytest.mark.parametrize("name", ["example_gpm", "singularity", "example_pus", "example_rus"])
+def test_block_decisions_equal_the_per_probe_functions(name):
+    """The search reads a block's estimates, verdicts and (fixed base) certified steps from
+    planes computed row by row; they must be the per-probe functions' values, bit for bit, on
+    margins of every kind (negative, zero, NaN, +inf, tiny and huge)."""
+    from hexapod_workspace.core import search_kernels
+
+    config = CONFIG.parent / f"{name if name.startswith('example') else 'example_gpm'}.yaml"
+    machine = Manipulator.from_params_file(config, warn=False)
+    if name == "singularity":
+        parameters = machine.to_parameters()
+        parameters["limits.singularity_min"] = 0.02
+        machine = Manipulator.from_mapping(parameters, warn=False)
+    model = kernels.model_vector(machine)
+    used = int(model[kernels.ROWS_USED])
+    fixed = machine.architecture == "ups"
+    block = margin_kernels.BLOCK
+    rng = np.random.default_rng(11)
+    work = np.full(margin_kernels._BLOCK_ROWS * block, np.inf)
+    special = np.array([0.0, -0.0, np.nan, np.inf, 1e-300, -1e-300, 1e300, 5e-324])
+    for c in range(used):
+        # Mostly feasible (the steps matter there), some violated, some special values.
+        row = np.abs(rng.normal(scale=0.05, size=block)) * rng.choice([1.0, 1e-6, 30.0], block)
+        row[rng.random(block) < 0.05] *= -1.0
+        picks = rng.random(block) < 0.12
+        row[picks] = rng.choice(special, size=int(picks.sum()))
+        work[c * block : (c + 1) * block] = row
+    for m in range(4 * used):  # one NaN or +inf in each row in turn, the others feasible
+        for c in range(used):
+            work[c * block + m] = abs(work[c * block + m]) if m % used != c else special[2 + m % 2]
+    estimates, verdicts, steps = np.empty(block), np.empty(block), np.full(block, -1.0)
+    search_kernels._block_decisions(
+        model, work, block, used, fixed, estimates, verdicts, steps, np.empty(2 * block)
+    )
+    out = np.full(margin_kernels.OUT_SIZE, np.inf)
+    for m in range(block):
+        out[:used] = work[m : used * block : block]
+        expected = search_kernels._estimate(model, out)
+        assert estimates[m] == expected or (math.isnan(estimates[m]) and math.isnan(expected))
+        assert verdicts[m] == float(margin_kernels._feasible(out, used))
+        if fixed:
+            step = search_kernels.certified_step(model, out)
+            assert steps[m] == step and math.copysign(1.0, steps[m]) == math.copysign(1.0, step)
+    assert np.isnan(estimates).any() and (verdicts == 1.0).any() and (verdicts == 0.0).any()
+    if fixed:
+        assert (steps > 0.0).any() and (steps == 0.0).any()
+
+
 def test_sincos_within_an_ulp_of_libm():
     x = np.concatenate(
         [np.linspace(-kernels.FAST_TRIG_LIMIT, kernels.FAST_TRIG_LIMIT, 200_001), [0.0, -0.0]]

@@ -11,6 +11,7 @@ import math
 
 # Imported first: it points numba's cache directory somewhere writable before numba loads.
 from .jit import helper as _helper
+from .jit import inline as _inline
 from .jit import jit as _jit
 
 # isort: split
@@ -234,6 +235,72 @@ def recovery_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> float
     return min(recover, floor / rho) * SAFETY
 
 
+@_inline
+def _fmin_select(a: float, b: float) -> float:
+    """:func:`_fmin` as one expression (no early return), so that loops over probes vectorise."""
+    return b if a != a else (a if b != b else (a if a < b else b))
+
+
+@_helper
+def _block_decisions(
+    model: NDArray[np.float64],
+    work: NDArray[np.float64],
+    size: int,
+    used: int,
+    fixed: bool,
+    estimates: NDArray[np.float64],
+    verdicts: NDArray[np.float64],
+    steps: NDArray[np.float64],
+    lengths: NDArray[np.float64],
+) -> None:
+    """What :func:`search_rays` reads from each probe of a block, row by row over the block.
+
+    ``work`` holds the margins of ``size`` probes as :func:`_check_block` leaves them (rows
+    0..used − 1). Writes, each (BLOCK,), for probe m < size: ``estimates[m]`` = :func:`_estimate`,
+    ``verdicts[m]`` 1.0 where every margin is ≥ 0 (:func:`_feasible`) else 0.0, and with fixed
+    base joints ``steps[m]`` = :func:`certified_step` (``lengths`` (2·BLOCK,): scratch). Each
+    is the per-probe function's arithmetic, the same operations in the same order (a NaN start
+    is what :func:`_fmin` turns into its other argument), so the values are the same bit for
+    bit; the loops run over the probes of one row at a time, without calls, and vectorise.
+    Steps are computed for every probe and read for the feasible probes of the march only.
+    """
+    for m in range(size):
+        value = work[m]
+        estimates[m] = value / model[ESTIMATE_RATE]
+        verdicts[m] = 1.0 if value >= 0.0 else 0.0
+    for c in range(1, used):
+        rate = model[ESTIMATE_RATE + c]
+        for m in range(size):
+            value = work[c * BLOCK + m]
+            ratio = value / rate
+            best = estimates[m]
+            estimates[m] = ratio if (ratio < best) | (ratio != ratio) else best
+            verdicts[m] = verdicts[m] if value >= 0.0 else 0.0
+    if not fixed:
+        return
+    rho = model[RHO]
+    length_min = model[LENGTH_FLOOR]
+    for m in range(size):
+        length_now = length_min + max(work[LEG_LENGTH * BLOCK + m], 0.0)
+        lengths[m] = length_now
+        lengths[BLOCK + m] = max(length_min, 0.5 * length_now)  # the leg floor of the rates
+        steps[m] = np.nan
+    for c in range(used):
+        constant = model[RAY_CONSTANT + c]
+        turn = model[RAY_TURN + c]
+        if turn != 0.0:  # _rate: the turn term only where its coefficient is not 0
+            for m in range(size):
+                rate = constant + turn / lengths[BLOCK + m]
+                steps[m] = _fmin_select(steps[m], work[c * BLOCK + m] / rate)
+        else:
+            for m in range(size):
+                steps[m] = _fmin_select(steps[m], work[c * BLOCK + m] / constant)
+    for m in range(size):
+        step = _fmin_select(steps[m], 0.5 * lengths[m] / rho)
+        step = _fmin_select(step, MAX_STEP)
+        steps[m] = (step if step > 0.0 else 0.0) * SAFETY  # a NaN step becomes 0
+
+
 # Phases of a ray in search_rays.
 _MARCH, _GUESS, _PLUS, _DONE = 0, 1, 2, 3
 
@@ -450,6 +517,13 @@ def search_rays(
     half = 0.25 * tolerance
     evaluations = 0
     collisions = 0
+    # Estimates, verdicts and (fixed base) certified steps of a block's probes, computed for the
+    # whole block (_block_decisions) where nothing changes a margin after the block kernel.
+    estimates = np.empty(BLOCK)
+    verdicts = np.empty(BLOCK)
+    steps = np.empty(BLOCK)
+    lengths = np.empty(2 * BLOCK)
+    fixed = model[ARCH] == 0.0
     # Lazy collision margin: the model with its scene off, the margins of every probe of a
     # round, and per ray the last evaluated collision margin (anchor_s NaN: none usable).
     collide = model[COLLISION_ON] != 0.0
@@ -518,6 +592,10 @@ def search_rays(
         for block in range(0, probes, BLOCK):
             size = min(BLOCK, probes - block)
             _check_block(plain, angles, position, block, size, work, scratch, out, r)
+            if not lazy:
+                _block_decisions(
+                    model, work, size, used, fixed, estimates, verdicts, steps, lengths
+                )
             for m in range(size):
                 n = block + m
                 ray = rays[n]
@@ -572,8 +650,12 @@ def search_rays(
                         for slot in range(used):  # the one-pose kernel used `out` as scratch
                             out[slot] = work[slot * BLOCK + m]
                     out[COLLISION] = collision
-                ok = _feasible(out, used)
-                estimate = _estimate(model, out)
+                if lazy:  # the collision slot was placed above: decided from `out`
+                    ok = _feasible(out, used)
+                    estimate = _estimate(model, out)
+                else:
+                    ok = verdicts[m] != 0.0
+                    estimate = estimates[m]
                 state = phase[ray]
                 if state == _MARCH:
                     if not ok:
@@ -589,7 +671,7 @@ def search_rays(
                     first[ray] = False
                     feasible[ray] = s[ray]
                     low_value[ray] = estimate
-                    certified = certified_step(model, out)
+                    certified = steps[m] if fixed and not lazy else certified_step(model, out)
                     step = max(certified, min_step)
                     if step > certified and not everywhere:
                         anchor_s[ray] = np.nan  # (1) does not reach over an uncertified step
