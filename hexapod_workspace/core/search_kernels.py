@@ -198,7 +198,10 @@ def certified_step(model: NDArray[np.float64], out: NDArray[np.float64]) -> floa
     """Length over which no margin can reach zero, from feasible margins (core.search).
 
     Like every step and estimate here, reads only the rows in use (``model[ROWS_USED]``): the
-    kernels write +inf in the others, which can bound no step."""
+    kernels write +inf in the others, which can bound no step. :func:`_block_decisions` does
+    this function's fixed-base arithmetic (and :func:`_estimate`'s) for a whole block: a change
+    here goes there too (``test_block_decisions_equal_the_per_probe_functions`` holds them
+    equal, bit for bit)."""
     if model[ARCH] != 0.0:
         return _certified_step_moving(model, out)
     rho = model[RHO]
