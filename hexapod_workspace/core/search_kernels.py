@@ -537,6 +537,7 @@ def search_rays(
     if lazy:
         plain[COLLISION_ON] = 0.0
     single = np.empty(_BLOCK_ROWS * BLOCK if lazy else 0)  # the lazy pass's one-pose planes
+    single_out = np.empty(OUT_SIZE)  # and its one-pose scratch (`out` holds the probe's margins)
     at = np.empty(count)
     anchor_s = np.full(count, np.nan)  # per ray: s, a lower bound of the margin there and
     anchor_value = np.zeros(count)  # the evaluated margin that bound comes from
@@ -636,7 +637,7 @@ def search_rays(
                     if not placed:
                         # Evaluated: the block kernel on this one pose (the margin of a search
                         # without laziness) in planes of its own, which becomes the ray's anchor.
-                        _check_block(model, angles, position, n, 1, single, scratch, out, r)
+                        _check_block(model, angles, position, n, 1, single, scratch, single_out, r)
                         collision = single[COLLISION * BLOCK]
                         usable = collision == collision
                         anchor_s[ray] = at[n] if usable else np.nan
@@ -650,11 +651,8 @@ def search_rays(
                             if usable:
                                 recent = ray
                         collisions += 1
-                        for slot in range(used):  # the one-pose kernel used `out` as scratch
-                            out[slot] = work[slot * BLOCK + m]
                     out[COLLISION] = collision
-                if lazy:  # the collision slot was placed above: decided from `out`
-                    ok = _feasible(out, used)
+                    ok = _feasible(out, used)  # decided from `out`, its collision slot placed
                     estimate = _estimate(model, out)
                 else:
                     ok = verdicts[m] != 0.0
