@@ -12,9 +12,19 @@ from hexapod_workspace.core import kernels
 
 @pytest.fixture(scope="session", autouse=True)
 def compiled_kernels() -> float:
-    """Compile (or load) the kernels once before any test: the CLI subprocesses of the tests
-    share this source tree's cache, so none of them prints the first-run notice."""
-    return kernels.warm_up()
+    """Compile (or load) the kernels of the packaged examples' variants once before any test
+    (with and without the reported singularity margin): the CLI subprocesses of the tests share
+    this source tree's cache, so none of them prints the first-run notice. A test of another
+    variant compiles it where it first uses it."""
+    config = example_config_path().parent
+    models = [
+        kernels.model_vector(
+            Manipulator.from_params_file(config / f"{name}.yaml"), report_singularity=report
+        )
+        for name in ("example_gpm", "example_collision", "example_pus", "example_rus")
+        for report in (False, True)
+    ]
+    return kernels.warm_up(*models)
 
 
 @pytest.fixture(scope="session")

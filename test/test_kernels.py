@@ -336,7 +336,7 @@ def test_block_decisions_equal_the_per_probe_functions(name):
         assert estimates[m] == expected or (math.isnan(estimates[m]) and math.isnan(expected))
         assert verdicts[m] == float(margin_kernels._feasible(out, used))
         if fixed:
-            step = search_kernels.certified_step(model, out)
+            step = search_kernels.certified_step(model, out, None)
             assert steps[m] == step and math.copysign(1.0, steps[m]) == math.copysign(1.0, step)
     assert np.isnan(estimates).any() and (verdicts == 1.0).any() and (verdicts == 0.0).any()
     if fixed:
@@ -447,7 +447,93 @@ def test_cache_works_in_a_read_only_install(tmp_path):
     assert first.stdout == second.stdout
     lines = first.stderr.strip().splitlines()
     assert len(lines) == 1 and "compiling the numerical kernels" in lines[0], first.stderr
-    assert str(cache / "hexapod_workspace" / "numba") in lines[0]
+    assert str(cache / "hexapod_workspace" / "numba-") in lines[0]
     assert second.stderr == ""
-    assert any((cache / "hexapod_workspace" / "numba").rglob("*.nbi"))
+    assert any((cache / "hexapod_workspace").rglob("numba-*/**/*.nbi"))
     assert not list(site.rglob("__pycache__/*.nbi"))
+
+
+def _python(code: str, **environment: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-c", code],
+        env={**os.environ, **environment},
+        capture_output=True,
+        text=True,
+        timeout=900,
+        check=False,
+    )
+
+
+def test_one_signature_per_kernel_after_a_mixed_workload():
+    """Inputs of every layout (strided views, read-only, integer, Fortran order, Python lists)
+    are normalised at the boundary: each kernel of the variant has one compiled signature."""
+    code = """
+import numpy as np
+from hexapod_workspace import Manipulator, check, projected_workspace
+from hexapod_workspace.core import kernels
+from hexapod_workspace.core.constraints import check_pose, pose_margins
+from hexapod_workspace.core.orientation import torsion_range
+m = Manipulator.example()
+T = np.eye(4)
+T[:3, 3] = m.position
+angles = np.radians([[0, 10, 0], [30, 20, 5]])
+frozen = angles.copy()
+frozen.setflags(write=False)
+check(m, angles, T[:3, 3])
+check(m, frozen, tuple(m.position))
+check(m, np.asfortranarray(np.tile(angles, (3, 1))), list(m.position))
+check(m, np.zeros((2, 3), dtype=np.int64), m.position.astype(np.float32))
+check(m, [[0.0, 0.1, 0.0]])
+check_pose(m, 0, 0.1, 0, T[:3, 3])
+check_pose(m, 0.0, 0.1, 0.0)
+pose_margins(m, np.eye(3)[None], T[:3, 3])
+pose_margins(m, np.asfortranarray(np.eye(3))[None], [0.0, 0.0, -1.3])
+projected_workspace(m, T[:3, 3], method="exact", n_phi=8)
+projected_workspace(m, list(m.position), method="torsion_zero", n_phi=8)
+torsion_range(m, 0.3, 0.2, T[:3, 3])
+for key, variant in kernels._VARIANTS.items():
+    for name, dispatcher in variant._asdict().items():
+        if name != "collide":
+            print(key, name, len(dispatcher.signatures))
+"""
+    done = _python(code)
+    assert done.returncode == 0, done.stderr
+    counts = [line.rsplit(" ", 2) for line in done.stdout.splitlines()]
+    assert counts, done.stdout
+    assert len(counts) == 5 and all(count == "1" for *_, count in counts), done.stdout
+
+
+def test_a_6ups_check_compiles_no_stage_it_does_not_use(tmp_path):
+    """The switches leave the moving-base, collision and singularity stages out of the 6-UPS
+    kernel: with a cold cache, a check of the packaged example compiles none of their helpers
+    (each stage costs tens of seconds of compilation)."""
+    code = """
+import numpy as np
+from hexapod_workspace import Manipulator, check
+from hexapod_workspace.core import collision_kernels, margin_kernels
+check(Manipulator.example(), np.radians([[0, 30, 0]]))
+for name in ("_pose_moving", "_pose_collision", "_block_collision", "_block_singularity",
+             "_pose_singularity", "_leg_planes_pus", "_leg_planes_rus"):
+    print(name, len(getattr(margin_kernels, name).signatures))
+print("collision_margin", len(collision_kernels.collision_margin.signatures))
+print("_check_block", len(margin_kernels._check_block.signatures))
+"""
+    done = _python(code, NUMBA_CACHE_DIR=str(tmp_path))
+    assert done.returncode == 0, done.stderr
+    counts = dict(line.split() for line in done.stdout.splitlines())
+    assert counts.pop("_check_block") == "1", done.stdout
+    assert set(counts.values()) == {"0"}, done.stdout
+
+
+def test_kernel_sources_name_every_module_with_compiled_code():
+    """The cache directory is named by a hash of KERNEL_SOURCES: a module with compiled code
+    missing from it would be loaded stale from the cache after a change."""
+    from hexapod_workspace.core import jit
+
+    decorated = set()
+    for path in PACKAGE.rglob("*.py"):
+        text = path.read_text(encoding="utf-8")
+        if any(mark in text for mark in ("@_jit", "@_helper", "@_inline", "numba.njit(")):
+            decorated.add(path.resolve())
+    assert decorated
+    assert decorated <= {source.resolve() for source in jit.KERNEL_SOURCES}

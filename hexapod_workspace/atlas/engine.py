@@ -170,7 +170,7 @@ class _OnDask:
         self.workers = len(self.client.scheduler_info().get("workers", {}))
         # Each worker process loads (or, on a fresh cache, compiles) the kernels once, all at
         # the same time, instead of inside its first chunk.
-        self.client.run(kernels.warm_up)
+        self.client.run(kernels.warm_up, kernels.model_vector(self.manipulator))
 
     def run(self, jobs, finished) -> None:
         from distributed import as_completed

@@ -92,7 +92,8 @@ def run_demo(
     from .plotting import plot_orientation, plot_projected
     from .progress import ProgressBar
 
-    kernels.warm_up()  # compiled (first run after install) before anything is timed
+    # Compiled (first run after install) before anything is timed.
+    kernels.warm_up(kernels.model_vector(manipulator))
 
     if out_dir.exists() and not out_dir.is_dir():
         msg = f"--out: {out_dir} exists and is not a folder"

@@ -733,3 +733,69 @@ def _platform_body(
     row[_P + 1] = model[at + _P + 1]
     row[_P + 2] = 0.0
     row[_INFLATION] = 0.0
+
+
+# ------------------------------------------------------------------------------ first-class entry
+def _collision_pose(
+    model: NDArray[np.float64],
+    block: int,
+    joints: int,
+    r: NDArray[np.float64],
+    px: float,
+    py: float,
+    pz: float,
+    lx: NDArray[np.float64],
+    ly: NDArray[np.float64],
+    lz: NDArray[np.float64],
+    memory: NDArray[np.float64],
+) -> tuple[float, float, float]:
+    """:func:`collision_margin` with the broad phase on: the function the margin kernels call."""
+    return collision_margin(model, block, joints, r, px, py, pz, lx, ly, lz, memory, True)
+
+
+_COLLISION_FUNCTION: list[object] = []
+
+
+def collision_function() -> object:
+    """The collision margin of one pose, compiled once (and cached) as a first-class function.
+
+    The margin and search kernels of a model with a scene take it as their ``collide`` switch
+    (:mod:`~hexapod_workspace.core.jit`) and call it through its address: its code, the largest
+    of the core (GJK and the broad phase), is compiled and optimised once instead of again
+    inside every kernel and every variant that calls it (numba links a callee's code into each
+    caller and optimises the whole again). Its type is :func:`collision_type`.
+    """
+    if not _COLLISION_FUNCTION:
+        from .jit import first_class
+
+        _COLLISION_FUNCTION.append(first_class(_collision_pose, collision_signature()))
+    return _COLLISION_FUNCTION[0]
+
+
+def collision_signature() -> object:
+    """The numba signature of :func:`collision_function` (the model read-only or not: a
+    writable C array converts to the read-only type)."""
+    from numba import types
+
+    vector = types.Array(types.float64, 1, "C")
+    model = types.Array(types.float64, 1, "C", readonly=True)
+    return types.UniTuple(types.float64, 3)(
+        model,
+        types.int64,
+        types.int64,
+        vector,
+        types.float64,
+        types.float64,
+        types.float64,
+        vector,
+        vector,
+        vector,
+        vector,
+    )
+
+
+def collision_type() -> object:
+    """The numba type of :func:`collision_function` as an argument of a kernel."""
+    from numba import types
+
+    return types.FunctionType(collision_signature())

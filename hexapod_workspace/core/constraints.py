@@ -290,14 +290,17 @@ def pose_margins(
     margins = np.empty((N_CONSTRAINTS, count))
     legs = np.empty((N_CONSTRAINTS, count), dtype=np.int64)
     pairs = np.empty((count, 2), dtype=np.int64)
-    kernels.margins_rotations(
-        kernels.model_vector(manipulator, report_singularity=singularity),
+    model = kernels.model_vector(manipulator, report_singularity=singularity)
+    variant = kernels.for_model(model)
+    variant.margins_rotations(
+        model,
         rotations,
         positions,
         interference,
         margins,
         legs,
         pairs,
+        variant.collide,
     )
     return PoseMargins(margins, legs, pairs)
 
@@ -484,11 +487,10 @@ def check(
         if candidate.shape != (3,) or not np.all(np.isfinite(candidate)):
             _require_finite_angles(angles)  # bad angles are reported before a bad position
     position = validate_position(manipulator, position)  # 3 finite values, |p| bounded
-    # numba compiles one specialisation per read-only flag; the kernels are warmed up for
-    # writable arrays (a read-only input, e.g. a frozen Manipulator's position, is copied).
-    position = position if position.flags.writeable else position.copy()
-    if not angles.flags.writeable:
-        angles = angles.copy()
+    # One compiled signature per kernel: C-contiguous, writable float64 (a strided view such as
+    # T[:3, 3], or a frozen Manipulator's read-only position, is copied).
+    position = kernels.vector(position)
+    angles = kernels.vector(angles)
 
     model = kernels.model_vector(manipulator, report_singularity=singularity)
     # Only the rows up to the last one that applies (6-UPS: 5 of the table's rows): the others
@@ -497,13 +499,21 @@ def check(
     margins, ints, pairs, reachable = _output_arrays(used, count)
     outputs = (margins, ints, pairs, reachable)
     workers = _cores() if count >= PARALLEL_POSES else 1
+    variant = kernels.for_model(model)
+
+    def check_range(start: int, stop: int) -> int:
+        status: int = variant.check_angles(
+            model, angles, position, start, stop, *outputs, variant.collide
+        )
+        return status
+
     if workers == 1:
-        status = kernels.check_angles(model, angles, position, 0, count, *outputs)
+        status = check_range(0, count)
     else:
         _require_finite_angles(angles)
         bounds = np.linspace(0, count, workers + 1).astype(int)
         jobs = [
-            _pool().submit(kernels.check_angles, model, angles, position, start, stop, *outputs)
+            _pool().submit(check_range, int(start), int(stop))
             for start, stop in itertools.pairwise(bounds)
         ]
         status = min(job.result() for job in jobs)
@@ -633,7 +643,9 @@ def check_pose(
             or math.sqrt(x * x + y * y + z * z) > MAX_POSITION_NORM
         ):
             validate_position(manipulator, values)  # raises, with the same reason as check()
-    fields = kernels.check_one(kernels.model_vector(manipulator), *angles, x, y, z)
+    model = kernels.model_vector(manipulator)
+    variant = kernels.for_model(model)
+    fields = variant.check_one(model, *angles, x, y, z, variant.collide)
     return _POSE_CHECK(PoseCheck, fields)
 
 

@@ -1,24 +1,91 @@
-"""numba set-up shared by every compiled kernel of the core: the cache directory and the decorators.
+"""numba set-up shared by every compiled kernel of the core: the cache directory, the decorators
+and the compile-time switches.
 
-numba stores the compiled code next to the core modules (``__pycache__``) when that directory is
-writable, otherwise in the user cache directory (``$XDG_CACHE_HOME/hexapod_workspace/numba``,
-default ``~/.cache/hexapod_workspace/numba``), so a read-only install (colcon install space,
-system site-packages) compiles once per user. This module must be imported before numba (every
-kernel module imports it first): numba reads its cache directory once, at import.
+**The cache.** numba keys a cached kernel on the source file of its entry point only (its
+modification time and size), so a changed helper in another module (a margin kernel compiled
+into a search kernel) would be loaded stale from the cache. The kernels are therefore cached in
+a directory named by a hash of the *contents* of every module whose code ends up in a kernel
+(:data:`KERNEL_SOURCES`): a change to any of them selects a new, empty directory. This uses
+numba's public configuration only (``NUMBA_CACHE_DIR``, set before numba is imported, or
+``numba.config.CACHE_DIR`` when it already was). The directory lies next to the core modules
+(``__pycache__/numba-<hash>``) when that is writable, otherwise in the user cache directory
+(``$XDG_CACHE_HOME/hexapod_workspace/numba-<hash>``, default ``~/.cache/...``), so a read-only
+install (colcon install space, system site-packages) compiles once per user. A directory given
+in ``NUMBA_CACHE_DIR`` is used as the parent of ``numba-<hash>``. This module must be imported
+before numba (every kernel module imports it first). Other numba users in the same process
+share the directory (numba has one cache setting per process).
+
+**The switches.** A kernel is compiled for one *variant* of the model: fixed or moving base
+joints (``moving``), slides or cranks (``cranks``), a collision scene (``collide``), an evaluated
+singularity margin (``singular``). Each switch is ``None`` (off) or ``1`` (on) and is passed
+down to every helper as an argument: numba removes a branch on ``switch is None`` or ``switch is
+not None`` where the argument's type is ``none`` before it types the function (its dead-branch
+pruning), so a 6-UPS model without a scene compiles none of the moving-base, collision or
+singularity stages. With a switch on, the model's own flag still decides at run time (the ray
+search evaluates a copy of the model with its scene off). :func:`switches` reads them off the
+packed model; :mod:`hexapod_workspace.core.kernels` builds one set of entry points per variant.
 :func:`compile_notice` says once when a kernel of the core really compiles.
 """
 
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import os
+import shutil
 import sys
 import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TypeVar
 
-__all__ = ["CACHE_DIRECTORY", "compile_notice", "helper", "inline", "jit"]
+__all__ = [
+    "CACHE_DIRECTORY",
+    "KERNEL_SOURCES",
+    "OFF",
+    "ON",
+    "Collide",
+    "Switches",
+    "compile_notice",
+    "entry",
+    "entry_points",
+    "first_class",
+    "helper",
+    "inline",
+    "jit",
+]
+
+_HERE = Path(__file__).resolve().parent
+
+#: The modules whose code ends up in the compiled kernels (relative to the core package). A test
+#: checks that every module of the package that defines a kernel is listed.
+KERNEL_SOURCES: tuple[Path, ...] = tuple(
+    _HERE / name
+    for name in (
+        "jit.py",
+        "constraint_table.py",
+        "model_layout.py",
+        "collision_kernels.py",
+        "collision/distance.py",
+        "collision/scene.py",
+        "margin_kernels.py",
+        "search_kernels.py",
+        "planner_kernels.py",
+    )
+)
+
+
+def _sources_hash() -> str:
+    """The first 16 hex digits of the SHA-256 of every kernel source, in order."""
+    digest = hashlib.sha256()
+    for source in KERNEL_SOURCES:
+        digest.update(source.name.encode())
+        digest.update(source.read_bytes())
+    return digest.hexdigest()[:16]
+
+
+#: Name of this version's cache directory.
+CACHE_NAME = f"numba-{_sources_hash()}"
 
 
 def _writable(directory: Path) -> bool:
@@ -32,105 +99,59 @@ def _writable(directory: Path) -> bool:
     return True
 
 
+def _prune(parent: Path) -> None:
+    """Remove the cache directories of earlier kernel sources in ``parent`` (the in-tree
+    cache belongs to this source tree alone; best effort)."""
+    for stale in parent.glob("numba-*"):
+        if stale.name != CACHE_NAME and stale.is_dir():
+            shutil.rmtree(stale, ignore_errors=True)
+
+
 def _cache_directory() -> Path | None:
-    """Where numba caches this module's compiled code (None: nowhere writable, no cache)."""
+    """Where numba caches the kernels (None: nowhere writable, no cache)."""
     configured = os.environ.get("NUMBA_CACHE_DIR")
     if configured:
-        return Path(configured)
-    in_tree = Path(__file__).resolve().parent / "__pycache__"
-    if _writable(in_tree):
-        return in_tree
+        given = Path(configured)
+        # Inherited from a parent process that ran this set-up: already ours.
+        target = given if given.name == CACHE_NAME else given / CACHE_NAME
+        return target if _writable(target) else None
+    in_tree = _HERE / "__pycache__"
+    if _writable(in_tree / CACHE_NAME):
+        _prune(in_tree)
+        return in_tree / CACHE_NAME
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    user = Path(base) / "hexapod_workspace" / "numba"
-    if _writable(user):
-        # Must be set before numba is imported: numba reads it once, at import.
-        os.environ["NUMBA_CACHE_DIR"] = str(user)
-        return user
-    return None
+    user = Path(base) / "hexapod_workspace" / CACHE_NAME
+    return user if _writable(user) else None
 
 
 #: Directory of the compiled-code cache (None when no directory is writable: then every
-#: process compiles, which takes seconds, and nothing is cached).
+#: process compiles, and nothing is cached).
 CACHE_DIRECTORY = _cache_directory()
-if CACHE_DIRECTORY is not None and "numba" in sys.modules:
-    # numba was imported earlier by someone else: point its configuration here as well.
-    import numba.core.config
+if CACHE_DIRECTORY is not None:
+    os.environ["NUMBA_CACHE_DIR"] = str(CACHE_DIRECTORY)  # read by numba at import
+    if "numba" in sys.modules:  # imported earlier by someone else: its runtime setting
+        import numba
 
-    if os.environ.get("NUMBA_CACHE_DIR"):
-        numba.core.config.CACHE_DIR = os.environ["NUMBA_CACHE_DIR"]
+        numba.config.CACHE_DIR = str(CACHE_DIRECTORY)
 
 import numba  # noqa: E402
 import numba.core.event  # noqa: E402
 
 _CACHE = CACHE_DIRECTORY is not None
 
-#: The modules whose code ends up in the compiled kernels. numba keys a cached kernel on the
-#: source file of its entry point only, so a changed helper in another module (a margin kernel
-#: compiled into a search kernel) would be loaded stale from the cache; every kernel of the
-#: core is therefore keyed on all of them together (numba's cache locators are internal API).
-KERNEL_SOURCES = tuple(
-    (Path(__file__).resolve().parent / name).resolve()
-    for name in (
-        "jit.py",
-        "constraint_table.py",
-        "model_layout.py",
-        "collision_kernels.py",
-        "collision/distance.py",
-        "margin_kernels.py",
-        "search_kernels.py",
-        "planner_kernels.py",
-    )
-)
-
-
-def _kernel_stamp() -> tuple[tuple[float, int], ...]:
-    stamps = []
-    for source in KERNEL_SOURCES:
-        status = source.stat()
-        stamps.append((status.st_mtime, status.st_size))
-    return tuple(stamps)
-
-
-def _kernel_locators() -> list[type]:
-    """numba cache locators that stamp our kernels with every kernel module's stamp."""
-    from numba.core import caching
-
-    class _KernelStamp:
-        def get_source_stamp(self) -> tuple[tuple[float, int], ...]:
-            return _kernel_stamp()
-
-    locators: list[type] = []
-    for base in (
-        caching._UserProvidedCacheLocator,
-        caching._InTreeCacheLocator,
-        caching._UserWideCacheLocator,
-    ):
-
-        def from_function(cls: type, py_func: Any, py_file: str, _base: Any = base) -> Any:
-            if Path(py_file).resolve() not in KERNEL_SOURCES:
-                return None
-            return _base.from_function.__func__(cls, py_func, py_file)
-
-        locators.append(
-            type(
-                f"_Kernel{base.__name__}",
-                (_KernelStamp, base),
-                {"from_function": classmethod(from_function)},
-            )
-        )
-    return locators
-
-
-if _CACHE:
-    from numba.core import caching as _caching
-
-    if not any(c.__name__.startswith("_Kernel") for c in _caching.CacheImpl._locator_classes):
-        _caching.CacheImpl._locator_classes[:0] = _kernel_locators()
+#: The two values of a compile-time switch (module docstring).
+ON: int = 1
+OFF: None = None
+#: The switches of one kernel variant: (moving, cranks, collide, singular).
+Switches = tuple[int | None, int | None, int | None, int | None]
+#: The ``collide`` switch as the kernels take it: None (no scene), or the first-class
+#: collision function of :func:`hexapod_workspace.core.collision_kernels.collision_function`.
+Collide = Callable[..., tuple[float, float, float]] | None
 
 # numba ships no type information: the decorators below are typed as returning the function they
 # compile, so that mypy checks the kernels' signatures at every call (the returned Dispatcher is
 # called exactly like the function).
-_F = TypeVar("_F", bound=Callable[..., Any])
+_F = TypeVar("_F", bound=Callable[..., object])
 
 
 def jit(function: _F) -> _F:
@@ -146,6 +167,38 @@ def helper(function: _F) -> _F:
     return compiled
 
 
+def first_class(function: _F, signature: object) -> _F:
+    """A function compiled once for ``signature`` (and cached), for kernels that take it as an
+    argument of numba's ``FunctionType`` and call it through its address (its code is not
+    compiled again into theirs)."""
+    compiled: _F = numba.njit(signature, cache=_CACHE, nogil=True, error_model="numpy")(function)
+    return compiled
+
+
+def entry(function: _F, signature: object) -> _F:
+    """An entry point compiled eagerly for one ``signature`` (and cached): for the kernels that
+    take a first-class function, whose argument type numba infers only from a signature
+    (``signature``: a tuple of argument types, the return type inferred)."""
+    compiled: _F = numba.njit([signature], cache=_CACHE, nogil=True, error_model="numpy")(function)
+    return compiled
+
+
+def entry_points(
+    signatures: dict[str, tuple[object, ...]] | None,
+) -> Callable[[str], Callable[[_F], _F]]:
+    """The decorator of each entry point of a variant, by name: :func:`jit` (compiled lazily,
+    for the types of its first call) without ``signatures``, else :func:`entry` for
+    ``signatures[name]``."""
+
+    def decorate(name: str) -> Callable[[_F], _F]:
+        if signatures is None:
+            return jit
+        signature = signatures[name]
+        return lambda function: entry(function, signature)
+
+    return decorate
+
+
 def inline(function: _F) -> _F:
     """A small helper inlined into its callers at the numba IR level."""
     compiled: _F = numba.njit(inline="always")(function)
@@ -153,6 +206,10 @@ def inline(function: _F) -> _F:
 
 
 _CORE_PACKAGE = __name__.rpartition(".")[0] + "."
+
+#: What the first compilation costs, measured by ``benchmarks/compile.py`` on a 2-core machine
+#: (CPU seconds, cold cache): the notice quotes it instead of a guess.
+MEASURED_FIRST_CHECK_S = 7
 
 
 class _CompileAnnouncer(numba.core.event.Listener):  # type: ignore[misc]  # numba: no stubs
@@ -172,7 +229,9 @@ class _CompileAnnouncer(numba.core.event.Listener):  # type: ignore[misc]  # num
         self.announced = True
         where = CACHE_DIRECTORY if CACHE_DIRECTORY is not None else "nowhere writable: not cached"
         self.announce(
-            f"compiling the numerical kernels, once after install (about 10 s; cache: {where})"
+            "compiling the numerical kernels for this machine model, once after install "
+            f"(measured: {MEASURED_FIRST_CHECK_S} s of CPU for a 6-UPS check, up to a minute "
+            f"for every kernel of a model with a scene; cache: {where})"
         )
 
     def on_end(self, event: numba.core.event.Event) -> None:

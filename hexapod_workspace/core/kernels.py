@@ -1,27 +1,35 @@
 """Compiled kernels (numba): one import for the margin and search kernels, and their warm-up.
 
-The kernels live in modules of their own: numba set-up in :mod:`~hexapod_workspace.core.jit`,
-model layout in :mod:`~hexapod_workspace.core.model_layout`, margins in
-:mod:`~hexapod_workspace.core.margin_kernels`, ray searches in
-:mod:`~hexapod_workspace.core.search_kernels`. This module gathers their entry points,
-tells whether a run will compile (:func:`cache_is_warm`) and compiles or loads every kernel
-(:func:`warm_up`, returning the seconds it took).
+The kernels live in modules of their own: numba set-up and the compile-time switches in
+:mod:`~hexapod_workspace.core.jit`, model layout in :mod:`~hexapod_workspace.core.model_layout`,
+margins in :mod:`~hexapod_workspace.core.margin_kernels`, ray searches in
+:mod:`~hexapod_workspace.core.search_kernels`. This module builds the entry points of each
+variant of the model (:func:`for_model`: fixed or moving base joints, slides or cranks, a scene,
+a singularity margin), tells whether a model's kernels are compiled (:func:`cache_is_warm`) and
+compiles or loads them (:func:`warm_up`, returning the seconds it took). Arrays handed to a
+kernel are normalised once here (:func:`vector`): one compiled signature per kernel.
 """
 
 from __future__ import annotations
 
+import contextlib
+import json
+import threading
 import time
-from typing import Any
+from collections.abc import Iterable
+from typing import Any, NamedTuple
 
 # Imported first: it points numba's cache directory somewhere writable before numba loads.
-from .jit import CACHE_DIRECTORY, compile_notice
+from .jit import CACHE_DIRECTORY, OFF, ON, Switches, compile_notice
 
 # isort: split
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from .constraint_table import N_CONSTRAINTS
-from .margin_kernels import FAST_TRIG_LIMIT, check_angles, check_one, margins_rotations
+from .margin_kernels import FAST_TRIG_LIMIT, margin_entry_points
 from .model_layout import (
+    ARCH,
     COLLISION_ON,
     ESTIMATE_FLOOR,
     LENGTH_FLOOR,
@@ -31,14 +39,17 @@ from .model_layout import (
     RHO,
     ROWS_USED,
     SCALE,
+    SINGULARITY_ON,
     A,
     B,
     model_vector,
 )
-from .search_kernels import KIND_CYLINDRICAL, KIND_TT, MAX_STEP, SAFETY, search_rays, torsion_scan
+from .search_kernels import KIND_CYLINDRICAL, KIND_TT, MAX_STEP, SAFETY, search_entry_points
 
 __all__ = [
+    "ALL_SWITCHES",
     "CACHE_DIRECTORY",
+    "CHECKS",
     "COLLISION_ON",
     "FAST_TRIG_LIMIT",
     "KIND_CYLINDRICAL",
@@ -47,47 +58,166 @@ __all__ = [
     "ROWS_USED",
     "SAFETY",
     "SCALE",
+    "Kernels",
     "cache_is_warm",
-    "check_angles",
-    "check_one",
     "compile_notice",
-    "margins_rotations",
+    "for_model",
     "model_vector",
-    "search_rays",
-    "torsion_scan",
+    "switches",
+    "vector",
     "warm_up",
 ]
 
 
-def _kernels() -> list[Any]:
-    """The cached entry points, as numba Dispatchers (untyped: numba ships no stubs)."""
-    return [check_angles, check_one, margins_rotations, search_rays, torsion_scan]
+class Kernels(NamedTuple):
+    """The compiled entry points of one variant of the model (numba Dispatchers), and the
+    ``collide`` switch every one of them takes as its last argument."""
+
+    check_angles: Any
+    check_one: Any
+    margins_rotations: Any
+    search_rays: Any
+    torsion_scan: Any
+    #: None (no scene) or the first-class collision function.
+    collide: Any
 
 
-def cache_is_warm() -> bool:
-    """Whether every kernel is already compiled in this process or in the on-disk cache.
+def switches(model: NDArray[np.float64]) -> Switches:
+    """The compile-time switches (moving, cranks, collide, singular) of a packed model."""
+    arch = model[ARCH]
+    return (
+        ON if arch != 0.0 else OFF,
+        ON if arch == 2.0 else OFF,
+        ON if model[COLLISION_ON] != 0.0 else OFF,
+        ON if model[SINGULARITY_ON] != 0.0 else OFF,
+    )
 
-    False means the next use compiles (seconds). Uses numba's cache index (an internal
-    interface); when it cannot be read, answers False.
-    """
+
+#: Every variant: 6-UPS, 6-PUS, 6-RUS, each with or without a scene and a singularity margin.
+ALL_SWITCHES: tuple[Switches, ...] = tuple(
+    (moving, cranks, collide, singular)
+    for moving, cranks in ((OFF, OFF), (ON, OFF), (ON, ON))
+    for collide in (OFF, ON)
+    for singular in (OFF, ON)
+)
+
+_VARIANTS: dict[Switches, Kernels] = {}
+_LOCK = threading.Lock()
+
+
+def _signatures() -> dict[str, tuple[object, ...]]:
+    """The argument types of each entry point of a variant with a scene: the normalised
+    layouts (:func:`vector`; the packed model is read-only) and the collision function's type
+    last. Without a scene the entry points compile lazily, for the same types."""
+    from numba import types
+
+    from .collision_kernels import collision_type
+
+    f8 = types.float64
+    i8 = types.int64
+    model = types.Array(f8, 1, "C", readonly=True)
+    v1, v2, v3 = (types.Array(f8, n, "C") for n in (1, 2, 3))
+    n1, n2 = types.Array(i8, 1, "C"), types.Array(i8, 2, "C")
+    flags = types.Array(types.boolean, 1, "C")
+    collide = collision_type()
+    return {
+        "check_angles": (model, v2, v1, i8, i8, v2, n2, n2, flags, collide),
+        "check_one": (model, f8, f8, f8, f8, f8, f8, collide),
+        "margins_rotations": (model, v3, v2, types.boolean, v2, n2, n2, collide),
+        "search_rays": (
+            model,
+            v1,
+            i8,
+            v2,
+            v2,
+            v1,
+            v1,
+            f8,
+            f8,
+            v1,
+            v1,
+            n1,
+            flags,
+            types.boolean,
+            collide,
+        ),
+        "torsion_scan": (model, v1, f8, f8, f8, f8, f8, v1, flags, types.boolean, collide),
+    }
+
+
+def _variant(key: Switches) -> Kernels:
+    kernels = _VARIANTS.get(key)
+    if kernels is None:
+        with _LOCK:
+            kernels = _VARIANTS.get(key)
+            if kernels is None:
+                moving, cranks, collide, singular = key
+                signatures = None
+                function = None
+                if collide is not None:
+                    from .collision_kernels import collision_function
+
+                    function = collision_function()
+                    signatures = _signatures()
+                kernels = Kernels(
+                    *margin_entry_points(moving, cranks, singular, signatures),
+                    *search_entry_points(moving, cranks, singular, signatures),
+                    function,
+                )
+                _VARIANTS[key] = kernels
+    return kernels
+
+
+def for_model(model: NDArray[np.float64]) -> Kernels:
+    """The entry points compiled for ``model``'s variant (built once per variant per process;
+    compiled, or loaded from the cache, on first call)."""
+    return _variant(switches(model))
+
+
+def vector(values: ArrayLike) -> NDArray[np.float64]:
+    """``values`` as the kernels take every array input: float64, C-contiguous, writable (a
+    copy only where it is not), so that a strided view, a read-only, integer or Fortran-ordered
+    array or a list compiles no second signature."""
+    array = np.asarray(values, dtype=np.float64)
+    if not (array.flags.c_contiguous and array.flags.writeable):
+        array = np.array(array, dtype=np.float64, order="C")
+    return array
+
+
+_MARKER = "warm.json"
+
+
+def _warm_keys() -> set[str]:
+    if CACHE_DIRECTORY is None:
+        return set()
     try:
-        for kernel in _kernels():
-            if kernel.signatures:
-                continue
-            if kernel._cache is None or not kernel._cache._cache_file._load_index():
-                return False
-    except (AttributeError, OSError, TypeError, ValueError):
-        return False
+        return set(json.loads((CACHE_DIRECTORY / _MARKER).read_text(encoding="utf-8")))
+    except (OSError, ValueError, TypeError):
+        return set()
+
+
+def _key_text(key: Switches) -> str:
+    return "".join("1" if flag is not None else "0" for flag in key)
+
+
+def cache_is_warm(model: NDArray[np.float64] | None = None) -> bool:
+    """Whether :func:`warm_up` has compiled ``model``'s kernels into the on-disk cache (every
+    variant when ``model`` is None), or they are compiled in this process already.
+
+    False means the next use compiles (seconds). Read from a marker that :func:`warm_up` writes
+    in the cache directory, next to numba's own files.
+    """
+    keys = ALL_SWITCHES if model is None else (switches(model),)
+    warm = _warm_keys()
+    for key in keys:
+        compiled = key in _VARIANTS and all(k.signatures for k in _VARIANTS[key][:5])
+        if not compiled and _key_text(key) not in warm:
+            return False
     return True
 
 
-def warm_up() -> float:
-    """Compile (first run after install) or load from the cache every kernel; seconds taken.
-
-    Runs each kernel once on a tiny problem of the argument types production uses. For the
-    ROS node to call before it reports ready, and for the CLI.
-    """
-    started = time.perf_counter()
+def _tiny_model(key: Switches) -> NDArray[np.float64]:
+    """A small model of variant ``key`` (6-UPS layout; the kernels only need its flags)."""
     model = np.zeros(MODEL_SIZE)
     model[A : A + 18] = np.tile([1.0, 0.0, 0.0], 6)
     model[B : B + 18] = np.tile([0.5, 0.0, 0.0], 6)
@@ -97,52 +227,100 @@ def warm_up() -> float:
     model[LENGTH_FLOOR] = model[ESTIMATE_FLOOR] = 1e-3
     model[LMAX : LMAX + 6] = 2.0
     model[ORDER : ORDER + 15] = np.arange(15)
-    model.setflags(write=False)
+    return model
+
+
+#: The entry points a pose check needs (``check``, ``check_pose``): what the ROS node compiles
+#: before it answers, the others after.
+CHECKS = ("check_angles", "check_one")
+
+
+def _run_variant(kernels: Kernels, names: Iterable[str] | None = None) -> None:
+    """Run each entry point of one variant (or those ``names``) once on a tiny problem of the
+    argument types production uses (the model's own flags off: the compiled code is the
+    variant's)."""
+    wanted = set(Kernels._fields if names is None else names)
+    model = _tiny_model((OFF, OFF, OFF, OFF))
+    model.setflags(write=False)  # as model_vector's
     position = np.array([0.0, 0.0, 1.0])
     angles = np.zeros((1, 3))
     margins = np.empty((N_CONSTRAINTS, 1))
     legs = np.empty((N_CONSTRAINTS, 1), dtype=np.int64)
     pairs = np.empty((1, 2), dtype=np.int64)
-    check_angles(
-        model,
-        angles,
-        position,
-        0,
-        1,
-        margins,
-        np.empty((N_CONSTRAINTS + 2, 1), dtype=np.int64),
-        pairs,
-        np.empty(1, dtype=np.bool_),
+    if "check_angles" in wanted:
+        kernels.check_angles(
+            model,
+            angles,
+            position,
+            0,
+            1,
+            margins,
+            np.empty((N_CONSTRAINTS + 2, 1), dtype=np.int64),
+            pairs,
+            np.empty(1, dtype=np.bool_),
+            kernels.collide,
+        )
+    if "check_one" in wanted:
+        kernels.check_one(model, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, kernels.collide)
+    if "margins_rotations" in wanted:
+        kernels.margins_rotations(
+            model, np.eye(3)[None], position[None], True, margins, legs, pairs, kernels.collide
+        )
+    if "search_rays" in wanted:
+        ones = np.ones(1)
+        kernels.search_rays(
+            model,
+            position,
+            KIND_TT,
+            angles,
+            np.array([[0.0, 1.0, 0.0]]),
+            np.zeros(1),
+            ones,
+            1e-3,
+            1e-3,
+            np.empty(1),
+            np.empty(1),
+            np.empty(1, dtype=np.int64),
+            np.empty(1, dtype=np.bool_),
+            True,
+            kernels.collide,
+        )
+    if "torsion_scan" in wanted:
+        kernels.torsion_scan(
+            model,
+            position,
+            0.0,
+            0.0,
+            1e-3,
+            0.25,
+            1e-3,
+            np.empty(8),
+            np.empty(8, dtype=np.bool_),
+            True,
+            kernels.collide,
+        )
+
+
+def warm_up(*models: NDArray[np.float64], names: Iterable[str] | None = None) -> float:
+    """Compile (first run after install) or load from the cache the kernels of the variants of
+    ``models`` (packed, :func:`model_vector`; none given: every variant); seconds taken.
+
+    For the ROS node (with its model), the CLI and the tests. ``names``: only these entry
+    points (:data:`CHECKS`: what a pose check needs). Records the variants whose every entry
+    point it compiled in the cache directory's marker (:func:`cache_is_warm`).
+    """
+    started = time.perf_counter()
+    keys: Iterable[Switches] = (
+        dict.fromkeys(switches(model) for model in models) if models else ALL_SWITCHES
     )
-    check_one(model, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)
-    margins_rotations(model, np.eye(3)[None], position[None], True, margins, legs, pairs)
-    ones = np.ones(1)
-    search_rays(
-        model,
-        position,
-        KIND_TT,
-        angles,
-        np.array([[0.0, 1.0, 0.0]]),
-        np.zeros(1),
-        ones,
-        1e-3,
-        1e-3,
-        np.empty(1),
-        np.empty(1),
-        np.empty(1, dtype=np.int64),
-        np.empty(1, dtype=np.bool_),
-        True,
-    )
-    torsion_scan(
-        model,
-        position,
-        0.0,
-        0.0,
-        1e-3,
-        0.25,
-        1e-3,
-        np.empty(8),
-        np.empty(8, dtype=np.bool_),
-        True,
-    )
+    done = []
+    for key in keys:
+        _run_variant(_variant(key), names)
+        if names is None:
+            done.append(_key_text(key))
+    if CACHE_DIRECTORY is not None:
+        warm = _warm_keys() | set(done)
+        # A read-only cache: the marker only saves a later warm-up's question.
+        with contextlib.suppress(OSError):
+            (CACHE_DIRECTORY / _MARKER).write_text(json.dumps(sorted(warm)), encoding="utf-8")
     return time.perf_counter() - started

@@ -11,18 +11,21 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import Any, NamedTuple
+
+from .jit import Collide
+from .jit import entry_points as _entry_points
 
 # Imported first: it points numba's cache directory somewhere writable before numba loads.
 from .jit import helper as _helper
 from .jit import inline as _inline
-from .jit import jit as _jit
 
 # isort: split
 import numpy as np
 from numba.np.unsafe.ndarray import to_fixed_tuple
 from numpy.typing import NDArray
 
-from .collision_kernels import SCRATCH_FLOATS, collision_margin
+from .collision_kernels import SCRATCH_FLOATS
 from .constraint_table import (
     ACTUATOR,
     BASE_JOINT,
@@ -38,7 +41,6 @@ from .constraint_table import (
 from .model_layout import (
     ALPHA,
     ALPHA_EQUAL,
-    ARCH,
     AXIS_ALONG,
     AXIS_CROSS,
     BETA,
@@ -78,7 +80,7 @@ from .model_layout import (
     B,
 )
 
-__all__ = ["SCRATCH_ROWS", "check_angles", "check_one", "margins_rotations"]
+__all__ = ["SCRATCH_ROWS", "MarginKernels", "margin_entry_points"]
 
 # ------------------------------------------------------------------------------ one pose
 # Slots of the per-pose result vector ``out``.
@@ -115,6 +117,10 @@ def _pose(
     scratch: NDArray[np.float64],
     out: NDArray[np.float64],
     want_pair: bool,
+    moving: int | None,
+    cranks: int | None,
+    collide: Collide,
+    singular: int | None,
 ) -> None:
     """Margins of one pose into ``out`` (OUT_SIZE,).
 
@@ -124,10 +130,12 @@ def _pose(
     the smallest margin of each constraint and its leg (first one on ties; NaN, a zero-length
     leg, wins), the closest pair by Ericson's clamped closest points.
     ``want_pair`` False skips the interference check (margin +inf). Models with moving base
-    joints (pus, rus) go to :func:`_pose_moving`.
+    joints (pus, rus) go to :func:`_pose_moving`. ``moving``, ``cranks``, ``collide`` and
+    ``singular`` are the compile-time switches of :mod:`~hexapod_workspace.core.jit` (None: the
+    code is left out of the compiled function).
     """
-    if model[ARCH] != 0.0:
-        _pose_moving(model, r, px, py, pz, scratch, out, want_pair)
+    if moving is not None:
+        _pose_moving(model, r, px, py, pz, scratch, out, want_pair, cranks, collide, singular)
         return
     out[ACTUATOR] = np.inf
     out[IK] = np.inf
@@ -209,12 +217,15 @@ def _pose(
     out[OUT_SHORTEST] = shortest
     # The collision and singularity kernels are called only when they are on: passing the
     # arrays to a call costs about a fifth of a 6-UPS pose, even when it returns at once.
-    if model[COLLISION_ON] != 0.0:
-        _pose_collision(model, r, px, py, pz, scratch, out)
+    if collide is not None and model[COLLISION_ON] != 0.0:
+        _pose_collision(model, r, px, py, pz, scratch, out, collide)
     else:
         _no_collision(out)
     out[OUT_LEG + SINGULARITY] = 0
-    out[SINGULARITY] = _pose_singularity(model, r, scratch) if model[SINGULARITY_ON] else np.inf
+    if singular is not None and model[SINGULARITY_ON] != 0.0:
+        out[SINGULARITY] = _pose_singularity(model, r, scratch)
+    else:
+        out[SINGULARITY] = np.inf
     if not want_pair or model[INTERFERENCE] == 0.0:
         out[LEG_INTERFERENCE] = np.inf
         out[OUT_LEG + LEG_INTERFERENCE] = 0
@@ -472,6 +483,9 @@ def _pose_moving(
     scratch: NDArray[np.float64],
     out: NDArray[np.float64],
     want_pair: bool,
+    cranks: int | None,
+    collide: Collide,
+    singular: int | None,
 ) -> None:
     """Margins of one pose of a pus or rus model into ``out`` (OUT_SIZE,), as :func:`_pose`.
 
@@ -493,7 +507,6 @@ def _pose_moving(
     r00, r01, r02 = r[0], r[1], r[2]
     r10, r11, r12 = r[3], r[4], r[5]
     r20, r21, r22 = r[6], r[7], r[8]
-    rus = model[ARCH] == 2.0
     tau_min = model[TAU_MIN]
     m_act = np.inf
     leg_act = 0
@@ -516,7 +529,7 @@ def _pose_moving(
         dx = platform_x - model[A + 3 * k]
         dy = platform_y - model[A + 3 * k + 1]
         dz = platform_z - model[A + 3 * k + 2]
-        if not rus:
+        if cranks is None:  # pus
             ux, uy, uz = model[RAIL + 3 * k], model[RAIL + 3 * k + 1], model[RAIL + 3 * k + 2]
             ik, q = _slide_leg(dx, dy, dz, ux, uy, uz, model[LEG + k], model[BRANCH + k])
             q = q if ik >= 0.0 else np.nan
@@ -597,8 +610,8 @@ def _pose_moving(
     out[PLATFORM_JOINT] = m_b
     out[OUT_LEG + PLATFORM_JOINT] = leg_b
     out[OUT_SHORTEST] = model[LENGTH_FLOOR]
-    if model[COLLISION_ON] != 0.0:  # called only when on, as in _pose
-        _pose_collision(model, r, px, py, pz, scratch, out)
+    if collide is not None and model[COLLISION_ON] != 0.0:  # called only when on, as in _pose
+        _pose_collision(model, r, px, py, pz, scratch, out, collide)
     else:
         _no_collision(out)
     out[OUT_LEG + SINGULARITY] = 0
@@ -613,11 +626,14 @@ def _pose_moving(
         out[PLATFORM_JOINT] = np.nan
         out[SINGULARITY] = np.nan if model[SINGULARITY_ON] != 0.0 else np.inf
         out[LEG_INTERFERENCE] = np.nan if want_pair and model[INTERFERENCE] != 0.0 else np.inf
-        if model[COLLISION_ON] != 0.0:
+        if collide is not None and model[COLLISION_ON] != 0.0:
             out[COLLISION] = np.nan  # a leg body of an unsolved leg is nowhere
             out[OUT_LEG + COLLISION] = -1.0
         return
-    out[SINGULARITY] = _pose_singularity(model, r, scratch) if model[SINGULARITY_ON] else np.inf
+    if singular is not None and model[SINGULARITY_ON] != 0.0:
+        out[SINGULARITY] = _pose_singularity(model, r, scratch)
+    else:
+        out[SINGULARITY] = np.inf
     if not want_pair or model[INTERFERENCE] == 0.0:
         out[LEG_INTERFERENCE] = np.inf
         return
@@ -675,13 +691,15 @@ def _pose_collision(
     pz: float,
     scratch: NDArray[np.float64],
     out: NDArray[np.float64],
+    collide: Callable[..., tuple[float, float, float]],
 ) -> None:
     """The collision margin, its pair (as the constraint's "leg") and gap into ``out``, from the
     leg planes of ``scratch`` (the leg bodies run from B_k − L_k to B_k, so a moving base-side
-    end is where the leg architecture put it; +inf, −1, 0 without a scene)."""
+    end is where the leg architecture put it; +inf, −1, 0 without a scene). ``collide`` is
+    :func:`~hexapod_workspace.core.collision_kernels.collision_function`."""
     if model[COLLISION_ON] != 0.0:
         memory = scratch[_COLLISION_SCRATCH:].reshape(-1)
-        value, pair, gap = collision_margin(
+        value, pair, gap = collide(
             model, MODEL_SIZE, B, r, px, py, pz, scratch[0], scratch[1], scratch[2], memory
         )
     else:
@@ -851,16 +869,20 @@ def _smallest_singular_value(rows: NDArray[np.float64]) -> float:
 
 @_helper
 def _block_singularity(
-    model: NDArray[np.float64], work: NDArray[np.float64], count: int, rows: NDArray[np.float64]
+    model: NDArray[np.float64],
+    work: NDArray[np.float64],
+    count: int,
+    rows: NDArray[np.float64],
+    moving: int | None,
 ) -> None:
     """The singularity margin of the poses of a block that take the vectorised path (the
     others are computed whole by :func:`_pose`) into the _SIGMA row, from the leg and rotation
     planes (before the outputs overwrite the rotation planes)."""
-    moving = model[ARCH] != 0.0  # pus/rus poses with an unsolved leg: NaN, not computed
     for n in range(count):
-        if work[(_MIN + _FIX) * BLOCK + n] != 0.0 or (
-            moving and work[(_MOVE + _UNSOLVED) * BLOCK + n] != 0.0
-        ):
+        if work[(_MIN + _FIX) * BLOCK + n] != 0.0:
+            continue
+        # pus/rus poses with an unsolved leg: NaN, not computed
+        if moving is not None and work[(_MOVE + _UNSOLVED) * BLOCK + n] != 0.0:
             continue
         for k in range(6):
             leg = (_LEGS + 7 * k) * BLOCK + n
@@ -905,6 +927,8 @@ def _block_collision(
     pz: float,
     scratch: NDArray[np.float64],
     r: NDArray[np.float64],
+    moving: int | None,
+    collide: Callable[..., tuple[float, float, float]],
 ) -> None:
     """The collision margin and its pair of the poses of a block that take the vectorised path
     (the others are computed whole by :func:`_pose`) into the _COLLIDE rows, from the leg and
@@ -912,11 +936,10 @@ def _block_collision(
     L_k = B_k − A_k with A_k where the leg architecture puts it (NaN for an unsolved leg, whose
     pose is answered by :func:`_unsolved_outputs`)."""
     memory = scratch[_COLLISION_SCRATCH:].reshape(-1)
-    moving = model[ARCH] != 0.0
     for n in range(count):
         if work[(_MIN + _FIX) * BLOCK + n] != 0.0:
             continue
-        if moving and work[(_MOVE + _UNSOLVED) * BLOCK + n] != 0.0:
+        if moving is not None and work[(_MOVE + _UNSOLVED) * BLOCK + n] != 0.0:
             continue
         for i in range(9):
             r[i] = work[(_R + i) * BLOCK + n]
@@ -925,7 +948,7 @@ def _block_collision(
             scratch[0, k] = work[leg + _LX * BLOCK]
             scratch[1, k] = work[leg + _LY * BLOCK]
             scratch[2, k] = work[leg + _LZ * BLOCK]
-        value, pair, _ = collision_margin(
+        value, pair, _ = collide(
             model, MODEL_SIZE, B, r, px, py, pz, scratch[0], scratch[1], scratch[2], memory
         )
         work[_COLLIDE * BLOCK + n] = value
@@ -1512,6 +1535,10 @@ def _check_block(
     scratch: NDArray[np.float64],
     out: NDArray[np.float64],
     r: NDArray[np.float64],
+    moving: int | None,
+    cranks: int | None,
+    collide: Collide,
+    singular: int | None,
 ) -> None:
     """Margins of poses angles[first : first + count] (count ≤ BLOCK) into ``work`` planes.
 
@@ -1524,8 +1551,6 @@ def _check_block(
     fast path handles, the others are +inf for every pose and left to the reader.
     """
     px, py, pz = position[0], position[1], position[2]
-    moving = model[ARCH] != 0.0
-    rus = model[ARCH] == 2.0
     for n in range(count):  # strided reads: a loop of its own (it does not vectorise)
         work[_PHI * BLOCK + n] = angles[first + n, 0]
         work[_THETA * BLOCK + n] = angles[first + n, 1]
@@ -1563,16 +1588,16 @@ def _check_block(
     rotation = _planes(work, _R, 9)
     minima = _planes(work, _MIN, 9)
     moves = _planes(work, _MOVE, 8)
-    if moving:
+    if moving is not None:
         for n in range(count):
             for row in (_M_ACT, _M_IK, _M_TAU, _UNSOLVED):
                 moves[row * BLOCK + n] = 0.0 if row == _UNSOLVED else np.inf
                 moves[(row + 1) * BLOCK + n] = 0.0
     for k in range(6):
-        if moving:
+        if moving is not None:
             leg = _planes(work, _LEGS + 7 * k, 7)
             base = _planes(work, _BASE + 3 * k, 3)
-            if rus:
+            if cranks is not None:
                 _leg_planes_rus(model, rotation, leg, base, minima, moves, count, k, px, py, pz)
             else:
                 _leg_planes_pus(model, rotation, leg, base, minima, moves, count, k, px, py, pz)
@@ -1587,7 +1612,7 @@ def _check_block(
             for j in range(i + 1, 6):
                 leg_i = _planes(work, _LEGS + 7 * i, 7)
                 leg_j = _planes(work, _LEGS + 7 * j, 7)
-                if moving:
+                if moving is not None:
                     _pair_plane_moving(
                         leg_i,
                         leg_j,
@@ -1600,12 +1625,16 @@ def _check_block(
                 else:
                     _pair_plane(model, leg_i, leg_j, minima, count, pair)
                 pair += 1
-    singular = model[SINGULARITY_ON] != 0.0
-    if singular:
-        _block_singularity(model, work, count, np.empty(ROWS_SCRATCH))
-    collide = model[COLLISION_ON] != 0.0
-    if collide:
-        _block_collision(model, work, count, px, py, pz, scratch, r)
+    # The singularity and collision stages exist in the compiled code only where their switch is
+    # on; the model says whether they run (search_rays checks a copy with its scene off).
+    singular_on = False
+    if singular is not None and model[SINGULARITY_ON] != 0.0:
+        singular_on = True
+        _block_singularity(model, work, count, np.empty(ROWS_SCRATCH), moving)
+    collide_on = False
+    if collide is not None and model[COLLISION_ON] != 0.0:
+        collide_on = True
+        _block_collision(model, work, count, px, py, pz, scratch, r, moving, collide)
     # Per pose: the joint-angle margins (arccos), the rare poses that need care, the outputs.
     alpha_equal = model[ALPHA_EQUAL] != 0.0
     beta_equal = model[BETA_EQUAL] != 0.0
@@ -1616,14 +1645,14 @@ def _check_block(
     for n in range(count):
         if work[(_MIN + _FIX) * BLOCK + n] != 0.0:
             _tt_matrix(angles[first + n, 0], angles[first + n, 1], angles[first + n, 2], r)
-            _pose(model, r, px, py, pz, scratch, out, True)
+            _pose(model, r, px, py, pz, scratch, out, True, moving, cranks, collide, singular)
             for slot in range(OUT_SHORTEST):
                 work[(slot) * BLOCK + n] = out[slot]
             continue
-        if moving and moves[_UNSOLVED * BLOCK + n] != 0.0:
-            _unsolved_outputs(work, moves, n, singular, interference)
+        if moving is not None and moves[_UNSOLVED * BLOCK + n] != 0.0:
+            _unsolved_outputs(work, moves, n, singular_on, interference)
             continue
-        if moving:
+        if moving is not None:
             work[LEG_LENGTH * BLOCK + n] = np.inf
             work[(OUT_LEG + LEG_LENGTH) * BLOCK + n] = 0.0
         else:
@@ -1661,16 +1690,20 @@ def _check_block(
             work[(OUT_PAIR + 1) * BLOCK + n] = 0.0
         if not rest:
             continue
-        work[SINGULARITY * BLOCK + n] = work[_SIGMA * BLOCK + n] if singular else np.inf
+        work[SINGULARITY * BLOCK + n] = work[_SIGMA * BLOCK + n] if singular_on else np.inf
         work[(OUT_LEG + SINGULARITY) * BLOCK + n] = 0.0
-        work[COLLISION * BLOCK + n] = work[_COLLIDE * BLOCK + n] if collide else np.inf
+        work[COLLISION * BLOCK + n] = work[_COLLIDE * BLOCK + n] if collide_on else np.inf
         work[(OUT_LEG + COLLISION) * BLOCK + n] = (
-            work[(_COLLIDE + 1) * BLOCK + n] if collide else -1.0
+            work[(_COLLIDE + 1) * BLOCK + n] if collide_on else -1.0
         )
         # Rows of the moving-base architectures (+inf where they do not apply).
         for row, slot in ((ACTUATOR, _M_ACT), (IK, _M_IK), (TRANSMISSION, _M_TAU)):
-            work[row * BLOCK + n] = moves[slot * BLOCK + n] if moving else np.inf
-            work[(OUT_LEG + row) * BLOCK + n] = moves[(slot + 1) * BLOCK + n] if moving else 0.0
+            if moving is not None:
+                work[row * BLOCK + n] = moves[slot * BLOCK + n]
+                work[(OUT_LEG + row) * BLOCK + n] = moves[(slot + 1) * BLOCK + n]
+            else:
+                work[row * BLOCK + n] = np.inf
+                work[(OUT_LEG + row) * BLOCK + n] = 0.0
 
 
 @_helper
@@ -1691,151 +1724,206 @@ def _per_leg_angle(
 
 
 # ------------------------------------------------------------------------------ batches
-@_jit
-def check_angles(
-    model: NDArray[np.float64],
-    angles: NDArray[np.float64],
-    position: NDArray[np.float64],
-    start: int,
-    stop: int,
-    margins: NDArray[np.float64],
-    ints: NDArray[np.int64],
-    pairs: NDArray[np.int64],
-    reachable: NDArray[np.bool_],
-) -> int:
-    """Check poses ``angles[start:stop]`` (N, 3) of T&T angles (rad) at ``position`` (3,), m.
+class MarginKernels(NamedTuple):
+    """The compiled entry points of one kernel variant (:func:`margin_entry_points`)."""
 
-    Writes, for each pose n in [start, stop): ``margins[:, n]`` (C, N) with C the rows in use
-    (``model[ROWS_USED]``: the rows after the last one that applies to the model are +inf for
-    every pose and not written; the arrays may have more rows);
-    ``ints[:C, n]`` (C + 2, N), the 1-based leg with the smallest margin of each constraint,
-    ``ints[C, n]`` the constraint with the smallest relative margin and ``ints[C + 1, n]`` its
-    leg; ``pairs[n]`` (N, 2), the
-    1-based closest pair; ``reachable[n]``. Legs and pairs of ``leg_interference`` are 0 when
-    the check is disabled. Releases the GIL (threads split large batches).
+    check_angles: Callable[..., int]
+    check_one: Callable[..., tuple[Any, ...]]
+    margins_rotations: Callable[..., None]
 
-    Returns
-    -------
-    int
-        −1 when every input is finite (and the outputs are written); otherwise nothing is
-        written and it is the first pose in [start, stop) with a non-finite angle, or −2 when
-        the angles are finite and the position is not.
+
+def margin_entry_points(
+    moving: int | None,
+    cranks: int | None,
+    singular: int | None,
+    signatures: dict[str, tuple[object, ...]] | None = None,
+) -> MarginKernels:
+    """The margin entry points compiled for one set of switches (:mod:`.jit`).
+
+    Each is a closure whose switches are constants of its compiled code (numba keys its cache
+    on them), so a 6-UPS model without a scene or a singularity margin compiles none of the
+    moving-base, collision or singularity stages. Called once per variant by
+    :func:`hexapod_workspace.core.kernels.for_model`. Each takes the ``collide`` switch as its
+    last argument: None, or the first-class collision function (then ``signatures`` gives each
+    entry point's argument types: numba types a ``FunctionType`` argument only from a
+    signature).
     """
-    for n in range(start, stop):
-        if not (
-            math.isfinite(angles[n, 0])
-            and math.isfinite(angles[n, 1])
-            and math.isfinite(angles[n, 2])
-        ):
-            return n
-    for k in range(3):
-        if not math.isfinite(position[k]):
-            return -2
-    scratch = np.empty((SCRATCH_ROWS, 6))
-    out = np.empty(OUT_SIZE)
-    r = np.empty(9)
-    work = np.empty(_BLOCK_ROWS * BLOCK)
-    enabled = 1 if model[INTERFERENCE] != 0.0 else 0
-    used = int(model[ROWS_USED])
-    for first in range(start, stop, BLOCK):
-        count = min(BLOCK, stop - first)
-        _check_block(model, angles, position, first, count, work, scratch, out, r)
-        for m in range(count):
-            n = first + m
-            # Only the rows in use: the others are +inf (never limiting, never violated).
-            feasible = True
-            for c in range(used):
-                out[c] = work[c * BLOCK + m]
-                margins[c, n] = out[c]
-                ints[c, n] = int(work[(OUT_LEG + c) * BLOCK + m]) + 1
-                feasible = feasible and out[c] >= 0.0  # NaN counts as violated
-            ints[LEG_INTERFERENCE, n] *= enabled
-            ints[SINGULARITY, n] = 0  # a property of all legs together: no limiting leg
-            pairs[n, 0] = (int(work[OUT_PAIR * BLOCK + m]) + 1) * enabled
-            pairs[n, 1] = (int(work[(OUT_PAIR + 1) * BLOCK + m]) + 1) * enabled
-            worst = _limiting_constraint(model, out)
-            ints[used, n] = worst
-            ints[used + 1, n] = ints[worst, n] if worst < used else 0
-            reachable[n] = feasible
-    return -1
 
+    decorate = _entry_points(signatures)
 
-@_jit
-def check_one(
-    model: NDArray[np.float64],
-    phi: float,
-    theta: float,
-    psi: float,
-    px: float,
-    py: float,
-    pz: float,
-) -> tuple[bool, tuple[float, ...], tuple[int, ...], tuple[int, int], int, int]:
-    """One pose (φ, θ, ψ) rad at (px, py, pz) m, finite; the fast path of constraints.check_pose.
+    @decorate("check_angles")
+    def check_angles(
+        model: NDArray[np.float64],
+        angles: NDArray[np.float64],
+        position: NDArray[np.float64],
+        start: int,
+        stop: int,
+        margins: NDArray[np.float64],
+        ints: NDArray[np.int64],
+        pairs: NDArray[np.int64],
+        reachable: NDArray[np.bool_],
+        collide: Collide,
+    ) -> int:
+        """Check poses ``angles[start:stop]`` (N, 3) of T&T angles (rad) at ``position`` (3,), m.
 
-    Returns the fields of ``constraints.PoseCheck`` as one tuple of plain numbers (numba boxes
-    it in C: cheaper than an output array read back and converted in Python): reachable,
-    margins (N_CONSTRAINTS), 1-based limiting legs (N_CONSTRAINTS; the interference leg 0 when
-    the check is disabled), closest pair (2, 1-based; 0 when disabled), the limiting constraint
-    and its leg.
-    """
-    scratch = np.empty((SCRATCH_ROWS, 6))
-    out = np.empty(OUT_SIZE)
-    r = np.empty(9)
-    _tt_matrix(phi, theta, psi, r)
-    _pose(model, r, px, py, pz, scratch, out, True)
-    enabled = 1 if model[INTERFERENCE] != 0.0 else 0
-    legs = np.empty(N_CONSTRAINTS, dtype=np.int64)
-    for c in range(N_CONSTRAINTS):
-        legs[c] = int(out[OUT_LEG + c]) + 1
-    legs[LEG_INTERFERENCE] *= enabled
-    legs[SINGULARITY] = 0
-    worst = _limiting_constraint(model, out)
-    return (
-        _feasible(out, N_CONSTRAINTS),
-        to_fixed_tuple(out[:N_CONSTRAINTS], N_CONSTRAINTS),
-        to_fixed_tuple(legs, N_CONSTRAINTS),
-        ((int(out[OUT_PAIR]) + 1) * enabled, (int(out[OUT_PAIR + 1]) + 1) * enabled),
-        worst,
-        legs[worst],
-    )
+        Writes, for each pose n in [start, stop): ``margins[:, n]`` (C, N) with C the rows in use
+        (``model[ROWS_USED]``: the rows after the last one that applies to the model are +inf for
+        every pose and not written; the arrays may have more rows);
+        ``ints[:C, n]`` (C + 2, N), the 1-based leg with the smallest margin of each constraint,
+        ``ints[C, n]`` the constraint with the smallest relative margin and ``ints[C + 1, n]`` its
+        leg; ``pairs[n]`` (N, 2), the
+        1-based closest pair; ``reachable[n]``. Legs and pairs of ``leg_interference`` are 0 when
+        the check is disabled. Releases the GIL (threads split large batches).
 
+        Returns
+        -------
+        int
+            −1 when every input is finite (and the outputs are written); otherwise nothing is
+            written and it is the first pose in [start, stop) with a non-finite angle, or −2 when
+            the angles are finite and the position is not.
+        """
+        for n in range(start, stop):
+            if not (
+                math.isfinite(angles[n, 0])
+                and math.isfinite(angles[n, 1])
+                and math.isfinite(angles[n, 2])
+            ):
+                return n
+        for k in range(3):
+            if not math.isfinite(position[k]):
+                return -2
+        scratch = np.empty((SCRATCH_ROWS, 6))
+        out = np.empty(OUT_SIZE)
+        r = np.empty(9)
+        work = np.empty(_BLOCK_ROWS * BLOCK)
+        enabled = 1 if model[INTERFERENCE] != 0.0 else 0
+        used = int(model[ROWS_USED])
+        for first in range(start, stop, BLOCK):
+            count = min(BLOCK, stop - first)
+            _check_block(
+                model,
+                angles,
+                position,
+                first,
+                count,
+                work,
+                scratch,
+                out,
+                r,
+                moving,
+                cranks,
+                collide,
+                singular,
+            )
+            for m in range(count):
+                n = first + m
+                # Only the rows in use: the others are +inf (never limiting, never violated).
+                feasible = True
+                for c in range(used):
+                    out[c] = work[c * BLOCK + m]
+                    margins[c, n] = out[c]
+                    ints[c, n] = int(work[(OUT_LEG + c) * BLOCK + m]) + 1
+                    feasible = feasible and out[c] >= 0.0  # NaN counts as violated
+                ints[LEG_INTERFERENCE, n] *= enabled
+                ints[SINGULARITY, n] = 0  # a property of all legs together: no limiting leg
+                pairs[n, 0] = (int(work[OUT_PAIR * BLOCK + m]) + 1) * enabled
+                pairs[n, 1] = (int(work[(OUT_PAIR + 1) * BLOCK + m]) + 1) * enabled
+                worst = _limiting_constraint(model, out)
+                ints[used, n] = worst
+                ints[used + 1, n] = ints[worst, n] if worst < used else 0
+                reachable[n] = feasible
+        return -1
 
-@_jit
-def margins_rotations(
-    model: NDArray[np.float64],
-    rotations: NDArray[np.float64],
-    positions: NDArray[np.float64],
-    interference: bool,
-    margins: NDArray[np.float64],
-    legs: NDArray[np.int64],
-    pairs: NDArray[np.int64],
-) -> None:
-    """Margins of N poses given as rotation matrices (N, 3, 3) at positions (M, 3), M ∈ {1, N}.
+    @decorate("check_one")
+    def check_one(
+        model: NDArray[np.float64],
+        phi: float,
+        theta: float,
+        psi: float,
+        px: float,
+        py: float,
+        pz: float,
+        collide: Collide,
+    ) -> tuple[bool, tuple[float, ...], tuple[int, ...], tuple[int, int], int, int]:
+        """One pose (φ, θ, ψ) rad at (px, py, pz) m, finite; the fast path of check_pose.
 
-    Writes ``margins`` (C, N), ``legs`` (C, N) (C = N_CONSTRAINTS) and ``pairs`` (N, 2) as
-    :func:`check_angles`.
-    """
-    scratch = np.empty((SCRATCH_ROWS, 6))
-    out = np.empty(OUT_SIZE)
-    r = np.empty(9)
-    shared = positions.shape[0] == 1
-    used = int(model[ROWS_USED])
-    for n in range(rotations.shape[0]):
-        for i in range(3):
-            for j in range(3):
-                r[3 * i + j] = rotations[n, i, j]
-        p = 0 if shared else n
-        _pose(
-            model, r, positions[p, 0], positions[p, 1], positions[p, 2], scratch, out, interference
+        Returns the fields of ``constraints.PoseCheck`` as one tuple of plain numbers (numba boxes
+        it in C: cheaper than an output array read back and converted in Python): reachable,
+        margins (N_CONSTRAINTS), 1-based limiting legs (N_CONSTRAINTS; the interference leg 0 when
+        the check is disabled), closest pair (2, 1-based; 0 when disabled), the limiting constraint
+        and its leg.
+        """
+        scratch = np.empty((SCRATCH_ROWS, 6))
+        out = np.empty(OUT_SIZE)
+        r = np.empty(9)
+        _tt_matrix(phi, theta, psi, r)
+        _pose(model, r, px, py, pz, scratch, out, True, moving, cranks, collide, singular)
+        enabled = 1 if model[INTERFERENCE] != 0.0 else 0
+        legs = np.empty(N_CONSTRAINTS, dtype=np.int64)
+        for c in range(N_CONSTRAINTS):
+            legs[c] = int(out[OUT_LEG + c]) + 1
+        legs[LEG_INTERFERENCE] *= enabled
+        legs[SINGULARITY] = 0
+        worst = _limiting_constraint(model, out)
+        return (
+            _feasible(out, N_CONSTRAINTS),
+            to_fixed_tuple(out[:N_CONSTRAINTS], N_CONSTRAINTS),
+            to_fixed_tuple(legs, N_CONSTRAINTS),
+            ((int(out[OUT_PAIR]) + 1) * enabled, (int(out[OUT_PAIR + 1]) + 1) * enabled),
+            worst,
+            legs[worst],
         )
-        for c in range(used):
-            margins[c, n] = out[c]
-            legs[c, n] = int(out[OUT_LEG + c])
-        if n == 0:
-            # The rows past the last one that applies are the same for every pose (+inf and a
-            # fixed leg): written whole, once, instead of pose by pose.
-            for c in range(used, N_CONSTRAINTS):
-                margins[c, :] = out[c]
-                legs[c, :] = int(out[OUT_LEG + c])
-        pairs[n, 0] = int(out[OUT_PAIR])
-        pairs[n, 1] = int(out[OUT_PAIR + 1])
+
+    @decorate("margins_rotations")
+    def margins_rotations(
+        model: NDArray[np.float64],
+        rotations: NDArray[np.float64],
+        positions: NDArray[np.float64],
+        interference: bool,
+        margins: NDArray[np.float64],
+        legs: NDArray[np.int64],
+        pairs: NDArray[np.int64],
+        collide: Collide,
+    ) -> None:
+        """Margins of N poses given as rotation matrices (N, 3, 3) at positions (M, 3), M ∈ {1, N}.
+
+        Writes ``margins`` (C, N), ``legs`` (C, N) (C = N_CONSTRAINTS) and ``pairs`` (N, 2) as
+        :func:`check_angles`.
+        """
+        scratch = np.empty((SCRATCH_ROWS, 6))
+        out = np.empty(OUT_SIZE)
+        r = np.empty(9)
+        shared = positions.shape[0] == 1
+        used = int(model[ROWS_USED])
+        for n in range(rotations.shape[0]):
+            for i in range(3):
+                for j in range(3):
+                    r[3 * i + j] = rotations[n, i, j]
+            p = 0 if shared else n
+            _pose(
+                model,
+                r,
+                positions[p, 0],
+                positions[p, 1],
+                positions[p, 2],
+                scratch,
+                out,
+                interference,
+                moving,
+                cranks,
+                collide,
+                singular,
+            )
+            for c in range(used):
+                margins[c, n] = out[c]
+                legs[c, n] = int(out[OUT_LEG + c])
+            if n == 0:
+                # The rows past the last one that applies are the same for every pose (+inf and a
+                # fixed leg): written whole, once, instead of pose by pose.
+                for c in range(used, N_CONSTRAINTS):
+                    margins[c, :] = out[c]
+                    legs[c, :] = int(out[OUT_LEG + c])
+            pairs[n, 0] = int(out[OUT_PAIR])
+            pairs[n, 1] = int(out[OUT_PAIR + 1])
+
+    return MarginKernels(check_angles, check_one, margins_rotations)

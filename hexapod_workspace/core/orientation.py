@@ -31,7 +31,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError, ResolutionError
-from . import kernels
 from .constraints import relative_margins
 from .manipulator import Manipulator
 from .projected import reference_torsion_interval, require_reachable_reference
@@ -453,7 +452,7 @@ def torsion_range(
     capacity = math.ceil(2.0 * math.pi / search.min_step) + 2
     edges: NDArray[np.float64] = np.empty(capacity)
     rising: NDArray[np.bool_] = np.empty(capacity, dtype=np.bool_)
-    count, start_feasible = kernels.torsion_scan(
+    count, start_feasible = search.kernels.torsion_scan(
         search.model,
         search.position,
         float(phi),
@@ -464,6 +463,7 @@ def torsion_range(
         edges,
         rising,
         search.lazy_collision,
+        search.kernels.collide,
     )
     edges, rising = edges[:count], rising[:count]
     intervals = []

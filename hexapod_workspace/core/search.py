@@ -119,9 +119,11 @@ class RaySearch:
         self, manipulator: Manipulator, position: NDArray[np.float64], min_step: float = 1e-3
     ) -> None:
         self.manipulator = manipulator
-        self.position = np.array(position, dtype=np.float64)  # writable: see _vectors
+        self.position = np.array(position, dtype=np.float64, order="C")  # writable: _vectors
         self.min_step = float(min_step)
         self.model = kernels.model_vector(manipulator)
+        #: The entry points compiled for this model's variant.
+        self.kernels = kernels.for_model(self.model)
         self.evaluations = 0
         #: Poses at which the collision margin was evaluated (the ray searches evaluate it only
         #: where it can change the answer: ``search_kernels.search_rays``).
@@ -135,7 +137,7 @@ class RaySearch:
         count = angles.shape[0]
         margins = np.empty((N_CONSTRAINTS, count))
         margins[int(self.model[kernels.ROWS_USED]) :] = np.inf  # rows the kernel leaves out
-        kernels.check_angles(
+        self.kernels.check_angles(
             self.model,
             angles,
             self.position,
@@ -145,6 +147,7 @@ class RaySearch:
             np.empty((N_CONSTRAINTS + 2, count), dtype=np.int64),
             np.empty((count, 2), dtype=np.int64),
             np.empty(count, dtype=np.bool_),
+            self.kernels.collide,
         )
         self.evaluations += count
         if self.model[kernels.COLLISION_ON] != 0.0:
@@ -187,7 +190,7 @@ class RaySearch:
         violated = np.empty(count)
         limiting = np.empty(count, dtype=np.int64)
         start_feasible = np.empty(count, dtype=np.bool_)
-        evaluations, collisions = kernels.search_rays(
+        evaluations, collisions = self.kernels.search_rays(
             self.model,
             self.position,
             RAY_KINDS[kind],
@@ -202,6 +205,7 @@ class RaySearch:
             limiting,
             start_feasible,
             self.lazy_collision,
+            self.kernels.collide,
         )
         self.evaluations += evaluations
         self.collision_evaluations += collisions

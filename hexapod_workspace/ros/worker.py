@@ -27,7 +27,6 @@ from typing import Any
 
 import numpy as np
 
-from hexapod_workspace.core import kernels
 from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.core.orientation import OrientationWorkspace, orientation_workspace
 from hexapod_workspace.core.projected import ProjectedWorkspace, projected_workspace
@@ -210,7 +209,8 @@ def _serve(
     time_sharing()
     publisher, broken = _cloud_publisher(topics)
     background(policy)  # throughput work: the node's checks are scheduled first
-    kernels.warm_up()  # compiled (or loaded) before the first job arrives
+    # The kernels of the node's model: the node's warm-up fills the cache while this process
+    # starts, and the first job loads them (a job for another model compiles its own variant).
     while True:
         try:
             job = connection.recv()
