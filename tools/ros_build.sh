@@ -33,14 +33,19 @@ if ! PATH="$VENV/bin:$PATH" CMAKE_PREFIX_PATH="$VENV" AMENT_PREFIX_PATH="$VENV" 
   exit 1
 fi
 log "colcon build done in $((SECONDS - start)) s"
-# The install space holds a copy of the package whose numba cache is empty after a build: fill
-# it here, once, with the node's own warm-up (about 70 s on a loaded 2-core machine), instead of
-# in the first node, test or benchmark that starts from the install space, where it looked like
-# a node that does not answer. (python -P: the install space's package, not the source tree of
-# the working directory that -c would put first.)
+# The install space holds a copy of the package whose numba cache is empty after a build. A
+# node compiles its own model's kernels when it configures (a plain colcon build needs nothing
+# more); the tests start nodes of every packaged example, so their kernels are compiled here,
+# once, with the node's own warm-up. (python -P: the install space's package, not the source
+# tree of the working directory that -c would put first.)
 start=$SECONDS
-log "compiling the install space's kernels (numba cache)"
-"$ROOT/tools/with_ros_env.sh" python -P -c \
-  "from hexapod_workspace.ros.node import warm_up_kernels; warm_up_kernels()"
+log "compiling the install space's kernels for the packaged examples (numba cache)"
+"$ROOT/tools/with_ros_env.sh" python -P -c "
+from hexapod_workspace._resources import data_path
+from hexapod_workspace.core.manipulator import Manipulator
+from hexapod_workspace.ros.node import warm_up_kernels
+names = ('example_gpm', 'example_collision', 'example_pus', 'example_rus')
+warm_up_kernels(*(Manipulator.from_params_file(data_path('config', f'{n}.yaml')) for n in names))
+"
 log "kernels ready in $((SECONDS - start)) s"
 touch "$stamp"

@@ -181,7 +181,7 @@ class ManagedTransitions:
         if settings.recording_enabled:
             node.recorder.open(settings.recording_directory, settings.recording_rotation)
         node.worker.start()  # it warms its own kernels up meanwhile
-        node.get_logger().info(f"configured: core kernels ready in {node.warm_up():.1f} s")
+        node.get_logger().info(f"configured: pose-check kernels ready in {node.warm_up():.1f} s")
         return TransitionCallbackReturn.SUCCESS
 
     def on_activate(self, state: LifecycleState) -> TransitionCallbackReturn:

@@ -59,6 +59,7 @@ from __future__ import annotations
 
 import inspect
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterable
 from typing import Any
@@ -83,6 +84,7 @@ from rclpy.serialization import serialize_message
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import kernels, params, planner_kernels
 from hexapod_workspace.core.constraints import check
+from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.core.params import NODE_PARAMETERS, ROS_PARAMETERS, unknown_parameter
 from hexapod_workspace.errors import ConfigError, InputError
 from hexapod_workspace.logs import (
@@ -171,13 +173,23 @@ def _result_qos(depth: int = 1) -> QoSProfile:
     )
 
 
-def warm_up_kernels() -> float:
-    """Compile (first run) or load the core's kernels before the node reports ready, so that
-    the first pose check and the first planned path are as fast as the others; returns the
-    seconds taken. ``make ros`` calls it once after each build to fill the install space's
-    cache."""
+def warm_up_kernels(*manipulators: Manipulator, checks_only: bool = False) -> float:
+    """Compile (first run) or load the core's kernels, so that the first pose check and the
+    first planned path are as fast as the others; returns the seconds taken. The kernels of
+    each manipulator's variant (checked with and without the reported singularity margin); none
+    given: every variant. ``checks_only``: only what a pose check of the manipulators as
+    configured needs (``kernels.CHECKS``), which the node compiles before it answers."""
     started = time.perf_counter()
-    kernels.warm_up()
+    if checks_only:
+        models = [kernels.model_vector(manipulator) for manipulator in manipulators]
+        kernels.warm_up(*models, names=kernels.CHECKS)
+        return time.perf_counter() - started
+    models = [
+        kernels.model_vector(manipulator, report_singularity=report)
+        for manipulator in manipulators
+        for report in (False, True)
+    ]
+    kernels.warm_up(*models)
     planner_kernels.warm_up()  # ~/check_path with free torsion
     return time.perf_counter() - started
 
@@ -291,10 +303,18 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
             raise InputError(self.inactive_reason() or "inactive: the node is unconfigured")
         return self.state
 
-    @staticmethod
-    def warm_up() -> float:
-        """Load the core's kernels; seconds taken (configure calls it)."""
-        return warm_up_kernels()
+    def warm_up(self) -> float:
+        """Load (or compile) the pose-check kernels of the configured manipulator; seconds
+        taken (configure calls it). The others (searches, the reported singularity margin,
+        the torsion planner) are loaded or compiled after, in a thread of their own, while the
+        node already answers: after a plain colcon build the cache is empty, and a first
+        answer should not wait for every kernel."""
+        manipulators = [self.state.manipulator] if self.state is not None else []
+        seconds = warm_up_kernels(*manipulators, checks_only=True)
+        threading.Thread(
+            target=warm_up_kernels, args=manipulators, name="kernel-warm-up", daemon=True
+        ).start()
+        return seconds
 
     # ------------------------------------------------------------------ wiring helpers
     def recorded_publisher(self, message_class: type, topic: str, depth: int = 1) -> Any:
