@@ -200,3 +200,29 @@ def test_the_missing_extra_hint_is_a_command_that_works(tmp_path):
     )
     assert done.returncode == 0, done.stdout + done.stderr
     assert "Would install" not in done.stdout  # every requirement already satisfied here
+
+
+# ------------------------------------------------------------------------ declared ranges
+def test_pip_install_works_at_both_ends_of_the_declared_ranges(tmp_path):
+    """``pip install .`` in fresh venvs, with the newest releases pip resolves and with numpy
+    and numba at setup.py's lower bounds: each imports, answers ``check`` as the pinned venv
+    does and runs ``projected --method exact`` (tools/check_install.py; needs the package
+    index, as every venv here does)."""
+    done = subprocess.run(
+        [sys.executable, str(ROOT / "tools" / "check_install.py"), "--keep", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=1800,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr + done.stdout
+    lines = done.stdout.splitlines()
+    assert [line.split(":")[0] for line in lines] == ["newest", "lowest"], done.stdout
+    bounds = {
+        name: version
+        for name, version in (
+            re.match(r"^([a-z]+)>=([0-9.]+)$", item).groups()  # type: ignore[union-attr]
+            for item in ("numpy>=1.26", "numba>=0.59")
+        )
+    }
+    assert f"numpy {bounds['numpy']}.0, numba {bounds['numba']}.0" in lines[1], lines[1]
