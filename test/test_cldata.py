@@ -214,6 +214,11 @@ def test_mm_feeds_state_mm_without_units():
             "mm",
             r"^line 2: FEDRAT/IPM,20: a feed in inches, but the units given .*--cl-units.* mm",
         ),
+        (
+            "UNITS/MM\nGOTO/0,0,0\n",
+            "inch",
+            r"^line 1: UNITS/MM: the file says mm, but the units given .*--cl-units.* inch",
+        ),
     ],
 )
 def test_statements_that_disagree_on_the_units_are_refused_naming_both(text, units, message):

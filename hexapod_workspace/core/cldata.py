@@ -46,10 +46,11 @@ statement                       meaning here
 Units are never guessed. ``UNITS``/``UNIT`` statements say them; before the first one, a feed
 with a unit (``FEDRAT/MMPM`` says mm, ``IPM`` says inches: NX CLSF writes no ``UNITS``
 statement in either unit) or the caller's ``units`` (``check-path --cl-units``) does. A file
-whose statements disagree (``UNITS/MM`` and ``FEDRAT/IPM``; a feed against ``--cl-units``) is
-refused naming both lines. A file that states no units at all (no ``UNITS``, no feed with a
-unit) is refused at its first length unless ``units`` is given: APT itself has no default unit,
-and an inch file read as mm is a path 25.4 times smaller that may well pass.
+whose statements disagree (``UNITS/MM`` and ``FEDRAT/IPM``; a ``UNITS`` statement or a feed
+against ``--cl-units``) is refused naming both. A file that states no units at all (no
+``UNITS``, no feed with a unit) is refused at its first length unless ``units`` is given: APT
+itself has no default unit, and an inch file read as mm is a path 25.4 times smaller that may
+well pass.
 
 Refused, with the line and why: ``CIRCLE``, ``MOVARC`` and ``NURBS``/``KNOT``/``CNTRL`` (a
 curve's chord is not the curve: the move certificate covers straight moves, and a spline's
@@ -372,6 +373,7 @@ class _Reader:
         self.tools = tools
         self.unit, self.unit_source = unit, source
         self.first_unit = unit
+        self.option: str | None = None  # the caller's units (--cl-units)
         self.unit_said: tuple[int, str] | None = None  # the UNITS statement in force
         self.axis_given = False
         self.rotation: NDArray[np.float64] = np.eye(3)  # file coordinates -> work frame
@@ -499,6 +501,7 @@ def parse_cldata(
     statements = _statements(text)
     unit, source = _initial_units(statements, units)
     state = _Reader(tools, unit, source)
+    state.option = units
     for line, statement in statements:
         shown = _shown(statement)
         word, arguments = _split(statement, line, shown)
@@ -600,6 +603,12 @@ def _statement(state: _Reader, word: str, arguments: list[str], line: int, shown
         state.feed = _feed(state, arguments, line, shown)
     elif word in ("UNITS", "UNIT"):
         state.unit = _unit_of(word, arguments, line, shown)
+        if state.option is not None and state.unit != state.option:
+            msg = (
+                f"line {line}: {shown}: the file says {_NAMES[state.unit]}, but the units "
+                f"given for the file (--cl-units) are {state.option}"
+            )
+            raise InputError(msg)
         if state.first_unit is None:
             state.first_unit, state.unit_source = state.unit, f"line {line}: {shown}"
         state.unit_said = (line, shown)
