@@ -273,6 +273,12 @@ def test_load_tool_acts_like_loadtl():
     assert program.parts == ((0, 2), (2, 4)) and program.tools.tolist() == [1, 1, 2, 2]
     with pytest.raises(InputError, match=r"line 5: LOAD/TOOL,2,ADJUST,2: tool 2 is not in"):
         parse_cldata(text, tools={1})
+    catia = parse_cldata(
+        "UNITS/MM\nTOOLNO/1,MILL,10\nLOADTL/1\nGOTO/0,0,0\nGOTO/1,0,0\nTOOLNO/2,MILL,6\n"
+        "LOADTL/2\nGOTO/1,0,5\nGOTO/2,0,5\n",
+        tools={1, 2},
+    )
+    assert catia.parts == ((0, 2), (2, 4)) and catia.tools.tolist() == [1, 1, 2, 2]
     with pytest.raises(InputError, match=r"line 1: LOAD/WIRE: expected LOAD/TOOL,n"):
         parse_cldata("LOAD/WIRE\n", units="mm")
 
@@ -373,7 +379,7 @@ def test_catia_file_reads():
     assert len(program) == 5 and program.tools.tolist() == [1] * 5
     counts = {name: count for name, _, count in program.passed_over}
     assert counts["PARTNO"] == 1 and counts["PPRINT"] == 2 and counts["CHANNEL"] == 1
-    assert counts["TPRINT"] == 1 and counts["TOOLNO"] == 1
+    assert counts["TPRINT"] == 1 and "TOOLNO" not in counts  # TOOLNO/1: a tool change
 
 
 @pytest.mark.parametrize("feed", ["FEDRAT/0.1,PERREV", "FEDRAT/PERREV,0.1", "FEDRAT/0.1,IPR"])

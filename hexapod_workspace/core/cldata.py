@@ -30,8 +30,10 @@ statement                       meaning here
 ``UNITS/MM|INCHES``             unit of the following coordinates and unit-less feeds; also
                                 ``UNIT/``, ``INCH``, ``IN``, ``MILLIMETERS``, ``MILLIMETRES``
 ``MULTAX[/ON|OFF]``             recorded (5-axis output); GOTO takes 3 or 6 values either way
-``LOADTL/n``, ``LOAD/TOOL,n``   selects tool n of the tool table; between moves it splits the
-                                path (the controller stops for the tool change)
+``LOADTL/n``, ``LOAD/TOOL,n``,  selects tool n of the tool table; between moves it splits the
+``TOOLNO/n,...``                path (the controller stops for the tool change); CATIA's
+                                ``TOOLNO`` is read as a tool change too (a ``LOADTL`` of the
+                                same tool before any move changes nothing)
 ``TOOL PATH/...``,              part boundaries (NX CLSF operations): the path is split there
 ``END-OF-PATH``
 ``MSYS/x,y,z,a,b,c,d,e,f``      NX's machining coordinate system: origin (x, y, z) and X and Y
@@ -119,7 +121,6 @@ PASSED_OVER: dict[str, str] = {
     "MACHIN": "post-processor selection",
     "CUTTER": "tool shape (the tool frame is the tool table's)",
     "TLDATA": "tool shape (NX)",
-    "TOOLNO": "tool description (CATIA; LOADTL selects the tool)",
     "SELECT/TOOL": "tool preselection (NX; LOAD/TOOL changes the tool)",
     "SELCTL": "tool preselection",
     "TOLER": "CAM tolerance",
@@ -618,8 +619,10 @@ def _statement(state: _Reader, word: str, arguments: list[str], line: int, shown
             msg = f"line {line}: {shown}: expected MULTAX, MULTAX/ON or MULTAX/OFF"
             raise InputError(msg)
         state.multax = state.multax or flag == "ON"
-    elif word == "LOADTL" or (word == "LOAD" and arguments[:1] and arguments[0].upper() == "TOOL"):
-        numbers = arguments if word == "LOADTL" else arguments[1:]
+    elif word in ("LOADTL", "TOOLNO") or (
+        word == "LOAD" and arguments[:1] and arguments[0].upper() == "TOOL"
+    ):
+        numbers = arguments if word != "LOAD" else arguments[1:]
         _load_tool(state, numbers, line, shown)
     elif word == "LOAD":
         msg = f"line {line}: {shown}: expected LOAD/TOOL,n (other LOAD statements are not modelled)"
