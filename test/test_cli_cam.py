@@ -60,7 +60,8 @@ def test_cl_file_checks_like_the_equivalent_csv(tmp_path):
     from_cl, from_csv = json.loads(out_cl), json.loads(out_csv)
     assert code_cl == code_csv
     assert from_cl["frame"] == "work" and from_csv["frame"] == "base"  # identity work frame
-    assert from_cl["ignored"] == [{"statement": "PARTNO", "first_line": 1, "count": 1}]
+    assert from_cl["passed_over"] == {"PARTNO": 1}
+    assert from_cl["cl_units"] == {"unit": "inch", "source": "line 2: units/inches"}
     for a, b in zip(from_cl["waypoints"], from_csv["waypoints"], strict=True):
         np.testing.assert_allclose(a["position"], b["position"], atol=1e-9)
         for key in ("phi_deg", "theta_deg", "psi_deg"):
@@ -212,7 +213,9 @@ def test_bad_cl_input_exits_2_in_one_line(tmp_path, text, extra, message):
     path = tmp_path / "bad.cl"
     path.write_text(text, encoding="utf-8")
     config = cell_config(tmp_path, extra)
-    code, out, err = run_main("--config", str(config), "check-path", str(path), "--json")
+    code, out, err = run_main(
+        "--config", str(config), "check-path", str(path), "--cl-units", "mm", "--json"
+    )
     assert code == 2 and out == ""
     assert pytest.importorskip("re").search(message, one_error_line(err))
 
@@ -220,7 +223,8 @@ def test_bad_cl_input_exits_2_in_one_line(tmp_path, text, extra, message):
 def test_rapid_without_a_rapid_feed_has_no_verdict_and_speeds_need_slerp(tmp_path):
     path = tmp_path / "rapid.cl"
     path.write_text(
-        "FEDRAT/600\nGOTO/0,0,-1300\nGOTO/10,0,-1300\nRAPID\nGOTO/10,0,-1250\nGOTO/0,0,-1250\n",
+        "UNITS/MM\nFEDRAT/600\nGOTO/0,0,-1300\nGOTO/10,0,-1300\nRAPID\nGOTO/10,0,-1250\n"
+        "GOTO/0,0,-1250\n",
         encoding="utf-8",
     )
     code, out, _ = run_main("check-path", str(path), "--json")
@@ -240,9 +244,11 @@ def test_rapid_without_a_rapid_feed_has_no_verdict_and_speeds_need_slerp(tmp_pat
 def test_one_goto_for_a_tool_is_refused(tmp_path):
     path = tmp_path / "short.cl"
     path.write_text("LOADTL/1\nGOTO/0,0,0\nGOTO/1,0,0\nLOADTL/2\nGOTO/0,0,5\n", encoding="utf-8")
-    code, _, err = run_main("--config", str(CELL), "check-path", str(path))
+    code, _, err = run_main("--config", str(CELL), "check-path", str(path), "--cl-units", "mm")
     assert code == 2
-    assert "line 5: the only GOTO of tool 2; expected at least 2 GOTO" in one_error_line(err)
+    assert "line 5: the only waypoint of part 1 (tool 2); expected at least 2" in one_error_line(
+        err
+    )
 
 
 def test_bad_flags_exit_2(tmp_path):
@@ -323,3 +329,44 @@ def test_feed_check_for_slides_and_cranks(tmp_path, architecture, z, unit):
         feed_max = 1200.0 * limit / segment["actuator_speed_peak"]
         assert segment["feed_max_mm_min"] == pytest.approx(feed_max, rel=1e-9)
         assert segment["speed_ok"] is (segment["actuator_speed_peak"] <= limit)
+
+
+def test_cl_units_are_stated_refused_or_given_and_passed_over_statements_counted(tmp_path):
+    """Issue #35: an NX-style file without UNITS and without a feed unit is refused (exit 2,
+    naming --cl-units), runs with --cl-units inch, and reports its units and what it passed
+    over; a CSV with --cl-units is refused."""
+    path = tmp_path / "nx.cls"
+    path.write_text(
+        "TOOL PATH/OP1,TOOL,EM10\nMSYS/0,0,0,1,0,0,0,1,0\nPAINT/PATH\nRAPID\n"
+        "GOTO/7.87,7.87,-37.4,0,0,1\nPAINT/COLOR,31\nGOTO/8.27,7.87,-37.4\n"
+        "PAINT/COLOR,36\nGOTO/8.27,8.27,-37.4\nEND-OF-PATH\n",
+        encoding="utf-8",
+    )
+    code, out, err = run_main("check-path", str(path), "--json")
+    assert code == 2 and out == ""
+    assert "line 2: MSYS/0,0,0,1,0,0,0,1,0: the file does not state its units" in one_error_line(
+        err
+    )
+    assert "--cl-units" in err
+    code, out, err = run_main("check-path", str(path), "--cl-units", "inch", "--json")
+    assert code in (0, 1), err
+    document = json.loads(out)
+    assert document["passed_over"] == {"PAINT": 3}
+    assert document["cl_units"] == {"unit": "inch", "source": "units='inch' (--cl-units)"}
+    assert document["cl_frames"][0]["line"] == 2
+    assert document["waypoints"][0]["position"] == pytest.approx([0.2, 0.2, -0.95], abs=1e-3)
+    code, out, _ = run_main("check-path", str(path), "--cl-units", "inch")
+    assert "passed over (cannot change motion, frame, tool or units): PAINT x3" in out
+    assert "CL units: inch (units='inch' (--cl-units))" in out
+    csv = tmp_path / "p.csv"
+    csv.write_text("x,y,z,i,j,k\n0,0,-1.3,0,0,1\n0.01,0,-1.3,0,0,1\n", encoding="utf-8")
+    code, _, err = run_main("check-path", str(csv), "--cl-units", "mm")
+    assert code == 2 and "--cl-units: only for CL files" in one_error_line(err)
+
+
+def test_nurbs_in_a_cl_file_exits_2_with_its_line():
+    """Issue #35 item 2: a real NX CLSF with NURBS spans is refused, not checked as chords."""
+    nurbs = Path(__file__).resolve().parent / "data" / "cl" / "nx_nurbs.cls"
+    code, out, err = run_main("check-path", str(nurbs))
+    assert code == 2 and out == ""
+    assert "line 13: NURBS/: spline moves are not modelled" in one_error_line(err)

@@ -13,13 +13,15 @@ until a ``LOADTL/n`` selects ``tools.T<n>``; every ``LOADTL`` between moves star
 (the controller stops for the tool change).
 
 JSON. A path of one part has the document of a CSV path plus ``frame``, ``tool``,
-``work_frame``, ``ignored`` and ``speed``; every move (``segments[k]``) gains ``duration_s``,
+``work_frame``, ``passed_over`` (CL statements passed over: count per statement), ``cl_units``
+(``unit``, ``source``: what stated them), ``cl_frames`` (each ``MSYS``/``ORIGIN`` applied) and
+``speed``; every move (``segments[k]``) gains ``duration_s``,
 ``feed_mm_min`` (or ``feed_deg_min`` for a rotation without translation), ``rapid``,
 ``actuator_speed_peak`` (certified bound, actuator unit/s, the largest over the actuators),
 ``speed_ok`` and ``feed_max_mm_min`` (``feed_max_deg_min`` for a rotation; ``null`` when no
 limit applies); a CL path's waypoints gain ``line``. A path with tool changes has ``ok``,
-``frame``, ``work_frame``, ``ignored``, ``speed`` and ``parts``: one such document per part with
-``first_waypoint``.
+``frame``, ``work_frame``, ``passed_over``, ``cl_units``, ``cl_frames``, ``speed`` and
+``parts``: one such document per part with ``first_waypoint``.
 
 Speeds. ``limits.actuator_speed_max`` (one or six values, actuator unit/s, 0 = unlimited). A
 move's feed is the CL file's ``FEDRAT`` (``--feed-mm-min`` before the first one, and for CSV
@@ -42,7 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._resources import example_config_path
-from ..core.cldata import CL_SUFFIXES, CLProgram, looks_like_cldata, read_cldata
+from ..core.cldata import CL_SUFFIXES, CL_UNITS, CLProgram, looks_like_cldata, read_cldata
 from ..core.frames import (
     CellFrames,
     Tool,
@@ -118,7 +120,7 @@ def is_cl_file(path: str | Path) -> bool:
 
 def cell_pipeline_applies(options: argparse.Namespace) -> bool:
     """Whether ``check-path`` needs this module (a CL file, a frame or a feed given)."""
-    flags = ("frame", "feed_mm_min", "rapid_feed_mm_min", "rotary_feed_deg_min")
+    flags = ("frame", "feed_mm_min", "rapid_feed_mm_min", "rotary_feed_deg_min", "cl_units")
     return is_cl_file(options.file) or any(getattr(options, f, None) is not None for f in flags)
 
 
@@ -154,6 +156,12 @@ def cell_arguments(sub: argparse.ArgumentParser) -> None:
         type=float,
         metavar="F",
         help="feed of RAPID moves, mm/min (default: none, so they get no speed verdict)",
+    )
+    sub.add_argument(
+        "--cl-units",
+        choices=tuple(CL_UNITS),
+        help="units of a CL file that does not state them (no UNITS statement, no feed in "
+        "MMPM or IPM); refused where the file states others",
     )
     sub.add_argument(
         "--rotary-feed-deg-min",
@@ -196,11 +204,12 @@ class _Part:
 
 def _read_parts(
     options: argparse.Namespace, cell: CellFrames, frame: str, feed: float
-) -> tuple[list[_Part], list[tuple[str, int, int]]]:
-    """The file's parts in the base frame, and the ignored CL statements."""
+) -> tuple[list[_Part], CLProgram | None]:
+    """The file's parts in the base frame, and the CL program (None for CSV)."""
     work = cell.work if frame == "work" else WorkFrame()
+    units = getattr(options, "cl_units", None)
     if is_cl_file(options.file):
-        program: CLProgram = read_cldata(options.file, tools=set(cell.tools))
+        program: CLProgram = read_cldata(options.file, tools=set(cell.tools), units=units)
         positions = work.origin + program.positions @ work.rotation.T
         axes = vectors_to_base(program.axes, work)
         feeds = np.where(np.isnan(program.feeds), feed, program.feeds)
@@ -222,14 +231,18 @@ def _read_parts(
                     start,
                 )
             )
-        for start, stop in program.parts:
+        for k, (start, stop) in enumerate(program.parts):
             if stop - start < 2:
                 msg = (
-                    f"CL file {options.file}: line {program.lines[start]}: the only GOTO of "
-                    f"tool {program.tools[start]}; expected at least 2 GOTO (one move) per tool"
+                    f"CL file {options.file}: line {program.lines[start]}: the only waypoint "
+                    f"of part {k} (tool {program.tools[start]}); expected at least 2 (one move) "
+                    "per part (tool change, TOOL PATH or END-OF-PATH)"
                 )
                 raise CliError(msg)
-        return parts, list(program.ignored)
+        return parts, program
+    if units is not None:
+        msg = f"--cl-units: only for CL files ({options.file} is read as CSV, in m)"
+        raise CliError(msg)
     waypoints = read_path_file(options.file)
     count = len(waypoints.positions)
     feeds = np.full(count, feed)
@@ -256,7 +269,7 @@ def _read_parts(
             0,
             written=frame == "base",
         )
-    return [part], []
+    return [part], None
 
 
 def _to_frame(document: dict[str, Any], work: WorkFrame) -> None:
@@ -502,7 +515,7 @@ def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str])
     feed = _positive(options.feed_mm_min, "--feed-mm-min", "mm/min") * _MM_MIN
     rapid = _positive(options.rapid_feed_mm_min, "--rapid-feed-mm-min", "mm/min") * _MM_MIN
     rotary = _positive(options.rotary_feed_deg_min, "--rotary-feed-deg-min", "deg/min") * _DEG_MIN
-    parts, ignored = _read_parts(options, cell, frame, feed)
+    parts, program = _read_parts(options, cell, frame, feed)
     results, documents, calls = [], [], []
     for part in parts:
         result, document, call = _check_part(platform, part, cell, options, (rapid, rotary))
@@ -517,9 +530,15 @@ def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str])
     common = {
         "frame": frame,
         "work_frame": work_json(cell.work),
-        "ignored": [{"statement": n, "first_line": line, "count": c} for n, line, c in ignored],
+        "passed_over": {} if program is None else {n: c for n, _, c in program.passed_over},
         "speed": speed,
     }
+    if program is not None:
+        common["cl_units"] = {"unit": program.units, "source": program.units_source}
+        common["cl_frames"] = [
+            {"line": line, "origin": origin.tolist(), "rotation": rotation.tolist()}
+            for line, origin, rotation in program.frames
+        ]
     if len(documents) == 1:
         report: dict[str, Any] = {**documents[0], **common, "ok": ok}
     else:
@@ -556,9 +575,17 @@ def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str])
 
 def _speed_text(report: dict[str, Any], out: IO[str]) -> None:
     speed = report["speed"]
-    if report["ignored"]:
-        names = ", ".join(f"{i['statement']} (line {i['first_line']})" for i in report["ignored"])
-        out.write(f"  ignored CL statements: {names}\n")
+    if "cl_units" in report:
+        units = report["cl_units"]
+        out.write(f"  CL units: {units['unit']} ({units['source']})\n")
+        for frame in report["cl_frames"]:
+            origin = ", ".join(f"{v:.6g}" for v in frame["origin"])
+            out.write(
+                f"  CL frame from line {frame['line']}: origin ({origin}) m in the work frame\n"
+            )
+    if report["passed_over"]:
+        names = ", ".join(f"{n} x{c}" for n, c in report["passed_over"].items())
+        out.write(f"  passed over (cannot change motion, frame, tool or units): {names}\n")
     out.write(f"  frame: {report['frame']}; speeds: {speed['covers']}\n")
     if not speed["limited"]:
         out.write("  no actuator speed limit (limits.actuator_speed_max is 0)\n")

@@ -1,37 +1,82 @@
 """Read APT cutter-location files (CLDATA, what CAM systems export) into waypoints.
 
-What is read
-------------
-=========================== =================================================================
-statement                   meaning here
-=========================== =================================================================
-``GOTO/x,y,z``              a waypoint; the tool axis stays the last one given (the work
-                            frame's z before any)
-``GOTO/x,y,z,i,j,k``        a waypoint with its tool axis (any non-zero length, normalised)
-``FEDRAT/f``                feed of the following cutting moves, per minute in the current
-                            ``UNITS``
-``FEDRAT/f,MMPM|IPM``       the same in mm/min or in/min; also ``FEDRAT/MMPM,f``
-``RAPID``                   the next motion statement only is a rapid move (APT)
-``UNITS/MM|INCHES``         unit of the following coordinates and unit-less feeds (default mm)
-``MULTAX[/ON|OFF]``         recorded (5-axis output); GOTO takes 3 or 6 values either way
-``LOADTL/n[,...]``          selects tool n of the tool table; between moves it splits the path
-                            (the controller stops for the tool change)
-=========================== =================================================================
+The policy
+----------
+Every statement of a CL file is **modelled**, or **refused** with its line and why. Only the
+fixed list :data:`PASSED_OVER` (statements that cannot change the motion, the frame, the tool
+or the units: part names, comments, spindle, coolant, tool descriptions, display colours, ...)
+is passed over, and :attr:`CLProgram.passed_over` counts them per statement (``check-path``
+reports the counts). A statement not in these tables is refused as unknown, never passed
+over: a reader that skips what it does not know checks a path other than the one the
+controller will run.
+
+What is modelled
+----------------
+=============================== ===============================================================
+statement                       meaning here
+=============================== ===============================================================
+``GOTO/x,y,z``                  a waypoint; the tool axis stays the last one given (``TLAXIS``,
+                                a 6-value ``GOTO``; the frame's z before any)
+``GOTO/x,y,z,i,j,k``            a waypoint with its tool axis (any non-zero length, normalised)
+``FROM/x,y,z[,i,j,k]``          the start point: the first waypoint of a part (refused after a
+                                move of the same part) and the point ``GOHOME`` returns to
+``GOHOME``                      a move to the ``FROM`` point (its axis if it gave one)
+``GODLTA/dx,dy,dz``, ``/d``     a move by (dx, dy, dz), or by d along the tool axis
+``SET/MODE,INCR|ABSOL``         following ``GOTO`` positions are increments / absolute
+``TLAXIS/i,j,k``                the tool axis of following 3-value ``GOTO`` statements
+``FEDRAT/f[,MMPM|IPM|PERMIN]``  feed of the following cutting moves (also ``FEDRAT/MMPM,f``);
+                                without a unit, per minute in the current units
+``RAPID``                       the next motion statement only is a rapid move (APT)
+``UNITS/MM|INCHES``             unit of the following coordinates and unit-less feeds; also
+                                ``UNIT/``, ``INCH``, ``IN``, ``MILLIMETERS``, ``MILLIMETRES``
+``MULTAX[/ON|OFF]``             recorded (5-axis output); GOTO takes 3 or 6 values either way
+``LOADTL/n``, ``LOAD/TOOL,n``,  selects tool n of the tool table; between moves it splits the
+``TOOLNO/n,...``                path (the controller stops for the tool change); CATIA's
+                                ``TOOLNO`` is read as a tool change too (a ``LOADTL`` of the
+                                same tool before any move changes nothing)
+``TOOL PATH/...``,              part boundaries (NX CLSF operations): the path is split there
+``END-OF-PATH``
+``MSYS/x,y,z,a,b,c,d,e,f``      NX's machining coordinate system: origin (x, y, z) and X and Y
+                                axes, given in the work frame; following coordinates and tool
+                                axes are in it (``p_work = origin + [X Y X×Y]·p``)
+``ORIGIN/x,y,z``                following coordinates are relative to the point (x, y, z)
+``CYCLE/OFF``, ``CUTCOM/OFF``,  no cycle, compensation or transformation is ever active (the
+``TRACUT/NOMORE``               other forms are refused), so these change nothing; counted
+                                with the passed-over statements
+=============================== ===============================================================
+
+Units are never guessed. ``UNITS``/``UNIT`` statements say them; before the first one, a feed
+with a unit (``FEDRAT/MMPM`` says mm, ``IPM`` says inches: NX CLSF writes no ``UNITS``
+statement in either unit) or the caller's ``units`` (``check-path --cl-units``) does. A file
+whose statements disagree (``UNITS/MM`` and ``FEDRAT/IPM``; a ``UNITS`` statement or a feed
+against ``--cl-units``) is refused naming both. A file that states no units at all (no
+``UNITS``, no feed with a unit) is refused at its first length unless ``units`` is given: APT
+itself has no default unit, and an inch file read as mm is a path 25.4 times smaller that may
+well pass.
+
+Refused, with the line and why: ``CIRCLE``, ``MOVARC`` and ``NURBS``/``KNOT``/``CNTRL`` (a
+curve's chord is not the curve: the move certificate covers straight moves, and a spline's
+deviation from its chords is not yet bounded here), canned cycles, cutter compensation,
+``TRACUT`` with a matrix, ``INSERT`` (text for the controller, whose effect is unknown),
+per-revolution feeds (``MMPR``, ``IPR``, ``PERREV``), ``ORIGIN`` together with a rotated
+``MSYS`` (the order they compose in is not stated), ``LOAD`` of anything but a tool, ``SET`` but
+``MODE,INCR|ABSOL``, a ``GODLTA``/``GOHOME``/incremental ``GOTO`` without a known previous
+point, a 6-value ``GOTO`` in incremental mode, and every statement not listed here or in
+:data:`PASSED_OVER`.
 
 Lines: ``$`` at the end of a line continues the statement on the next line; ``$$`` starts a
-comment (a whole line or the end of one); upper or lower case; spaces anywhere between tokens.
-Coordinates are in the work frame. Statements that do not change the geometry or the timing
-(``PARTNO``, ``SPINDL``, ``COOLNT``, ``CUTTER``, ...) are listed once each in
-:attr:`CLProgram.ignored` with their first line, never dropped silently. Statements that would
-change the motion and are not modelled (``CIRCLE``, ``MOVARC``, per-revolution feeds) are refused
-with their line number, like malformed ones.
+comment (a whole line or the end of one); upper or lower case; spaces anywhere between tokens;
+``WORD/args``, ``WORD,args`` (CATIA's ``CHANNEL,2``) or ``WORD`` alone. ``PPRINT``, ``PARTNO``,
+``TPRINT`` and ``INSERT`` are literal text to the end of their line (with or without ``/``): a
+``$`` there does not continue. Numbers may use Fortran exponents (``1.0D+01``).
 """
 
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Collection
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -39,21 +84,92 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 
-__all__ = ["CLProgram", "looks_like_cldata", "parse_cldata", "read_cldata"]
+__all__ = [
+    "CL_UNITS",
+    "PASSED_OVER",
+    "CLProgram",
+    "looks_like_cldata",
+    "parse_cldata",
+    "read_cldata",
+]
 
 #: File name suffixes of CL files (``check-path`` also sniffs the content).
-CL_SUFFIXES = (".cl", ".cls", ".apt", ".ncl", ".aptsource")
-#: Metres per unit.
-_LENGTH = {"MM": 1e-3, "INCHES": 0.0254, "INCH": 0.0254}
-#: Feed units: metres per second per unit value.
-_FEED = {"MMPM": 1e-3 / 60.0, "IPM": 0.0254 / 60.0}
+CL_SUFFIXES = (".cl", ".cls", ".clsf", ".apt", ".ncl", ".aptsource")
+#: Units a caller may state for a file that does not: metres per unit.
+CL_UNITS = {"mm": 1e-3, "inch": 0.0254}
+#: Spellings of the units in ``UNITS``/``UNIT`` statements.
+_UNIT_WORDS = {
+    "MM": "mm",
+    "MILLIMETER": "mm",
+    "MILLIMETERS": "mm",
+    "MILLIMETRE": "mm",
+    "MILLIMETRES": "mm",
+    "IN": "inch",
+    "INCH": "inch",
+    "INCHES": "inch",
+}
+#: Feed units per minute and the length unit each states.
+_FEED_UNITS = {"MMPM": "mm", "IPM": "inch"}
+#: Feed units per spindle revolution (refused).
+_PER_REVOLUTION = ("MMPR", "IPR", "PERREV")
+#: The only statements passed over: none can change the motion, the frame, the tool or the
+#: units. Keys are the statement (or the one form of it) as counted.
+PASSED_OVER: dict[str, str] = {
+    "PARTNO": "part name",
+    "PPRINT": "text for the operator",
+    "TPRINT": "tool text for the operator",
+    "MACHIN": "post-processor selection",
+    "CUTTER": "tool shape (the tool frame is the tool table's)",
+    "TLDATA": "tool shape (NX)",
+    "SELECT/TOOL": "tool preselection (NX; LOAD/TOOL changes the tool)",
+    "SELCTL": "tool preselection",
+    "TOLER": "CAM tolerance",
+    "INTOL": "CAM tolerance",
+    "OUTTOL": "CAM tolerance",
+    "THICK": "CAM stock allowance",
+    "AUTOPS": "CAM part-surface setting",
+    "SPINDL": "spindle speed",
+    "COOLNT": "coolant",
+    "PAINT": "display colour and speed (NX)",
+    "DISPLY": "display",
+    "OPSTOP": "optional stop (the path goes on from where it stopped)",
+    "STOP": "program stop (the path goes on from where it stopped)",
+    "DELAY": "dwell (the tool stays where it is)",
+    "SEQNO": "block numbering",
+    "CHANNEL": "controller channel (CATIA)",
+    "END": "end of a program section",
+    "FINI": "end of the file",
+    "REWIND": "tape rewind at the end of the program",
+    "CYCLE/OFF": "no cycle is active (every other CYCLE is refused)",
+    "CUTCOM/OFF": "no compensation is active (every other CUTCOM is refused)",
+    "TRACUT/NOMORE": "no transformation is active (every other TRACUT is refused)",
+}
 #: Statements that change the motion in ways this reader does not model: refused.
 _REFUSED = {
-    "CIRCLE": "circular moves are not modelled (export arcs as linear GOTO moves)",
-    "MOVARC": "circular moves are not modelled (export arcs as linear GOTO moves)",
+    "CIRCLE": "circular moves are not modelled (a chord would be checked instead of the arc; "
+    "export arcs as linear GOTO moves)",
+    "MOVARC": "circular moves are not modelled (a chord would be checked instead of the arc; "
+    "export arcs as linear GOTO moves)",
+    "NURBS": "spline moves are not modelled (a chord would be checked instead of the curve, "
+    "and its deviation is not bounded here; export splines as linear GOTO moves)",
+    "KNOT": "spline data (NURBS) is not modelled (export splines as linear GOTO moves)",
+    "CNTRL": "spline data (NURBS) is not modelled (export splines as linear GOTO moves)",
     "CYCLE": "canned cycles are not modelled (export them as GOTO moves)",
+    "CUTCOM": "cutter compensation (the controller offsets the path) is not modelled; "
+    "expected CUTCOM/OFF or a tool-centre path",
+    "TRACUT": "TRACUT transformations are not modelled (expected TRACUT/NOMORE)",
+    "INSERT": "INSERT passes text to the controller, whose effect on the motion is not known",
+    "RETRCT": "RETRCT moves to a clearance plane the file does not give as a point",
+    "ROTABL": "rotary-table motion is not modelled (a hexapod has no rotary axes)",
+    "ROTHED": "rotary-head motion is not modelled (a hexapod has no rotary axes)",
+    "AUXFUN": "auxiliary (M) functions have effects that are not known",
+    "PREFUN": "preparatory (G) functions change the motion in ways that are not known",
 }
-_MOTION = {"GOTO"}
+_LITERAL = {"PPRINT", "PARTNO", "TPRINT", "INSERT"}
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[EeDd][+-]?\d+)?")
+_WORD = re.compile(r"\s*([A-Za-z][A-Za-z0-9_]*)")
+_TOOL_PATH = re.compile(r"\s*TOOL\s+PATH\s*(?:/(.*))?$", re.IGNORECASE)
+_END_OF_PATH = re.compile(r"\s*END-OF-PATH\s*(?:/.*)?$", re.IGNORECASE)
 
 
 @dataclass(frozen=True)
@@ -74,13 +190,23 @@ class CLProgram:
     tools : ndarray, shape (N,), int
         Tool number active at waypoint k (0 before any ``LOADTL``).
     lines : ndarray, shape (N,), int
-        1-based line of the ``GOTO`` of each waypoint.
+        1-based line of the statement of each waypoint (``GOTO``, ``FROM``, ``GODLTA``,
+        ``GOHOME``).
     parts : tuple of (int, int)
-        Waypoint ranges [start, stop) between tool changes (``LOADTL`` between moves).
-    ignored : tuple of (str, int, int)
-        Statements not used: (name, first line, count), in order of first appearance.
+        Waypoint ranges [start, stop) between tool changes and part boundaries (``LOADTL``
+        between moves, ``TOOL PATH``, ``END-OF-PATH``).
+    passed_over : tuple of (str, int, int)
+        Statements of :data:`PASSED_OVER` met: (name, first line, count), in order of first
+        appearance.
     multax : bool
         ``MULTAX`` (on) appeared.
+    units : str
+        ``mm`` or ``inch``: the units the file's coordinates start in.
+    units_source : str
+        What stated them (``line 3: UNITS/MM``, ``line 12: FEDRAT/IPM,20``, ``units='inch'``).
+    frames : tuple of (int, ndarray, ndarray)
+        Each ``MSYS`` and ``ORIGIN`` applied: (line, origin in the work frame (m), rotation
+        from the file's coordinates to the work frame (3, 3)).
     """
 
     positions: NDArray[np.float64]
@@ -90,22 +216,35 @@ class CLProgram:
     tools: NDArray[np.int64]
     lines: NDArray[np.int64]
     parts: tuple[tuple[int, int], ...]
-    ignored: tuple[tuple[str, int, int], ...]
+    passed_over: tuple[tuple[str, int, int], ...]
     multax: bool
+    units: str = "mm"
+    units_source: str = ""
+    frames: tuple[tuple[int, NDArray[np.float64], NDArray[np.float64]], ...] = field(default=())
 
     def __len__(self) -> int:
         return int(self.positions.shape[0])
 
+    @property
+    def ignored(self) -> tuple[tuple[str, int, int], ...]:
+        """The former name of :attr:`passed_over`."""
+        return self.passed_over
+
 
 def _statements(text: str) -> list[tuple[int, str]]:
-    """Logical statements with the line they start on: comments removed, continuations joined."""
+    """Logical statements with the line they start on: comments removed, continuations
+    joined; ``PPRINT``/``PARTNO``/``TPRINT``/``INSERT`` lines kept literal."""
     statements: list[tuple[int, str]] = []
     pending: list[str] = []
     start = 0
     for number, raw in enumerate(text.splitlines(), start=1):
-        line = raw.split("$$", 1)[0].rstrip()
         if not pending:
             start = number
+            word = _WORD.match(raw)
+            if word and word.group(1).upper() in _LITERAL:
+                statements.append((number, raw.strip()))
+                continue
+        line = raw.split("$$", 1)[0].rstrip()
         if line.endswith("$"):
             pending.append(line[:-1])
             continue
@@ -120,19 +259,219 @@ def _statements(text: str) -> list[tuple[int, str]]:
     return statements
 
 
+def _split(statement: str, line: int, shown: str) -> tuple[str, list[str]]:
+    """A statement's major word (upper case) and its arguments."""
+    if _TOOL_PATH.match(statement):
+        return "TOOL PATH", []
+    if _END_OF_PATH.match(statement):
+        return "END-OF-PATH", []
+    match = _WORD.match(statement)
+    if match is None:
+        msg = f"line {line}: expected an APT statement (WORD or WORD/...), got {shown!r}"
+        raise InputError(msg)
+    word = match.group(1).upper()
+    rest = statement[match.end() :].strip()
+    if word in _LITERAL:
+        return word, [rest.removeprefix("/")] if rest else []
+    if rest.startswith(("/", ",")):
+        body = rest[1:]
+        return word, [a.strip() for a in body.split(",")] if body.strip() else []
+    if rest:
+        msg = f"line {line}: expected an APT statement (WORD or WORD/...), got {shown!r}"
+        raise InputError(msg)
+    return word, []
+
+
+def _is_number(token: str) -> bool:
+    return _NUMBER.fullmatch(token.strip()) is not None
+
+
 def _number(token: str, line: int, statement: str) -> float:
-    try:
-        value = float(token)
-    except ValueError:
+    text = token.strip()
+    if _NUMBER.fullmatch(text) is None:
         msg = f"line {line}: {statement}: expected a number, got {token!r}"
-        raise InputError(msg) from None
+        raise InputError(msg)
+    value = float(text.replace("D", "E").replace("d", "e"))
     if not math.isfinite(value):
         msg = f"line {line}: {statement}: expected a finite number, got {token!r}"
         raise InputError(msg)
     return value
 
 
-def parse_cldata(text: str, tools: Collection[int] | None = None) -> CLProgram:
+def _numbers(
+    arguments: list[str], counts: tuple[int, ...], line: int, shown: str, what: str
+) -> NDArray[np.float64]:
+    if len(arguments) not in counts:
+        got = len(arguments)
+        msg = f"line {line}: {shown}: expected {what}, got {got} value{'s' * (got != 1)}"
+        raise InputError(msg)
+    return np.array([_number(a, line, shown) for a in arguments], dtype=np.float64)
+
+
+def _unit_of(word: str, arguments: list[str], line: int, shown: str) -> str:
+    unit = arguments[0].upper() if len(arguments) == 1 else ""
+    if unit not in _UNIT_WORDS:
+        msg = f"line {line}: {shown}: expected {word}/MM or {word}/INCHES (or INCH)"
+        raise InputError(msg)
+    return _UNIT_WORDS[unit]
+
+
+def _feed_unit(arguments: list[str]) -> str | None:
+    """The length unit a FEDRAT's explicit per-minute unit states, else None."""
+    for argument in arguments:
+        if argument.strip().upper() in _FEED_UNITS:
+            return _FEED_UNITS[argument.strip().upper()]
+    return None
+
+
+def _initial_units(statements: list[tuple[int, str]], units: str | None) -> tuple[str | None, str]:
+    """The units the file starts in, and what says so: the first feed with a unit before the
+    first UNITS statement, else the caller's; disagreements refused."""
+    evidence: tuple[str, int, str] | None = None
+    for line, statement in statements:
+        shown = _shown(statement)
+        try:
+            word, arguments = _split(statement, line, shown)
+        except InputError:
+            break  # the main pass reports it
+        if word in ("UNITS", "UNIT"):
+            break
+        if word == "FEDRAT":
+            unit = _feed_unit(arguments)
+            if unit is not None:
+                if evidence is not None and evidence[0] != unit:
+                    msg = (
+                        f"line {line}: {shown}: a feed in {_NAMES[unit]}, but line "
+                        f"{evidence[1]} ({evidence[2]}) says {_NAMES[evidence[0]]}; the "
+                        "file's units disagree"
+                    )
+                    raise InputError(msg)
+                evidence = evidence or (unit, line, shown)
+    if evidence is not None:
+        if units is not None and units != evidence[0]:
+            msg = (
+                f"line {evidence[1]}: {evidence[2]}: a feed in {_NAMES[evidence[0]]}, but the "
+                f"units given for the file (--cl-units) are {units}"
+            )
+            raise InputError(msg)
+        return evidence[0], f"line {evidence[1]}: {evidence[2]}"
+    if units is not None:
+        return units, f"units={units!r} (--cl-units)"
+    return None, ""
+
+
+_NAMES = {"mm": "mm", "inch": "inches"}
+
+
+def _shown(statement: str) -> str:
+    return statement if len(statement) <= 60 else statement[:57] + "..."
+
+
+class _Reader:
+    """The state of the main pass."""
+
+    def __init__(self, tools: Collection[int] | None, unit: str | None, source: str) -> None:
+        self.tools = tools
+        self.unit, self.unit_source = unit, source
+        self.first_unit = unit
+        self.option: str | None = None  # the caller's units (--cl-units)
+        self.unit_said: tuple[int, str] | None = None  # the UNITS statement in force
+        self.axis_given = False
+        self.rotation: NDArray[np.float64] = np.eye(3)  # file coordinates -> work frame
+        self.origin: NDArray[np.float64] = np.zeros(3)  # of the file frame in the work frame, m
+        self.rotated_line = 0  # line of the MSYS that rotated the frame (0: none)
+        self.shifted_line = 0  # line of a non-zero ORIGIN (0: none)
+        self.msys_origin: NDArray[np.float64] = np.zeros(3)
+        self.shift: NDArray[np.float64] = np.zeros(3)
+        self.axis_file: NDArray[np.float64] = np.array(
+            [0.0, 0.0, 1.0]
+        )  # tool axis in file coordinates
+        self.feed = math.nan
+        self.rapid_next = False
+        self.incremental = False
+        self.tool = 0
+        self.multax = False
+        self.home: tuple[NDArray[np.float64], NDArray[np.float64] | None] | None = None
+        self.positions: list[NDArray[np.float64]] = []
+        self.axes: list[NDArray[np.float64]] = []
+        self.feeds: list[float] = []
+        self.rapid: list[bool] = []
+        self.tool_of: list[int] = []
+        self.lines: list[int] = []
+        self.part_starts = [0]
+        self.passed: dict[str, list[int]] = {}
+        self.frames: list[tuple[int, NDArray[np.float64], NDArray[np.float64]]] = []
+
+    # -- units -----------------------------------------------------------------------------
+    def scale(self, line: int, shown: str) -> float:
+        if self.unit is None:
+            msg = (
+                f"line {line}: {shown}: the file does not state its units (no UNITS statement "
+                "before this line, no feed in MMPM or IPM); give them with --cl-units mm|inch "
+                "(units= in the API)"
+            )
+            raise InputError(msg)
+        return CL_UNITS[self.unit]
+
+    # -- frames ----------------------------------------------------------------------------
+    def _update_frame(self) -> None:
+        self.origin = self.msys_origin + self.shift
+
+    def to_work(self, point_file: NDArray[np.float64]) -> NDArray[np.float64]:
+        result: NDArray[np.float64] = self.origin + self.rotation @ point_file
+        return result
+
+    def to_file(self, point_work: NDArray[np.float64]) -> NDArray[np.float64]:
+        result: NDArray[np.float64] = self.rotation.T @ (point_work - self.origin)
+        return result
+
+    # -- waypoints -------------------------------------------------------------------------
+    def in_part(self) -> bool:
+        return len(self.positions) > self.part_starts[-1]
+
+    def new_part(self) -> None:
+        if self.in_part():
+            self.part_starts.append(len(self.positions))
+
+    def last(self, line: int, shown: str) -> NDArray[np.float64]:
+        if not self.positions:
+            msg = f"line {line}: {shown}: expected a previous point (a GOTO or FROM) before it"
+            raise InputError(msg)
+        return self.positions[-1]
+
+    def add(
+        self, position: NDArray[np.float64], axis: NDArray[np.float64], line: int, shown: str
+    ) -> None:
+        """A waypoint (work frame, m), with the feed, RAPID flag and tool in force."""
+        if np.max(np.abs(position)) > 1e6:
+            msg = f"line {line}: {shown}: expected coordinates within 1e6 m"
+            raise InputError(msg)
+        self.positions.append(position)
+        self.axes.append(axis)
+        first = len(self.positions) - 1 == self.part_starts[-1]
+        self.feeds.append(math.nan if first else self.feed)
+        self.rapid.append(self.rapid_next and not first)
+        self.tool_of.append(self.tool)
+        self.lines.append(line)
+        self.rapid_next = False
+
+    def axis_work(self) -> NDArray[np.float64]:
+        result: NDArray[np.float64] = self.rotation @ self.axis_file
+        return result
+
+
+def _unit_axis(values: NDArray[np.float64], line: int, shown: str) -> NDArray[np.float64]:
+    norm = float(np.linalg.norm(values))
+    if not norm > 1e-12:
+        msg = f"line {line}: {shown}: expected a non-zero tool axis (i,j,k)"
+        raise InputError(msg)
+    result: NDArray[np.float64] = values / norm
+    return result
+
+
+def parse_cldata(
+    text: str, tools: Collection[int] | None = None, units: str | None = None
+) -> CLProgram:
     """Read the text of a CL file (see the module documentation).
 
     Parameters
@@ -142,6 +481,9 @@ def parse_cldata(text: str, tools: Collection[int] | None = None) -> CLProgram:
     tools : collection of int, optional
         Tool numbers of the tool table; a ``LOADTL`` of another number is refused. None: any
         number is accepted (the caller resolves them).
+    units : {'mm', 'inch'}, optional
+        The units of a file that does not state them (``check-path --cl-units``); refused
+        where the file states others before its first ``UNITS`` statement.
 
     Returns
     -------
@@ -151,154 +493,279 @@ def parse_cldata(text: str, tools: Collection[int] | None = None) -> CLProgram:
     ------
     InputError
         One line naming the file line, the statement, what was expected and what was given:
-        a GOTO without 3 or 6 numbers, a zero tool axis, an unknown unit, a negative or zero
-        feed, a ``LOADTL`` of a tool not in the table, ``CIRCLE``, no GOTO at all.
+        a malformed or refused statement (see the module documentation), units not stated or
+        disagreeing, a ``LOADTL`` of a tool not in the table, no waypoint at all.
     """
-    scale = _LENGTH["MM"]
-    axis = np.array([0.0, 0.0, 1.0])
-    feed = math.nan
-    rapid_next = False
-    tool = 0
-    multax = False
-    positions: list[NDArray[np.float64]] = []
-    axes: list[NDArray[np.float64]] = []
-    feeds: list[float] = []
-    rapid: list[bool] = []
-    tool_of: list[int] = []
-    lines: list[int] = []
-    part_starts = [0]
-    ignored: dict[str, list[int]] = {}
-    for line, statement in _statements(text):
-        major, _, rest = statement.partition("/")
-        word = major.strip().upper()
-        arguments = [a.strip() for a in rest.split(",")] if rest.strip() else []
-        shown = statement if len(statement) <= 60 else statement[:57] + "..."
-        if word == "GOTO":
-            if len(arguments) not in (3, 6):
-                msg = (
-                    f"line {line}: {shown}: expected 3 (x,y,z) or 6 (x,y,z,i,j,k) numbers, "
-                    f"got {len(arguments)}"
-                )
-                raise InputError(msg)
-            values = np.array([_number(a, line, shown) for a in arguments])
-            if values.size == 6:
-                norm = float(np.linalg.norm(values[3:]))
-                if not norm > 1e-12:
-                    msg = f"line {line}: {shown}: expected a non-zero tool axis (i,j,k)"
-                    raise InputError(msg)
-                axis = values[3:] / norm
-            if np.max(np.abs(values[:3])) * scale > 1e6:
-                msg = f"line {line}: {shown}: expected coordinates within 1e6 m"
-                raise InputError(msg)
-            positions.append(values[:3] * scale)
-            axes.append(axis)
-            first = len(positions) - 1 == part_starts[-1]
-            feeds.append(math.nan if first else feed)
-            rapid.append(rapid_next and not first)
-            tool_of.append(tool)
-            lines.append(line)
-            rapid_next = False
-        elif word == "RAPID":
-            if arguments:
-                msg = f"line {line}: {shown}: expected RAPID without arguments"
-                raise InputError(msg)
-            rapid_next = True
-        elif word == "FEDRAT":
-            feed = _feed(arguments, scale, line, shown)
-        elif word == "UNITS":
-            unit = arguments[0].upper() if len(arguments) == 1 else ""
-            if unit not in _LENGTH:
-                msg = f"line {line}: {shown}: expected UNITS/MM or UNITS/INCHES"
-                raise InputError(msg)
-            scale = _LENGTH[unit]
-        elif word == "MULTAX":
-            state = arguments[0].upper() if arguments else "ON"
-            if len(arguments) > 1 or state not in ("ON", "OFF"):
-                msg = f"line {line}: {shown}: expected MULTAX, MULTAX/ON or MULTAX/OFF"
-                raise InputError(msg)
-            multax = multax or state == "ON"
-        elif word == "LOADTL":
-            if not arguments:
-                msg = f"line {line}: {shown}: expected LOADTL/n (a tool number)"
-                raise InputError(msg)
-            number = _number(arguments[0], line, shown)
-            if number != int(number) or number < 1:
-                msg = f"line {line}: {shown}: expected a tool number 1, 2, ..., got {arguments[0]}"
-                raise InputError(msg)
-            if tools is not None and int(number) not in tools:
-                have = ", ".join(f"T{n}" for n in sorted(tools)) or "none"
-                msg = (
-                    f"line {line}: {shown}: tool {int(number)} is not in the tool table "
-                    f"(tools.T<n>; defined: {have})"
-                )
-                raise InputError(msg)
-            tool = int(number)
-            if len(positions) > part_starts[-1]:
-                part_starts.append(len(positions))
-        elif word in _REFUSED:
-            msg = f"line {line}: {shown}: {_REFUSED[word]}"
-            raise InputError(msg)
-        else:
-            if not word or not word.replace("_", "").isalnum():
-                msg = f"line {line}: expected an APT statement (WORD or WORD/...), got {shown!r}"
-                raise InputError(msg)
-            ignored.setdefault(word, []).append(line)
-    if not positions:
-        msg = "CL file: expected at least one GOTO statement, found none"
+    if units is not None and units not in CL_UNITS:
+        msg = f"units: expected one of {', '.join(CL_UNITS)}, got {units!r}"
         raise InputError(msg)
-    stops = [*part_starts[1:], len(positions)]
+    statements = _statements(text)
+    unit, source = _initial_units(statements, units)
+    state = _Reader(tools, unit, source)
+    state.option = units
+    for line, statement in statements:
+        shown = _shown(statement)
+        word, arguments = _split(statement, line, shown)
+        _statement(state, word, arguments, line, shown)
+    if not state.positions:
+        msg = "CL file: expected at least one GOTO (or FROM) statement, found none"
+        raise InputError(msg)
+    if state.part_starts[-1] == len(state.positions):  # a boundary after the last move
+        state.part_starts.pop()
+    stops = [*state.part_starts[1:], len(state.positions)]
     return CLProgram(
-        positions=np.array(positions, dtype=np.float64).reshape(-1, 3),
-        axes=np.array(axes, dtype=np.float64).reshape(-1, 3),
-        feeds=np.array(feeds, dtype=np.float64),
-        rapid=np.array(rapid, dtype=np.bool_),
-        tools=np.array(tool_of, dtype=np.int64),
-        lines=np.array(lines, dtype=np.int64),
-        parts=tuple(zip(part_starts, stops, strict=True)),
-        ignored=tuple((name, where[0], len(where)) for name, where in ignored.items()),
-        multax=multax,
+        positions=np.array(state.positions, dtype=np.float64).reshape(-1, 3),
+        axes=np.array(state.axes, dtype=np.float64).reshape(-1, 3),
+        feeds=np.array(state.feeds, dtype=np.float64),
+        rapid=np.array(state.rapid, dtype=np.bool_),
+        tools=np.array(state.tool_of, dtype=np.int64),
+        lines=np.array(state.lines, dtype=np.int64),
+        parts=tuple(zip(state.part_starts, stops, strict=True)),
+        passed_over=tuple((name, where[0], len(where)) for name, where in state.passed.items()),
+        multax=state.multax,
+        units=state.first_unit or "mm",
+        units_source=state.unit_source,
+        frames=tuple(state.frames),
     )
 
 
-def _feed(arguments: list[str], scale: float, line: int, shown: str) -> float:
-    """FEDRAT's feed in m/s: ``f``, ``f,UNIT`` or ``UNIT,f``; per minute in UNITS by default."""
+def _statement(state: _Reader, word: str, arguments: list[str], line: int, shown: str) -> None:
+    """Apply one statement to the reader's state (or refuse it)."""
+    if word == "GOTO":
+        values = _numbers(arguments, (3, 6), line, shown, "3 (x,y,z) or 6 (x,y,z,i,j,k) numbers")
+        if values.size == 6:
+            if state.incremental:
+                msg = (
+                    f"line {line}: {shown}: a tool axis in incremental mode (SET/MODE,INCR) "
+                    "is not modelled (whether i,j,k are increments is not standard)"
+                )
+                raise InputError(msg)
+            state.axis_file = _unit_axis(values[3:], line, shown)
+            state.axis_given = True
+        point = values[:3] * state.scale(line, shown)
+        if state.incremental:
+            point = state.to_file(state.last(line, shown)) + point
+        state.add(state.to_work(point), state.axis_work(), line, shown)
+    elif word == "FROM":
+        values = _numbers(arguments, (3, 6), line, shown, "3 (x,y,z) or 6 (x,y,z,i,j,k) numbers")
+        if state.in_part():
+            msg = (
+                f"line {line}: {shown}: FROM after a move of the same part (expected it first: "
+                "how the tool gets there is not stated)"
+            )
+            raise InputError(msg)
+        given = None
+        if values.size == 6:
+            state.axis_file = _unit_axis(values[3:], line, shown)
+            state.axis_given = True
+            given = state.axis_work()
+        position = state.to_work(values[:3] * state.scale(line, shown))
+        state.home = (position, given)
+        rapid = state.rapid_next
+        state.add(position, state.axis_work(), line, shown)
+        state.rapid_next = rapid  # FROM is not a motion: a RAPID before it is for the next one
+    elif word == "GOHOME":
+        if arguments:
+            msg = f"line {line}: {shown}: expected GOHOME without arguments"
+            raise InputError(msg)
+        if state.home is None:
+            msg = f"line {line}: {shown}: GOHOME without a FROM point before it"
+            raise InputError(msg)
+        position, given = state.home
+        if given is not None:
+            state.axis_file = state.rotation.T @ given
+        state.add(position.copy(), state.axis_work(), line, shown)
+    elif word == "GODLTA":
+        values = _numbers(arguments, (1, 3), line, shown, "1 (d along the tool axis) or 3 numbers")
+        last = state.last(line, shown)
+        scale = state.scale(line, shown)
+        if values.size == 1:
+            position = last + values[0] * scale * state.axis_work()
+        else:
+            position = last + state.rotation @ (values * scale)
+        state.add(position, state.axis_work(), line, shown)
+    elif word == "TLAXIS":
+        values = _numbers(arguments, (3,), line, shown, "TLAXIS/i,j,k (3 numbers)")
+        state.axis_file = _unit_axis(values, line, shown)
+        state.axis_given = True
+    elif word == "SET":
+        mode = [a.upper() for a in arguments]
+        if mode not in (["MODE", "INCR"], ["MODE", "ABSOL"]):
+            msg = f"line {line}: {shown}: expected SET/MODE,INCR or SET/MODE,ABSOL (other SET "
+            msg += "statements are not modelled)"
+            raise InputError(msg)
+        state.incremental = mode[1] == "INCR"
+    elif word == "RAPID":
+        if arguments:
+            msg = f"line {line}: {shown}: expected RAPID without arguments"
+            raise InputError(msg)
+        state.rapid_next = True
+    elif word == "FEDRAT":
+        state.feed = _feed(state, arguments, line, shown)
+    elif word in ("UNITS", "UNIT"):
+        state.unit = _unit_of(word, arguments, line, shown)
+        if state.option is not None and state.unit != state.option:
+            msg = (
+                f"line {line}: {shown}: the file says {_NAMES[state.unit]}, but the units "
+                f"given for the file (--cl-units) are {state.option}"
+            )
+            raise InputError(msg)
+        if state.first_unit is None:
+            state.first_unit, state.unit_source = state.unit, f"line {line}: {shown}"
+        state.unit_said = (line, shown)
+    elif word == "MULTAX":
+        flag = arguments[0].upper() if arguments else "ON"
+        if len(arguments) > 1 or flag not in ("ON", "OFF"):
+            msg = f"line {line}: {shown}: expected MULTAX, MULTAX/ON or MULTAX/OFF"
+            raise InputError(msg)
+        state.multax = state.multax or flag == "ON"
+    elif word in ("LOADTL", "TOOLNO") or (
+        word == "LOAD" and arguments[:1] and arguments[0].upper() == "TOOL"
+    ):
+        numbers = arguments if word != "LOAD" else arguments[1:]
+        _load_tool(state, numbers, line, shown)
+    elif word == "LOAD":
+        msg = f"line {line}: {shown}: expected LOAD/TOOL,n (other LOAD statements are not modelled)"
+        raise InputError(msg)
+    elif word in ("TOOL PATH", "END-OF-PATH"):
+        state.new_part()
+        state.home = None
+    elif word == "MSYS":
+        _msys(state, arguments, line, shown)
+    elif word == "ORIGIN":
+        values = _numbers(arguments, (3,), line, shown, "ORIGIN/x,y,z (3 numbers)")
+        if state.rotated_line and np.any(values != 0.0):
+            msg = (
+                f"line {line}: {shown}: ORIGIN with the rotated MSYS of line "
+                f"{state.rotated_line} in force: the order they compose in is not stated"
+            )
+            raise InputError(msg)
+        state.shift = values * state.scale(line, shown)
+        state.shifted_line = line if np.any(values != 0.0) else 0
+        state._update_frame()
+        state.frames.append((line, state.origin.copy(), state.rotation.copy()))
+    elif word in ("CYCLE", "CUTCOM", "TRACUT", "SELECT"):
+        form = f"{word}/{arguments[0].upper()}" if len(arguments) >= 1 else word
+        allowed = form in PASSED_OVER and (len(arguments) == 1 or form == "SELECT/TOOL")
+        if not allowed:
+            reason = _REFUSED.get(word, "expected SELECT/TOOL,n (other SELECT forms are unknown)")
+            msg = f"line {line}: {shown}: {reason}"
+            raise InputError(msg)
+        state.passed.setdefault(form, []).append(line)
+    elif word in _REFUSED:
+        msg = f"line {line}: {shown}: {_REFUSED[word]}"
+        raise InputError(msg)
+    elif word in PASSED_OVER:
+        state.passed.setdefault(word, []).append(line)
+    else:
+        msg = (
+            f"line {line}: {shown}: unknown statement {word}: not modelled, so refused (only "
+            "statements that cannot change the motion, frame, tool or units are passed over)"
+        )
+        raise InputError(msg)
+
+
+def _load_tool(state: _Reader, arguments: list[str], line: int, shown: str) -> None:
+    if not arguments:
+        msg = f"line {line}: {shown}: expected LOADTL/n or LOAD/TOOL,n (a tool number)"
+        raise InputError(msg)
+    number = _number(arguments[0], line, shown)
+    if number != int(number) or number < 1:
+        msg = f"line {line}: {shown}: expected a tool number 1, 2, ..., got {arguments[0]}"
+        raise InputError(msg)
+    if state.tools is not None and int(number) not in state.tools:
+        have = ", ".join(f"T{n}" for n in sorted(state.tools)) or "none"
+        msg = (
+            f"line {line}: {shown}: tool {int(number)} is not in the tool table "
+            f"(tools.T<n>; defined: {have})"
+        )
+        raise InputError(msg)
+    state.tool = int(number)
+    state.new_part()
+
+
+def _msys(state: _Reader, arguments: list[str], line: int, shown: str) -> None:
+    """MSYS/x,y,z,xi,xj,xk,yi,yj,yk: the machining coordinate system in the work frame."""
+    values = _numbers(arguments, (9,), line, shown, "MSYS/x,y,z,xi,xj,xk,yi,yj,yk (9 numbers)")
+    x_axis, y_axis = values[3:6], values[6:9]
+    if (
+        abs(np.linalg.norm(x_axis) - 1.0) > 1e-5
+        or abs(np.linalg.norm(y_axis) - 1.0) > 1e-5
+        or abs(float(x_axis @ y_axis)) > 1e-5
+    ):
+        msg = f"line {line}: {shown}: expected unit, orthogonal X and Y axes (within 1e-5)"
+        raise InputError(msg)
+    x_axis = x_axis / np.linalg.norm(x_axis)
+    y_axis = y_axis - (y_axis @ x_axis) * x_axis
+    y_axis = y_axis / np.linalg.norm(y_axis)
+    rotation = np.column_stack([x_axis, y_axis, np.cross(x_axis, y_axis)])
+    rotated = not np.allclose(rotation, np.eye(3), atol=1e-12)
+    if rotated and state.shifted_line:
+        msg = (
+            f"line {line}: {shown}: a rotated MSYS with the ORIGIN of line "
+            f"{state.shifted_line} in force: the order they compose in is not stated"
+        )
+        raise InputError(msg)
+    # a tool axis given before stays the same direction in the work frame until a new one is
+    # given; before any, the axis is the new frame's z
+    axis = state.axis_work()
+    state.rotation = rotation
+    if state.axis_given:
+        state.axis_file = rotation.T @ axis
+    state.msys_origin = values[:3] * state.scale(line, shown)
+    state.rotated_line = line if rotated else 0
+    state._update_frame()
+    state.frames.append((line, state.origin.copy(), rotation))
+
+
+def _feed(state: _Reader, arguments: list[str], line: int, shown: str) -> float:
+    """FEDRAT's feed in m/s: ``f``, ``f,UNIT`` or ``UNIT,f``; per minute in the units by
+    default; a unit that contradicts the units in force refused."""
     words = [a.upper() for a in arguments]
     units = [w for w in words if not _is_number(w)]
     numbers = [a for a in arguments if _is_number(a)]
+    if any(u in _PER_REVOLUTION for u in units):
+        msg = f"line {line}: {shown}: per-revolution feeds are not modelled (expected MMPM or IPM)"
+        raise InputError(msg)
     if len(numbers) != 1 or len(units) > 1 or len(arguments) > 2:
         msg = f"line {line}: {shown}: expected FEDRAT/f, FEDRAT/f,MMPM|IPM or FEDRAT/MMPM|IPM,f"
         raise InputError(msg)
     value = _number(numbers[0], line, shown)
-    if units and units[0] in ("MMPR", "IPR"):
-        msg = f"line {line}: {shown}: per-revolution feeds are not modelled (expected MMPM or IPM)"
-        raise InputError(msg)
-    if units and units[0] not in _FEED:
-        msg = f"line {line}: {shown}: unknown feed unit {units[0]!r} (expected MMPM or IPM)"
+    unit = units[0] if units else "PERMIN"
+    if unit not in _FEED_UNITS and unit != "PERMIN":
+        msg = f"line {line}: {shown}: unknown feed unit {unit!r} (expected MMPM or IPM)"
         raise InputError(msg)
     if not value > 0.0:
         msg = f"line {line}: {shown}: expected a feed > 0, got {numbers[0]}"
         raise InputError(msg)
-    per_unit = _FEED[units[0]] if units else scale / 60.0
-    return value * per_unit
-
-
-def _is_number(token: str) -> bool:
-    try:
-        float(token)
-    except ValueError:
-        return False
-    return True
+    if unit == "PERMIN":
+        return value * state.scale(line, shown) / 60.0
+    length = _FEED_UNITS[unit]
+    if state.unit is not None and state.unit != length:
+        said = state.unit_said
+        where = f"line {said[0]} ({said[1]})" if said else state.unit_source
+        msg = (
+            f"line {line}: {shown}: a feed in {_NAMES[length]}, but {where} says "
+            f"{_NAMES[state.unit]}; the file's units disagree"
+        )
+        raise InputError(msg)
+    if state.unit is None:  # cannot happen: the first such feed set the initial units
+        state.unit, state.unit_source = length, f"line {line}: {shown}"
+    return value * CL_UNITS[length] / 60.0
 
 
 def looks_like_cldata(text: str) -> bool:
-    """Whether a file's text is APT CLDATA rather than CSV: some line starts with ``GOTO/``."""
+    """Whether a file's text is APT CLDATA rather than CSV: some line starts with ``GOTO``
+    followed by ``/`` (spaces allowed between)."""
     return any(
         line.split("$$", 1)[0].strip().upper().replace(" ", "").startswith("GOTO/")
         for line in text.splitlines()
     )
 
 
-def read_cldata(path: str | Path, tools: Collection[int] | None = None) -> CLProgram:
+def read_cldata(
+    path: str | Path, tools: Collection[int] | None = None, units: str | None = None
+) -> CLProgram:
     """Read a CL file from disk (see :func:`parse_cldata`).
 
     Raises
@@ -317,7 +784,7 @@ def read_cldata(path: str | Path, tools: Collection[int] | None = None) -> CLPro
         msg = f"CL file {path} is not text"
         raise InputError(msg) from error
     try:
-        return parse_cldata(text, tools)
+        return parse_cldata(text, tools, units)
     except InputError as error:
         msg = f"CL file {path}: {error}"
         raise InputError(msg) from error
