@@ -617,9 +617,14 @@ def search_entry_points(
         rate_c = _lazy_rate(model, moving, collide) if lazy else 0.0
         lazy = rate_c > 0.0
         everywhere = model[ARCH] == 0.0  # (1) holds for every s, not only along certified steps
-        plain = model.copy()  # (a copy of a few hundred floats per call)
+        copy = model.copy()  # (a copy of a few hundred floats per call)
         if lazy:
-            plain[COLLISION_ON] = 0.0
+            copy[COLLISION_ON] = 0.0
+        # Typed as the model (read-only): numba unifies the two array types, so the block
+        # kernel is compiled once for both (the copy alone would be a second, writable type).
+        plain = model
+        if lazy:
+            plain = copy
         single = np.empty(_BLOCK_ROWS * BLOCK if lazy else 0)  # the lazy pass's one-pose planes
         single_out = np.empty(
             OUT_SIZE
@@ -894,8 +899,14 @@ def search_entry_points(
         rate_c = 0.0
         if moving is None and lazy:
             rate_c = _lazy_rate(model, moving, collide)
-        plain = model.copy()
-        plain[COLLISION_ON] = 0.0
+        copy = model.copy()
+        copy[COLLISION_ON] = 0.0
+        # ``plain`` is the copy, typed as the model (read-only): the branch, always taken but
+        # not decided at compile time, makes numba unify the two array types, so _pose is
+        # compiled once for both (the copy alone would be a second, writable type).
+        plain = model
+        if rate_c == rate_c:  # the rate is finite (never NaN)
+            plain = copy
         count = 0
         psi = -math.pi
         previous_ok = False
