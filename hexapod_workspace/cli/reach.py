@@ -6,8 +6,9 @@ JSON (``--json``):
 * ``reach``: ``plus``, ``minus`` (the largest t ≥ 0 in each sense, units of t: the direction is
   used as given), ``limited_by_plus``, ``limited_by_minus`` (constraint names; empty when the
   search bound was reached), ``t_max``, ``start_reachable``, ``frame``, ``position`` (m, in the
-  frame), ``pose_deg``, ``direction`` ([DX, DY, DZ] m and [RX, RY, RZ] rad per unit t),
-  ``tolerance_deg``, ``tool``, ``work_frame``.
+  frame), ``pose_deg`` (T&T; a pose given in another convention, ``--angles``, adds ``angles``
+  and ``pose_given`` with its own keys, ``u_deg``, ``qx``), ``direction`` ([DX, DY, DZ] m and
+  [RX, RY, RZ] rad per unit t), ``tolerance_deg``, ``tool``, ``work_frame``.
 * ``axis-limits``: ``{"frame": ..., "axes": {"x": {"plus", "minus", "limited_by_plus",
   "limited_by_minus"}, "y", "z", "rx", "ry", "rz"}, ...}`` with translations in m and rotations
   in degrees (magnitudes ≥ 0), about axes through the tool centre point.
@@ -31,10 +32,9 @@ from ..core.frames import CellFrames, Tool, cell_from_params_file, tool_model, w
 from ..core.manipulator import Manipulator
 from ..core.paths import DEFAULT_PATH_TOLERANCE
 from ..core.reach import AXES, DEFAULT_T_MAX, DEFAULT_T_MAX_ROTATION, Reach, axis_limits, reach
-from ..core.rotations import degrees_to_radians, tt_to_matrix
 from .cam import tool_json, work_json
 from .commands import PROG
-from .inputs import CliError, finite, load_manipulator
+from .inputs import CliError, GivenPoses, add_angles_option, finite, load_manipulator, pose_flag
 
 __all__ = [
     "AXIS_LIMITS_DESCRIPTION",
@@ -66,12 +66,13 @@ AXIS_LIMITS_DESCRIPTION = (
 def _common(parser: argparse.ArgumentParser, frames: tuple[str, ...]) -> None:
     parser.add_argument(
         "--pose",
-        nargs=3,
+        nargs="+",
         type=float,
-        default=[0.0, 0.0, 0.0],
-        metavar=("PHI", "THETA", "PSI"),
-        help="orientation of the tool, Tilt-and-Torsion angles, degrees (default 0 0 0)",
+        metavar="V",
+        help="orientation of the tool: PHI THETA PSI, Tilt-and-Torsion angles, degrees, or the "
+        "3 angles (4 quaternion components) of --angles (default: the identity, 0 0 0)",
     )
+    add_angles_option(parser)
     parser.add_argument(
         "--frame",
         choices=frames,
@@ -154,8 +155,7 @@ def _pose(
         if options.position is None
         else finite(options.position, "--position", "m")
     )
-    degrees = finite(options.pose, "--pose", "degrees")
-    rotation = tt_to_matrix(degrees_to_radians(degrees))
+    rotation = _given_pose(options).matrices()[0]
     frame_rotation = np.eye(3)
     if options.frame == "work":
         if options.position is None:
@@ -171,14 +171,37 @@ def _pose(
     return manipulator, cell, tool, rotation, position, frame_rotation, tolerance
 
 
+def _given_pose(options: argparse.Namespace) -> GivenPoses:
+    """``--pose`` in the convention of ``--angles`` (default: the identity)."""
+    convention = options.angles or "tt"
+    if options.pose is None:
+        identity = [0.0, 0.0, 0.0, 1.0] if convention == "quaternion" else [0.0, 0.0, 0.0]
+        return GivenPoses(convention, np.array([identity]))
+    return pose_flag(options.pose, convention)
+
+
 def _frames_json(options: argparse.Namespace, cell: CellFrames, tool: Tool) -> dict[str, Any]:
-    return {
+    """The pose and frames of the answer: ``pose_deg`` (T&T, as typed for tt) and, for a pose
+    given in another convention, ``angles`` and ``pose_given`` (its own keys: ``u_deg``)."""
+    given = _given_pose(options)
+    document: dict[str, Any] = {
         "frame": options.frame,
         "position": None if options.position is None else list(options.position),
-        "pose_deg": list(options.pose),
-        "tool": tool_json(tool),
-        "work_frame": work_json(cell.work),
+        "pose_deg": given.tt_degrees()[0].tolist(),
     }
+    if not given.is_tt:
+        document["angles"] = given.convention
+        document["pose_given"] = dict(zip(given.keys, given.values[0].tolist(), strict=True))
+    return {**document, "tool": tool_json(tool), "work_frame": work_json(cell.work)}
+
+
+def _pose_line(options: argparse.Namespace, out: IO[str]) -> None:
+    """For a pose given in another convention than T&T, one line: as given, then in T&T."""
+    given = _given_pose(options)
+    if given.is_tt:
+        return
+    phi, theta, psi = given.tt_degrees()[0].tolist()
+    out.write(f"pose: {given.echo()} = phi {phi:.6g}, theta {theta:.6g}, psi {psi:.6g} deg (tt)\n")
 
 
 def _limits_json(result: Reach, scale: float = 1.0) -> dict[str, Any]:
@@ -222,6 +245,7 @@ def cmd_reach(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
     if options.json:
         out.write(json.dumps(document, allow_nan=False) + "\n")
     else:
+        _pose_line(options, out)
         for sense in ("plus", "minus"):
             names = document[f"limited_by_{sense}"]
             why = ", ".join(names) if names else f"search bound t_max = {t_max:g} reached"
@@ -260,6 +284,7 @@ def cmd_axis_limits(options: argparse.Namespace, out: IO[str], err: IO[str]) -> 
     if options.json:
         out.write(json.dumps(document, allow_nan=False) + "\n")
     else:
+        _pose_line(options, out)
         out.write(f"axis limits in the {options.frame} frame (translations m, rotations deg)\n")
         for k, name in enumerate(AXES):
             axis = document["axes"][name]
