@@ -48,6 +48,7 @@ from .inputs import (
     given_poses,
     load_manipulator,
     output_file,
+    plausible_positions,
 )
 from .reports import write_json
 from .tables import (
@@ -579,6 +580,7 @@ def cmd_check_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> i
     )
     manipulator = load_manipulator(options.config, None, err)
     waypoints = read_path_file(options.file, options.angles)
+    plausible_positions(manipulator, waypoints.positions, f"path file {options.file}: x,y,z")
     tolerance = (
         DEFAULT_PATH_TOLERANCE
         if options.tol_deg is None

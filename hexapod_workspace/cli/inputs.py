@@ -28,6 +28,7 @@ from ..core.rotations import (
     degrees_to_radians,
     tt_to_matrix,
 )
+from ..core.validation import machine_size, millimetre_reason, require_plausible_cell
 from ..errors import HexapodWorkspaceError, InputError
 from .tables import (
     ORIENTATION_QUANTITIES,
@@ -48,6 +49,7 @@ __all__ = [
     "given_poses",
     "load_manipulator",
     "output_file",
+    "plausible_positions",
     "pose_flag",
     "poses_from_degrees",
     "psi_step_flag",
@@ -257,19 +259,34 @@ def load_manipulator(
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         manipulator = Manipulator.from_params_file(path)
+    cell = require_plausible_cell(manipulator, cell_from_params_file(path))
     if with_tool:
-        manipulator = tool_model(manipulator, cell_from_params_file(path).tool)
+        manipulator = tool_model(manipulator, cell.tool)
     for warning in caught:
         err.write(f"hexapod-workspace: warning: {warning.message}\n")
     if position is None:
         return manipulator
     position = finite(position, "--position", "m")
+    plausible_positions(manipulator, position, "--position")
     try:
         resolution.validate_position(manipulator, position)
     except InputError as error:
         msg = "--position" + str(error).removeprefix("position")
         raise CliError(msg) from error
     return manipulator.with_position(position)
+
+
+def plausible_positions(
+    manipulator: Manipulator, positions: NDArray[np.float64], where: str
+) -> None:
+    """Refuse positions (m) that fit the machine only once divided by 1000, with the unit
+    hint (:func:`~hexapod_workspace.core.validation.millimetre_reason`), naming ``where``."""
+    size = machine_size(
+        manipulator.base_joints, manipulator.platform_joints, manipulator.home_position
+    )
+    reason = millimetre_reason(where, np.linalg.norm(np.atleast_2d(positions), axis=-1), size)
+    if reason is not None:
+        raise CliError(reason.replace("got ", "got a distance from the base origin of ", 1))
 
 
 def output_file(path: str | Path, flag: str, *, force: bool, suffixes: tuple[str, ...]) -> Path:
