@@ -105,3 +105,83 @@ def test_unreachable_start_and_bad_directions(model):
         reach(model, np.eye(3), [0, 0, -1.2], [0, 0, 0], [0, 0, 4.0])
     with pytest.raises(InputError, match=r"^frame: expected base, work or tool"):
         axis_limits(model, np.eye(3), [0, 0, -1.2], frame="world")
+
+
+# ---------------------------------------------------------------------------- accuracy per unit
+def _first_violation(flags: list[bool], grid: np.ndarray) -> float:
+    """The first sampled t that is unreachable (inf when every sample is reachable)."""
+    bad = [t for t, ok in zip(grid.tolist(), flags, strict=True) if not ok]
+    return bad[0] if bad else math.inf
+
+
+@pytest.fixture(scope="module")
+def far_pivot() -> Manipulator:
+    """The pivot (tool centre point) 3 m from the platform joints: an angle tolerance of the
+    platform would make the translation limits 3 m × angle short."""
+    model = tool_model(Manipulator.example(warn=False), Tool(np.array([0.0, 0.0, -3.0])))
+    rho = float(np.max(np.linalg.norm(model.platform_joints, axis=1)))
+    assert rho >= 3.0
+    return model
+
+
+def test_translation_limit_is_within_tol_mm_of_the_sampled_boundary(far_pivot):
+    rotation, position = np.eye(3), np.array(far_pivot.home_position)
+    limits = axis_limits(far_pivot, rotation, position)  # defaults: 0.01 mm, 0.001 deg
+    for name, unit in (("x", np.array([1.0, 0.0, 0.0])), ("z", np.array([0.0, 0.0, 1.0]))):
+        found = limits[name].plus
+        assert limits[name].limited_by_plus, name  # a constraint limits it (not the bound)
+        coarse = np.linspace(0.0, found, 200)
+        assert all(
+            bool(check(far_pivot, np.zeros((1, 3)), position + t * unit).reachable[0])
+            for t in coarse
+        ), name
+        fine = found + np.arange(0.0, 0.05e-3, 0.5e-6)  # 0.5 µm samples past the limit
+        flags = [
+            bool(check(far_pivot, np.zeros((1, 3)), position + t * unit).reachable[0]) for t in fine
+        ]
+        boundary = _first_violation(flags, fine)
+        assert boundary - found <= 1e-5 + 0.5e-6, (name, (boundary - found) * 1e3)
+
+
+def test_rotation_limit_is_within_tol_deg_of_the_sampled_boundary(far_pivot):
+    rotation, position = np.eye(3), np.array(far_pivot.home_position)
+    tol = math.radians(0.001)
+    limits = axis_limits(far_pivot, rotation, position, tol_rotation=tol)
+    for name, axis in (("rx", np.array([1.0, 0.0, 0.0])), ("ry", np.array([0.0, 1.0, 0.0]))):
+        found = limits[name].plus
+        assert limits[name].limited_by_plus, name
+        grid = np.concatenate(
+            [np.linspace(0.0, found, 2000), found + np.arange(0.0, 20 * tol, tol / 20)]
+        )
+        rotations = rodrigues(axis, grid) @ rotation
+        reachable = check(far_pivot, matrix_to_tt(rotations), position).reachable
+        assert np.all(reachable[:2000]), name
+        boundary = _first_violation(reachable.tolist(), grid)
+        assert boundary - found <= tol + tol / 20, (name, math.degrees(boundary - found))
+
+
+def test_cli_tolerances_are_per_unit(far_pivot, tmp_path):
+    import json
+
+    from cli_support import run_main
+
+    config = tmp_path / "far.yaml"
+    parameters = {**Manipulator.example(warn=False).to_parameters(), "tool.offset": [0, 0, -3.0]}
+    config.write_text(
+        "hexapod_workspace:\n  ros__parameters:\n"
+        + "".join(f"    {name}: {value!r}\n" for name, value in parameters.items()),
+        encoding="utf-8",
+    )
+    home = [repr(v) for v in far_pivot.home_position.tolist()]
+    code, out, err = run_main(
+        "--json", "--config", str(config), "axis-limits", "--position", *home, "--tol-mm", "0.005"
+    )
+    assert code == 0, err
+    document = json.loads(out)
+    assert document["tolerance_mm"] == 0.005 and document["tolerance_deg"] == pytest.approx(0.001)
+    expected = axis_limits(
+        far_pivot, np.eye(3), np.array(far_pivot.home_position), tol_translation=5e-6
+    )
+    assert document["axes"]["x"]["plus"] == pytest.approx(expected["x"].plus, abs=1e-12)
+    code, _, err = run_main("--config", str(config), "axis-limits", "--tol-mm", "0")
+    assert code == 2 and "--tol-mm: expected a value > 0 mm, got 0" in err

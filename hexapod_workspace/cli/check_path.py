@@ -1,7 +1,9 @@
 """``hexapod-workspace check-path FILE``: certified check of a path, or torsion planning.
 
 The CSV file has a header row. Columns ``x,y,z,phi_deg,theta_deg,psi_deg`` (m, degrees) give a
-fixed orientation per waypoint; columns ``x,y,z,i,j,k`` give a tool axis (approach vector, any
+fixed orientation per waypoint (or the columns of another convention, ``u_deg,v_deg,w_deg``,
+``a_deg,b_deg,c_deg``, ``rx_deg,ry_deg,rz_deg``, ``qx,qy,qz,qw``: ``--angles``, echoed as given
+beside the T&T angles); columns ``x,y,z,i,j,k`` give a tool axis (approach vector, any
 non-zero length) and the torsion is then planned (:func:`hexapod_workspace.plan_torsion`).
 Columns are read by name, in any order; angles may be in radians (``phi_rad``), positions in
 millimetres (``x_mm``). Blank lines and lines starting with ``#`` are skipped; rules and errors
@@ -35,12 +37,29 @@ from ..core.paths import (
     plan_torsion,
     reported_parts,
 )
-from ..core.rotations import degrees_to_radians, matrix_to_quaternion, tt_to_matrix
+from ..core.rotations import matrix_to_quaternion, tt_to_matrix
 from ..errors import InputError
 from .commands import PROG
-from .inputs import PLOT_FORMATS, finite, load_manipulator, output_file
+from .inputs import (
+    PLOT_FORMATS,
+    GivenPoses,
+    add_angles_option,
+    finite,
+    given_poses,
+    load_manipulator,
+    output_file,
+    plausible_positions,
+)
 from .reports import write_json
-from .tables import ANGLE_UNITS, LENGTH_UNITS, PLAIN, Columns, parse_table
+from .tables import (
+    LENGTH_UNITS,
+    ORIENTATION_QUANTITIES,
+    PLAIN,
+    Columns,
+    conventions_text,
+    orientation_columns,
+    parse_table,
+)
 
 if TYPE_CHECKING:
     from matplotlib.projections.polar import PolarAxes
@@ -60,15 +79,16 @@ __all__ = [
 ]
 
 _POSITION = ("x", "y", "z")
-_ANGLES = ("phi", "theta", "psi")
 _AXIS = ("i", "j", "k")
-#: The columns of a path file: positions in m (or mm), angles in degrees or radians, axes.
+#: The columns of a path file: positions in m (or mm), the orientation of one convention
+#: (angles in degrees or radians, quaternions unitless), or tool axes.
 PATH_COLUMNS = Columns(
     {
         **dict.fromkeys(_POSITION, LENGTH_UNITS),
-        **dict.fromkeys(_ANGLES, ANGLE_UNITS),
+        **ORIENTATION_QUANTITIES,
         **dict.fromkeys(_AXIS, PLAIN),
-    }
+    },
+    expected=f"x, y, z (or x_m, x_mm, ...); {conventions_text()}; or i, j, k",
 )
 
 
@@ -81,28 +101,39 @@ class PathFile:
     positions : ndarray, shape (N, 3)
         m, base frame.
     degrees : ndarray, shape (N, 3) or None
-        (φ, θ, ψ) in degrees, as written (fixed orientations).
+        (φ, θ, ψ) in degrees (fixed orientations): as written for T&T columns, else converted
+        from the convention the columns name.
     axes : ndarray, shape (N, 3) or None
         Tool axes (free torsion).
+    given : GivenPoses or None
+        The fixed orientations as written, in their convention.
     """
 
     positions: NDArray[np.float64]
     degrees: NDArray[np.float64] | None
     axes: NDArray[np.float64] | None
+    given: GivenPoses | None = None
 
     @property
     def free_torsion(self) -> bool:
         return self.axes is not None
 
 
-def read_path_file(path: str | Path) -> PathFile:
+def read_path_file(path: str | Path, angles: str | None = None) -> PathFile:
     """Read a path CSV (see the module documentation; rules: :mod:`.tables`).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    angles : str, optional
+        The convention ``--angles`` names; columns of another convention are refused.
 
     Raises
     ------
     InputError
-        Unreadable file, missing or unknown columns, non-numbers, NaN or infinite values,
-        fewer than 2 waypoints; every line error names the line of the file.
+        Unreadable file, missing or unknown columns, the columns of two conventions or of
+        another convention than ``angles``, non-numbers, NaN or infinite values, fewer than 2
+        waypoints; every line error names the line of the file.
     """
     path = Path(path)
     try:
@@ -116,25 +147,27 @@ def read_path_file(path: str | Path) -> PathFile:
     table = parse_table(text, f"path file {path}", None, rows_name="waypoints")
     columns = PATH_COLUMNS.read(table)
     given = set(columns)
-    has_angles, has_axis = set(_ANGLES) <= given, set(_AXIS) <= given
+    bad_header = (
+        f"path file {path}, line {table.header_line}: expected a header "
+        f"x,y,z,phi_deg,theta_deg,psi_deg (or phi_rad, ..., or another convention's columns: "
+        f"u_deg,v_deg,w_deg, qx,qy,qz,qw, ...) or x,y,z,i,j,k, got "
+        f"{','.join(table.header or [])}"
+    )
+    orientation = orientation_columns(table, columns, angles, incomplete=bad_header)
+    has_axis = set(_AXIS) <= given
     if (
         not set(_POSITION) <= given
-        or has_angles == has_axis
-        or (has_angles and set(_AXIS) & given)
-        or (has_axis and set(_ANGLES) & given)
+        or (orientation is None) != has_axis
+        or (orientation is not None and set(_AXIS) & given)
     ):
-        msg = (
-            f"path file {path}, line {table.header_line}: expected a header "
-            f"x,y,z,phi_deg,theta_deg,psi_deg (or phi_rad, ...) or x,y,z,i,j,k, got "
-            f"{','.join(table.header or [])}"
-        )
-        raise InputError(msg)
+        raise InputError(bad_header)
     if table.values.shape[0] < 2:
         msg = f"path file {path}: expected at least 2 waypoints, got {table.values.shape[0]}"
         raise InputError(msg)
     positions = np.column_stack([columns[n] for n in _POSITION])
-    if has_angles:
-        return PathFile(positions, np.column_stack([columns[n] for n in _ANGLES]), None)
+    if orientation is not None:
+        poses = given_poses(orientation[1], orientation[0], f"path file {path}")
+        return PathFile(positions, poses.tt_degrees(), None, poses)
     return PathFile(positions, None, np.column_stack([columns[n] for n in _AXIS]))
 
 
@@ -152,6 +185,7 @@ def path_to_json(
     result: PathCheck | TorsionPlan,
     baseline: PathCheck,
     degrees: NDArray[np.float64] | None = None,
+    given: GivenPoses | None = None,
 ) -> dict[str, Any]:
     """The JSON document of a path check or a torsion plan (documented keys, degrees).
 
@@ -162,7 +196,10 @@ def path_to_json(
     baseline : PathCheck
         The ψ ≡ 0 path (:func:`psi_zero_baseline`, or ``plan.baseline``).
     degrees : ndarray, shape (N, 3), optional
-        The fixed orientations as the user wrote them (reported as given).
+        The fixed orientations in T&T degrees as the user wrote them (reported as given).
+    given : GivenPoses, optional
+        Fixed orientations written in another convention than T&T: each waypoint starts with
+        them (``u_deg, v_deg, w_deg``, ``qx, ..., qw``), and the document says ``angles``.
     """
     path, plan = reported_parts(result)
     waypoints, segments = path.waypoints, path.segments
@@ -171,7 +208,14 @@ def path_to_json(
     names = list(waypoints.margins)  # the constraints of the model's architecture
     scene = "collision" in waypoints.margins  # a collision scene is declared
     margins = {name: waypoints.margins[name].tolist() for name in names}
+    echo = given is not None and not given.is_tt
+    own = (
+        [dict(zip(given.keys, row, strict=True)) for row in given.values.tolist()]
+        if given is not None and echo
+        else [{}] * len(waypoints)
+    )
     document: dict[str, Any] = {
+        **({"angles": given.convention} if given is not None and echo else {}),
         "ok": bool(path.ok and (plan is None or plan.ok)),
         "planned_torsion": plan is not None,
         "interpolation": path.interpolation,
@@ -180,6 +224,7 @@ def path_to_json(
             {
                 "index": k,
                 "position": waypoints.positions[k].tolist(),
+                **own[k],
                 "phi_deg": float(angles_deg[k, 0]),
                 "theta_deg": float(angles_deg[k, 1]),
                 "psi_deg": float(angles_deg[k, 2]),
@@ -534,7 +579,8 @@ def cmd_check_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> i
         else output_file(options.plot, "--plot", force=options.force, suffixes=PLOT_FORMATS)
     )
     manipulator = load_manipulator(options.config, None, err)
-    waypoints = read_path_file(options.file)
+    waypoints = read_path_file(options.file, options.angles)
+    plausible_positions(manipulator, waypoints.positions, f"path file {options.file}: x,y,z")
     tolerance = (
         DEFAULT_PATH_TOLERANCE
         if options.tol_deg is None
@@ -560,8 +606,9 @@ def cmd_check_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> i
         degrees = None
         orientation = np.column_stack([result.directions, np.zeros(len(waypoints.positions))])
     else:
-        assert waypoints.degrees is not None  # read_path_file gives axes or angles
-        orientation = degrees_to_radians(waypoints.degrees)  # exact for any finite degrees
+        assert waypoints.given is not None  # read_path_file gives axes or angles
+        # T&T: exact for any finite degrees; another convention: through its matrix.
+        orientation = waypoints.given.radians()
         result = check_path(
             manipulator,
             waypoints.positions,
@@ -571,7 +618,7 @@ def cmd_check_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> i
         )
         degrees = waypoints.degrees
     baseline = reported_baseline(manipulator, result)
-    document = path_to_json(result, baseline, degrees)
+    document = path_to_json(result, baseline, degrees, waypoints.given)
     document["frame"] = "base"
     if record is not None:
         from ..logs.paths import check_path_request_fields
@@ -657,6 +704,7 @@ def check_path_arguments(sub: argparse.ArgumentParser) -> None:
         help="planned torsion: grid step, degrees (default %(default)g); the planner is "
         "complete on this grid",
     )
+    add_angles_option(sub)
     sub.add_argument(
         "--tol-deg",
         type=float,

@@ -25,7 +25,7 @@ from ..core.orientation import orientation_workspace, torsion_range
 from ..core.projected import projected_workspace
 from ..errors import ResolutionError, UnreachableReferenceError
 from . import reports
-from .inputs import CliError, poses_from_degrees
+from .inputs import CliError, GivenPoses, poses_from_degrees
 from .progress import ProgressBar
 
 __all__ = [
@@ -66,7 +66,7 @@ def _unreachable(
 
 def check_command(
     manipulator: Manipulator,
-    poses_deg: NDArray[np.float64],
+    poses_deg: NDArray[np.float64] | GivenPoses,
     *,
     as_json: bool = False,
     record: Path | None = None,
@@ -74,18 +74,24 @@ def check_command(
     out: IO[str],
     err: IO[str],
 ) -> int:
-    """``check``: reachability of poses (φ, θ, ψ in degrees, any finite values).
+    """``check``: reachability of poses (φ, θ, ψ in degrees, any finite values, or poses in
+    another convention, :class:`~hexapod_workspace.cli.inputs.GivenPoses`, echoed as given
+    beside their T&T angles).
 
     ``singularity`` reports the singularity margin even when ``limits.singularity_min`` is 0.
     Returns 0 when every pose is reachable, 1 when some is not (the count on ``err``).
     """
     started = time.time_ns()
-    result = check(manipulator, poses_from_degrees(poses_deg), singularity=singularity)
+    poses = poses_deg if isinstance(poses_deg, GivenPoses) else GivenPoses("tt", poses_deg)
+    degrees = poses.tt_degrees()
+    given = None if poses.is_tt else (poses.keys, poses.values)
+    radians = poses_from_degrees(degrees) if poses.is_tt else poses.radians()
+    result = check(manipulator, radians, singularity=singularity)
     _record(record, manipulator, [result], started, err)
     if as_json:
-        reports.check_json(result, out, poses_deg)
+        reports.check_json(result, out, degrees, given)
     else:
-        reports.check_table(result, out, poses_deg, manipulator)
+        reports.check_table(result, out, degrees, manipulator, given)
     unreachable = len(result) - int(np.count_nonzero(result.reachable))
     if unreachable:
         err.write(f"{PROG}: {unreachable} of {len(result)} poses unreachable\n")

@@ -7,9 +7,11 @@ and radians. The core still checks everything again; this layer only re-phrases.
 
 from __future__ import annotations
 
+import argparse
 import math
 import sys
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
 from typing import IO
 
@@ -20,17 +22,35 @@ from .._resources import example_config_path
 from ..core import resolution
 from ..core.frames import cell_from_params_file, tool_model
 from ..core.manipulator import Manipulator
-from ..core.rotations import degrees_to_radians
+from ..core.rotations import (
+    ANGLE_CONVENTIONS,
+    convention_to_tt,
+    degrees_to_radians,
+    tt_to_matrix,
+)
+from ..core.validation import machine_size, millimetre_reason, require_plausible_cell
 from ..errors import HexapodWorkspaceError, InputError
-from .tables import ANGLE_UNITS, Columns, parse_table
+from .tables import (
+    ORIENTATION_QUANTITIES,
+    Columns,
+    conventions_text,
+    orientation_columns,
+    orientation_header,
+    parse_table,
+)
 
 __all__ = [
     "PLOT_FORMATS",
     "POSE_COLUMNS",
     "CliError",
+    "GivenPoses",
+    "add_angles_option",
     "finite",
+    "given_poses",
     "load_manipulator",
     "output_file",
+    "plausible_positions",
+    "pose_flag",
     "poses_from_degrees",
     "psi_step_flag",
     "rays_flag",
@@ -101,6 +121,126 @@ def poses_from_degrees(degrees: NDArray[np.float64]) -> NDArray[np.float64]:
     return degrees_to_radians(degrees)
 
 
+# ---------------------------------------------------------------------------- conventions
+@dataclass(frozen=True)
+class GivenPoses:
+    """Orientations as the user gave them, in one convention (:data:`ANGLE_CONVENTIONS`).
+
+    Attributes
+    ----------
+    convention : str
+        ``tt``, ``xyz-moving``, ``xyz-fixed``, ``symetrie`` or ``quaternion``.
+    values : ndarray, shape (N, 3) or (N, 4)
+        As typed: angles in degrees (any finite values), or quaternions (x, y, z, w).
+    """
+
+    convention: str
+    values: NDArray[np.float64]
+
+    @property
+    def keys(self) -> list[str]:
+        """The JSON keys of the given numbers: ``u_deg, v_deg, w_deg`` or ``qx, qy, qz, qw``."""
+        return orientation_header(self.convention)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The names of the given numbers (``u``, ``v``, ``w``)."""
+        return ANGLE_CONVENTIONS[self.convention].components
+
+    @property
+    def is_tt(self) -> bool:
+        return self.convention == "tt"
+
+    def radians(self) -> NDArray[np.float64]:
+        """(φ, θ, ψ) in rad, shape (N, 3): ``tt`` each angle's principal value (exact for any
+        finite degrees), the others through their rotation matrix (canonical ranges)."""
+        if not ANGLE_CONVENTIONS[self.convention].angular:
+            return convention_to_tt(self.values, self.convention)
+        radians = degrees_to_radians(self.values)
+        return radians if self.is_tt else convention_to_tt(radians, self.convention)
+
+    def matrices(self) -> NDArray[np.float64]:
+        """Rotation matrices, shape (N, 3, 3): from each convention's own formula."""
+        if self.is_tt:
+            return tt_to_matrix(self.radians())
+        found = ANGLE_CONVENTIONS[self.convention]
+        return found.to_matrix(degrees_to_radians(self.values) if found.angular else self.values)
+
+    def echo(self, row: int = 0) -> str:
+        """One pose as typed, for text answers: ``u 10, v 5, w 0 deg (xyz-moving)``."""
+        unit = " deg" if ANGLE_CONVENTIONS[self.convention].angular else ""
+        numbers = ", ".join(
+            f"{n} {v:g}" for n, v in zip(self.names, self.values[row].tolist(), strict=True)
+        )
+        return f"{numbers}{unit} ({self.convention})"
+
+    def tt_degrees(self) -> NDArray[np.float64]:
+        """(φ, θ, ψ) in degrees, shape (N, 3): the values as typed for ``tt``."""
+        return self.values if self.is_tt else np.degrees(self.radians())
+
+
+def given_poses(values: NDArray[np.float64], convention: str, where: str) -> GivenPoses:
+    """Check orientations written in ``convention`` (finite; quaternions of non-zero norm).
+
+    Parameters
+    ----------
+    values : ndarray, shape (N, k)
+        k = 3 angles in degrees or k = 4 quaternion components.
+    convention : str
+        A key of :data:`ANGLE_CONVENTIONS`.
+    where : str
+        How messages name the source (``--pose``, ``poses file p.csv``).
+    """
+    values = np.asarray(values, dtype=np.float64)
+    if not ANGLE_CONVENTIONS[convention].angular:
+        norm = np.linalg.norm(values, axis=-1)
+        bad = np.flatnonzero(~(norm > 1e-12))
+        if bad.size:
+            shown = " ".join(f"{v:g}" for v in values[bad[0]].tolist())
+            msg = f"{where}: expected a quaternion qx qy qz qw of non-zero norm, got {shown}"
+            raise CliError(msg)
+    return GivenPoses(convention, values)
+
+
+def add_angles_option(parser: argparse.ArgumentParser) -> None:
+    """``--angles CONVENTION``: the convention of ``--pose`` and of the files' orientations."""
+    parser.add_argument(
+        "--angles",
+        choices=tuple(ANGLE_CONVENTIONS),
+        metavar="CONVENTION",
+        help="convention of the orientations given: tt (Tilt-and-Torsion phi theta psi, the "
+        "default), xyz-moving (PI's U V W: Rx(U) Ry(V) Rz(W)), xyz-fixed (LinuxCNC's A B C: "
+        "Rz(C) Ry(B) Rx(A)), symetrie (Symetrie's Rx Ry Rz: Rz(Rz) Ry(Ry) Rx(Rx)), quaternion "
+        "(qx qy qz qw); a file's columns name their own (docs/configuration.md)",
+    )
+
+
+def pose_flag(
+    values: list[list[float]] | list[float], convention: str | None, flag: str = "--pose"
+) -> GivenPoses:
+    """The orientations of a repeatable ``--pose`` (3 angles in degrees, or 4 quaternion
+    components), in the convention of ``--angles`` (default ``tt``)."""
+    name = convention or "tt"
+    found = ANGLE_CONVENTIONS[name]
+    rows: list[list[float]] = (
+        [list(values)]  # type: ignore[arg-type]  # one pose (nargs="+" without append)
+        if values and not isinstance(values[0], list)
+        else list(values)  # type: ignore[arg-type]
+    )
+    size = len(found.components)
+    for row in rows:
+        if len(row) != size:
+            words = " ".join(c.upper() for c in found.components)
+            unit = "degrees" if found.angular else "unitless"
+            msg = (
+                f"{flag}: expected {size} numbers {words} ({name}, {unit}), got {len(row)}: "
+                + " ".join(f"{v:g}" for v in row)
+            )
+            raise CliError(msg)
+    array = finite(rows, flag, "degrees" if found.angular else "quaternion components")
+    return given_poses(array.reshape(-1, size), name, flag)
+
+
 def load_manipulator(
     config: str | Path | None,
     position: NDArray[np.float64] | None,
@@ -119,19 +259,34 @@ def load_manipulator(
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         manipulator = Manipulator.from_params_file(path)
+    cell = require_plausible_cell(manipulator, cell_from_params_file(path))
     if with_tool:
-        manipulator = tool_model(manipulator, cell_from_params_file(path).tool)
+        manipulator = tool_model(manipulator, cell.tool)
     for warning in caught:
         err.write(f"hexapod-workspace: warning: {warning.message}\n")
     if position is None:
         return manipulator
     position = finite(position, "--position", "m")
+    plausible_positions(manipulator, position, "--position")
     try:
         resolution.validate_position(manipulator, position)
     except InputError as error:
         msg = "--position" + str(error).removeprefix("position")
         raise CliError(msg) from error
     return manipulator.with_position(position)
+
+
+def plausible_positions(
+    manipulator: Manipulator, positions: NDArray[np.float64], where: str
+) -> None:
+    """Refuse positions (m) that fit the machine only once divided by 1000, with the unit
+    hint (:func:`~hexapod_workspace.core.validation.millimetre_reason`), naming ``where``."""
+    size = machine_size(
+        manipulator.base_joints, manipulator.platform_joints, manipulator.home_position
+    )
+    reason = millimetre_reason(where, np.linalg.norm(np.atleast_2d(positions), axis=-1), size)
+    if reason is not None:
+        raise CliError(reason.replace("got ", "got a distance from the base origin of ", 1))
 
 
 def output_file(path: str | Path, flag: str, *, force: bool, suffixes: tuple[str, ...]) -> Path:
@@ -174,33 +329,40 @@ def output_file(path: str | Path, flag: str, *, force: bool, suffixes: tuple[str
 
 
 # ---------------------------------------------------------------------------- poses CSV
-#: The columns of a poses file: each angle in degrees or radians, named by the header.
-POSE_COLUMNS = Columns({"phi": ANGLE_UNITS, "theta": ANGLE_UNITS, "psi": ANGLE_UNITS})
-_POSE_DEFAULT = ["phi_deg", "theta_deg", "psi_deg"]
+#: The columns of a poses file: the orientation of one convention, each angle in degrees or
+#: radians (``u_deg``, ``u_rad``), the quaternion's components unitless.
+POSE_COLUMNS = Columns(ORIENTATION_QUANTITIES, expected=conventions_text())
 
 
-def read_poses_file(path: str | Path) -> NDArray[np.float64]:
-    """Read a CSV of poses (φ, θ, ψ), one pose per line (rules: :mod:`.tables`).
+def read_poses_file(path: str | Path, angles: str | None = None) -> GivenPoses:
+    """Read a CSV of poses, one pose per line (rules: :mod:`.tables`).
 
     With a header, the columns are read by name in any order, each angle in the unit it names
-    (``theta_deg``, ``phi_rad``); all three angles are required and any other name is refused.
-    Without a header, the columns are ``phi_deg,theta_deg,psi_deg``. ``-`` reads standard input
-    (as does ``/dev/stdin``, piped or not). Errors name the line of the file.
+    (``theta_deg``, ``phi_rad``); the header names one convention's columns, all of them
+    (``phi_deg,theta_deg,psi_deg``, ``u_deg,v_deg,w_deg``, ``a_deg,b_deg,c_deg``,
+    ``rx_deg,ry_deg,rz_deg`` or ``qx,qy,qz,qw``), and any other name is refused. Without a
+    header, the columns are those of ``angles`` (``phi_deg,theta_deg,psi_deg`` by default).
+    ``-`` reads standard input (as does ``/dev/stdin``, piped or not). Errors name the line of
+    the file.
 
     Parameters
     ----------
     path : str or pathlib.Path
+    angles : str, optional
+        The convention ``--angles`` names; a header of another convention is refused.
 
     Returns
     -------
-    ndarray, shape (N, 3)
-        (φ, θ, ψ) in degrees (as typed, or converted from the radians the header names).
+    GivenPoses
+        The convention and the values, shape (N, 3) in degrees (as typed, or converted from
+        the radians the header names) or (N, 4) quaternions.
 
     Raises
     ------
     InputError
-        Unreadable file, an unknown or incomplete header, a line without exactly 3 numbers,
-        NaN or infinite values, no poses.
+        Unreadable file, an unknown, incomplete or ambiguous header, a header of another
+        convention than ``angles``, a line with the wrong count of numbers, NaN or infinite
+        values, no poses.
     """
     name = "standard input" if str(path) == "-" else str(path)
     try:
@@ -215,18 +377,19 @@ def read_poses_file(path: str | Path) -> NDArray[np.float64]:
     except UnicodeDecodeError as error:
         msg = f"poses file {name} is not text"
         raise InputError(msg) from error
-    table = parse_table(text, f"poses file {name}", _POSE_DEFAULT, rows_name="poses")
+    default = orientation_header(angles or "tt")
+    where = f"poses file {name}"
+    table = parse_table(text, where, default, rows_name="poses")
     if table.header is None:
-        return table.values
-    columns = POSE_COLUMNS.read(table)
-    missing = [q for q in POSE_COLUMNS.quantities if q not in columns]
-    if missing:
+        return given_poses(table.values, angles or "tt", where)
+    found = orientation_columns(table, POSE_COLUMNS.read(table), angles)
+    if found is None:
         msg = (
-            f"poses file {name}, line {table.header_line}: no column for {missing[0]} "
-            f"(expected {POSE_COLUMNS.expected()})"
+            f"{where}, line {table.header_line}: no orientation columns "
+            f"(expected {conventions_text()})"
         )
         raise InputError(msg)
-    return np.column_stack([columns[q] for q in POSE_COLUMNS.quantities])
+    return given_poses(found[1], found[0], where)
 
 
 def core_error(error: HexapodWorkspaceError) -> str:

@@ -23,7 +23,6 @@ from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from .. import __version__
 from ..core import kernels, resolution
@@ -32,9 +31,12 @@ from . import atlas, cam, check_path, commands, reach, scene
 from .inputs import (
     PLOT_FORMATS,
     CliError,
+    GivenPoses,
+    add_angles_option,
     finite,
     load_manipulator,
     output_file,
+    pose_flag,
     psi_step_flag,
     rays_flag,
     read_poses_file,
@@ -155,18 +157,21 @@ def _manipulator(options: argparse.Namespace, err: IO[str]):
 def _check_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--pose",
-        nargs=3,
+        nargs="+",
         type=float,
         action="append",
-        metavar=("PHI", "THETA", "PSI"),
-        help="a pose in Tilt-and-Torsion angles, degrees, any finite values (repeatable)",
+        metavar="V",
+        help="a pose: PHI THETA PSI in Tilt-and-Torsion angles, degrees, any finite values, or "
+        "the 3 angles (4 quaternion components) of --angles (repeatable)",
     )
     parser.add_argument(
         "--poses-file",
         metavar="F",
-        help="CSV of lines phi_deg,theta_deg,psi_deg (header optional; ',' ';' tab or space "
-        "separated); - reads standard input",
+        help="CSV of lines phi_deg,theta_deg,psi_deg (header optional, it may name another "
+        "convention: u_deg,v_deg,w_deg, qx,qy,qz,qw, ...; ',' ';' tab or space separated); - "
+        "reads standard input",
     )
+    add_angles_option(parser)
     parser.add_argument(
         "--singularity",
         action="store_true",
@@ -177,18 +182,27 @@ def _check_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _check_run(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
-    parts: list[NDArray[np.float64]] = []
+    parts: list[GivenPoses] = []
     if options.pose:
-        parts.append(finite(options.pose, "--pose", "degrees").reshape(-1, 3))
+        parts.append(pose_flag(options.pose, options.angles))
     if options.poses_file:
-        parts.append(read_poses_file(options.poses_file))
+        from_file = read_poses_file(options.poses_file, options.angles)
+        if parts and options.angles is None and not from_file.is_tt:
+            msg = (
+                f"--poses-file {options.poses_file} names {from_file.convention} columns "
+                f"({','.join(from_file.keys)}) but --pose is in tt angles (no --angles); give "
+                f"--angles {from_file.convention} for both"
+            )
+            raise CliError(msg)
+        parts.append(from_file)
     if not parts:
         msg = "check: give at least one --pose PHI THETA PSI or a --poses-file"
         raise CliError(msg)
     record = _record_path(options)
+    poses = GivenPoses(parts[-1].convention, np.concatenate([part.values for part in parts]))
     return commands.check_command(
         _manipulator(options, err),
-        np.concatenate(parts),
+        poses,
         as_json=options.json,
         record=record,
         singularity=options.singularity,
@@ -300,6 +314,22 @@ def _torsion_range_run(options: argparse.Namespace, out: IO[str], err: IO[str]) 
         out=out,
         err=err,
     )
+
+
+# ---------------------------------------------------------------------------- check-path
+def _check_path_run(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
+    """``check-path``: ``--angles`` checked against the file before either pipeline runs (the
+    cell pipeline reads a CSV's convention from its columns; a CL file gives tool axes)."""
+    if options.angles is not None:
+        if cam.is_cl_file(options.file):
+            msg = (
+                f"--angles: a CL file gives tool axes, not angles; got --angles {options.angles} "
+                f"for {options.file}"
+            )
+            raise CliError(msg)
+        if cam.cell_pipeline_applies(options):
+            check_path.read_path_file(options.file, options.angles)  # refuses a mismatch
+    return cam.cmd_check_path_any(options, out, err)
 
 
 # ---------------------------------------------------------------------------- replay
@@ -420,7 +450,7 @@ for _command in (
         check_path.CHECK_PATH_HELP,
         check_path.CHECK_PATH_DESCRIPTION,
         cam.check_path_any_arguments,
-        cam.cmd_check_path_any,
+        _check_path_run,
         uses=("config", "json"),
     ),
     Command(

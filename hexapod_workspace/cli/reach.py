@@ -6,8 +6,11 @@ JSON (``--json``):
 * ``reach``: ``plus``, ``minus`` (the largest t ≥ 0 in each sense, units of t: the direction is
   used as given), ``limited_by_plus``, ``limited_by_minus`` (constraint names; empty when the
   search bound was reached), ``t_max``, ``start_reachable``, ``frame``, ``position`` (m, in the
-  frame), ``pose_deg``, ``direction`` ([DX, DY, DZ] m and [RX, RY, RZ] rad per unit t),
-  ``tolerance_deg``, ``tool``, ``work_frame``.
+  frame), ``pose_deg`` (T&T; a pose given in another convention, ``--angles``, adds ``angles``
+  and ``pose_given`` with its own keys, ``u_deg``, ``qx``), ``direction`` ([DX, DY, DZ] m and
+  [RX, RY, RZ] rad per unit t), ``tolerance_mm`` and ``tolerance_deg`` (the accuracies of
+  ``--tol-mm`` and ``--tol-deg``), ``accuracy_t`` (the step in t they give), ``tool``,
+  ``work_frame``.
 * ``axis-limits``: ``{"frame": ..., "axes": {"x": {"plus", "minus", "limited_by_plus",
   "limited_by_minus"}, "y", "z", "rx", "ry", "rz"}, ...}`` with translations in m and rotations
   in degrees (magnitudes ≥ 0), about axes through the tool centre point.
@@ -29,12 +32,28 @@ from numpy.typing import NDArray
 from .._resources import example_config_path
 from ..core.frames import CellFrames, Tool, cell_from_params_file, tool_model, work_to_base
 from ..core.manipulator import Manipulator
-from ..core.paths import DEFAULT_PATH_TOLERANCE
-from ..core.reach import AXES, DEFAULT_T_MAX, DEFAULT_T_MAX_ROTATION, Reach, axis_limits, reach
-from ..core.rotations import degrees_to_radians, tt_to_matrix
+from ..core.reach import (
+    AXES,
+    DEFAULT_T_MAX,
+    DEFAULT_T_MAX_ROTATION,
+    DEFAULT_TOL_ROTATION,
+    DEFAULT_TOL_TRANSLATION,
+    Reach,
+    axis_limits,
+    reach,
+)
+from ..core.validation import require_plausible_cell
 from .cam import tool_json, work_json
 from .commands import PROG
-from .inputs import CliError, finite, load_manipulator
+from .inputs import (
+    CliError,
+    GivenPoses,
+    add_angles_option,
+    finite,
+    load_manipulator,
+    plausible_positions,
+    pose_flag,
+)
 
 __all__ = [
     "AXIS_LIMITS_DESCRIPTION",
@@ -66,12 +85,13 @@ AXIS_LIMITS_DESCRIPTION = (
 def _common(parser: argparse.ArgumentParser, frames: tuple[str, ...]) -> None:
     parser.add_argument(
         "--pose",
-        nargs=3,
+        nargs="+",
         type=float,
-        default=[0.0, 0.0, 0.0],
-        metavar=("PHI", "THETA", "PSI"),
-        help="orientation of the tool, Tilt-and-Torsion angles, degrees (default 0 0 0)",
+        metavar="V",
+        help="orientation of the tool: PHI THETA PSI, Tilt-and-Torsion angles, degrees, or the "
+        "3 angles (4 quaternion components) of --angles (default: the identity, 0 0 0)",
     )
+    add_angles_option(parser)
     parser.add_argument(
         "--frame",
         choices=frames,
@@ -85,11 +105,19 @@ def _common(parser: argparse.ArgumentParser, frames: tuple[str, ...]) -> None:
         help="the tool of the tool table tools.T<N> (default: tool.*)",
     )
     parser.add_argument(
+        "--tol-mm",
+        type=float,
+        metavar="T",
+        help=f"accuracy of the translation limits (and of a direction's translation), mm "
+        f"(default {DEFAULT_TOL_TRANSLATION * 1e3:g}), whatever the tool's distance from the "
+        "platform joints",
+    )
+    parser.add_argument(
         "--tol-deg",
         type=float,
         metavar="T",
-        help=f"certified tolerance, degrees of platform rotation (default "
-        f"{math.degrees(DEFAULT_PATH_TOLERANCE):g}), as for check-path",
+        help=f"accuracy of the rotation limits (and of a direction's rotation), degrees "
+        f"(default {math.degrees(DEFAULT_TOL_ROTATION):g})",
     )
 
 
@@ -141,12 +169,14 @@ def _pose(
     NDArray[np.float64],
     NDArray[np.float64],
     NDArray[np.float64],
-    float,
+    tuple[float, float],
 ]:
     """Model (tool frame), cell, tool, rotation and position in the base frame, frame rotation,
-    tolerance."""
+    accuracies (m, rad)."""
     platform = load_manipulator(options.config, None, err, with_tool=False)
-    cell = cell_from_params_file(options.config or example_config_path())
+    cell = require_plausible_cell(
+        platform, cell_from_params_file(options.config or example_config_path())
+    )
     tool = cell.tool if options.tool is None else cell.select(options.tool)
     manipulator = tool_model(platform, tool)
     position = (
@@ -154,8 +184,9 @@ def _pose(
         if options.position is None
         else finite(options.position, "--position", "m")
     )
-    degrees = finite(options.pose, "--pose", "degrees")
-    rotation = tt_to_matrix(degrees_to_radians(degrees))
+    if options.position is not None:
+        plausible_positions(platform, position, "--position")
+    rotation = _given_pose(options).matrices()[0]
     frame_rotation = np.eye(3)
     if options.frame == "work":
         if options.position is None:
@@ -163,22 +194,55 @@ def _pose(
             raise CliError(msg)
         rotation, position = work_to_base(rotation, position, cell.work)
         frame_rotation = cell.work.rotation
-    tolerance = (
-        DEFAULT_PATH_TOLERANCE
-        if options.tol_deg is None
-        else math.radians(float(finite([options.tol_deg], "--tol-deg", "degrees")[0]))
+    accuracies = (
+        _accuracy(options.tol_mm, "--tol-mm", "mm", 1e-3, DEFAULT_TOL_TRANSLATION),
+        _accuracy(options.tol_deg, "--tol-deg", "degrees", math.radians(1.0), DEFAULT_TOL_ROTATION),
     )
-    return manipulator, cell, tool, rotation, position, frame_rotation, tolerance
+    return manipulator, cell, tool, rotation, position, frame_rotation, accuracies
+
+
+def _accuracy(value: float | None, flag: str, unit: str, factor: float, default: float) -> float:
+    """An accuracy typed in ``unit``, > 0, in SI (m or rad)."""
+    if value is None:
+        return default
+    number = float(finite([value], flag, unit)[0])
+    if not number > 0.0:
+        msg = f"{flag}: expected a value > 0 {unit}, got {number:g}"
+        raise CliError(msg)
+    return number * factor
+
+
+def _given_pose(options: argparse.Namespace) -> GivenPoses:
+    """``--pose`` in the convention of ``--angles`` (default: the identity)."""
+    convention = options.angles or "tt"
+    if options.pose is None:
+        identity = [0.0, 0.0, 0.0, 1.0] if convention == "quaternion" else [0.0, 0.0, 0.0]
+        return GivenPoses(convention, np.array([identity]))
+    return pose_flag(options.pose, convention)
 
 
 def _frames_json(options: argparse.Namespace, cell: CellFrames, tool: Tool) -> dict[str, Any]:
-    return {
+    """The pose and frames of the answer: ``pose_deg`` (T&T, as typed for tt) and, for a pose
+    given in another convention, ``angles`` and ``pose_given`` (its own keys: ``u_deg``)."""
+    given = _given_pose(options)
+    document: dict[str, Any] = {
         "frame": options.frame,
         "position": None if options.position is None else list(options.position),
-        "pose_deg": list(options.pose),
-        "tool": tool_json(tool),
-        "work_frame": work_json(cell.work),
+        "pose_deg": given.tt_degrees()[0].tolist(),
     }
+    if not given.is_tt:
+        document["angles"] = given.convention
+        document["pose_given"] = dict(zip(given.keys, given.values[0].tolist(), strict=True))
+    return {**document, "tool": tool_json(tool), "work_frame": work_json(cell.work)}
+
+
+def _pose_line(options: argparse.Namespace, out: IO[str]) -> None:
+    """For a pose given in another convention than T&T, one line: as given, then in T&T."""
+    given = _given_pose(options)
+    if given.is_tt:
+        return
+    phi, theta, psi = given.tt_degrees()[0].tolist()
+    out.write(f"pose: {given.echo()} = phi {phi:.6g}, theta {theta:.6g}, psi {psi:.6g} deg (tt)\n")
 
 
 def _limits_json(result: Reach, scale: float = 1.0) -> dict[str, Any]:
@@ -199,7 +263,7 @@ def _unreachable(result: Reach, err: IO[str]) -> int:
 
 def cmd_reach(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
     """``reach``: the largest steps along ±direction from the pose."""
-    manipulator, cell, tool, rotation, position, frame_rotation, tolerance = _pose(options, err)
+    manipulator, cell, tool, rotation, position, frame_rotation, accuracy = _pose(options, err)
     direction = finite(options.direction, "--direction", "m and rad")
     t_max = float(finite([options.t_max], "--t-max", "units of t")[0])
     result = reach(
@@ -209,19 +273,23 @@ def cmd_reach(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
         frame_rotation @ direction[:3],
         frame_rotation @ direction[3:],
         t_max=t_max,
-        tolerance=tolerance,
+        tol_translation=accuracy[0],
+        tol_rotation=accuracy[1],
     )
     document = {
         **_limits_json(result),
         "t_max": result.t_max,
         "start_reachable": result.start_reachable,
         "direction": {"translation": direction[:3].tolist(), "rotation": direction[3:].tolist()},
-        "tolerance_deg": math.degrees(tolerance),
+        "tolerance_mm": accuracy[0] * 1e3,
+        "tolerance_deg": math.degrees(accuracy[1]),
+        "accuracy_t": result.accuracy,
         **_frames_json(options, cell, tool),
     }
     if options.json:
         out.write(json.dumps(document, allow_nan=False) + "\n")
     else:
+        _pose_line(options, out)
         for sense in ("plus", "minus"):
             names = document[f"limited_by_{sense}"]
             why = ", ".join(names) if names else f"search bound t_max = {t_max:g} reached"
@@ -231,7 +299,7 @@ def cmd_reach(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
 
 def cmd_axis_limits(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
     """``axis-limits``: the ± reach along the six axes of a frame."""
-    manipulator, cell, tool, rotation, position, _, tolerance = _pose(options, err)
+    manipulator, cell, tool, rotation, position, _, accuracy = _pose(options, err)
     t_max = float(finite([options.max_translation], "--max-translation", "m")[0])
     rotation_max = float(finite([options.max_rotation_deg], "--max-rotation-deg", "degrees")[0])
     if not 0.0 < rotation_max < 180.0:
@@ -245,7 +313,8 @@ def cmd_axis_limits(options: argparse.Namespace, out: IO[str], err: IO[str]) -> 
         work=cell.work,
         t_max=t_max,
         t_max_rotation=math.radians(rotation_max),
-        tolerance=tolerance,
+        tol_translation=accuracy[0],
+        tol_rotation=accuracy[1],
     )
     document = {
         **_frames_json(options, cell, tool),
@@ -255,11 +324,13 @@ def cmd_axis_limits(options: argparse.Namespace, out: IO[str], err: IO[str]) -> 
         },
         "max_translation": t_max,
         "max_rotation_deg": rotation_max,
-        "tolerance_deg": math.degrees(tolerance),
+        "tolerance_mm": accuracy[0] * 1e3,
+        "tolerance_deg": math.degrees(accuracy[1]),
     }
     if options.json:
         out.write(json.dumps(document, allow_nan=False) + "\n")
     else:
+        _pose_line(options, out)
         out.write(f"axis limits in the {options.frame} frame (translations m, rotations deg)\n")
         for k, name in enumerate(AXES):
             axis = document["axes"][name]

@@ -79,19 +79,28 @@ def _write_rows(out: IO[str], template: str, columns: Sequence[Sequence[Any]], s
         out.write(text if start + block >= count else text + sep)
 
 
-def check_json(result: CheckResult, out: IO[str], degrees: NDArray[np.float64]) -> None:
+def check_json(
+    result: CheckResult,
+    out: IO[str],
+    degrees: NDArray[np.float64],
+    given: tuple[list[str], NDArray[np.float64]] | None = None,
+) -> None:
     """Write ``{"position": [...], "poses": [...]}`` for a check result, streaming.
 
     One object per pose in input order with ``phi_deg, theta_deg, psi_deg`` (as the user gave
-    them), ``reachable, violated, margins{...}`` (signed, SI: m, rad; null when a check is
-    disabled) and ``limiting_leg``. Numbers carry 12 significant digits.
+    them, or converted from the convention given), ``reachable, violated, margins{...}``
+    (signed, SI: m, rad; null when a check is disabled) and ``limiting_leg``; a pose given in
+    another convention than T&T starts with its own numbers (``u_deg, v_deg, w_deg``,
+    ``qx, qy, qz, qw``). Numbers carry 12 significant digits.
 
     Parameters
     ----------
     result : CheckResult
     out : text stream
     degrees : ndarray, shape (N, 3)
-        The poses as the user gave them, degrees.
+        The poses in T&T angles, degrees (as the user gave them for T&T).
+    given : (list of str, ndarray of shape (N, k)), optional
+        The JSON keys and the values of the convention the poses were given in, when not T&T.
     """
     texts: dict[tuple[str, ...], str] = {}
     violated = [texts.setdefault(tuple(v), json.dumps(v)) for v in result.violated]
@@ -106,11 +115,14 @@ def check_json(result: CheckResult, out: IO[str], degrees: NDArray[np.float64]) 
     # 12 significant digits: exact to 1e-12 relative, and twice as fast to format as repr().
     margin_fields = ", ".join(f'"{name}": {"%.12g" if finite[name] else "%s"}' for name in names)
     pair = ', "collision_pair": %s' if result.collision_pairs else ""
+    given_fields = "".join(f'"{key}": %.12g, ' for key in given[0]) if given else ""
     template = (
-        '{"phi_deg": %.12g, "theta_deg": %.12g, "psi_deg": %.12g, "reachable": %s, "violated": %s, '
+        f'{{{given_fields}"phi_deg": %.12g, "theta_deg": %.12g, "psi_deg": %.12g, '
+        '"reachable": %s, "violated": %s, '
         f'"margins": {{{margin_fields}}}, "limiting_leg": %d{pair}}}'
     )
     columns = [
+        *(np.asarray(given[1]).T.tolist() if given else []),
         *np.asarray(degrees).T.tolist(),
         np.where(result.reachable, "true", "false").tolist(),
         violated,
@@ -130,12 +142,15 @@ def check_table(
     out: IO[str],
     degrees: NDArray[np.float64],
     manipulator: Manipulator,
+    given: tuple[list[str], NDArray[np.float64]] | None = None,
 ) -> None:
     """Write a readable table: angles in degrees, margins (distance to each limit) in mm and
     degrees, the limiting leg and the violated constraints.
 
     Parameters are those of :func:`check_json`, and the model the result is of (the unit of a
-    row can depend on it: the ``actuator`` stroke in mm for slides, deg for cranks).
+    row can depend on it: the ``actuator`` stroke in mm for slides, deg for cranks). Poses given
+    in another convention than T&T get their own columns first (``u``, ``v``, ``w`` [deg],
+    ``qx`` ... [1]), then the T&T angles they denote.
     """
     x, y, z = result.position
     out.write(f"position: ({x:.4f}, {y:.4f}, {z:.4f}) m\n")
@@ -154,11 +169,20 @@ def check_table(
     report = [row.report(manipulator) for row in shown]  # (unit, factor), read once
     names = " ".join(f"{row.column:>11}" for row in shown)
     units = " ".join(f"{'[' + unit + ']':>11}" for unit, _ in report)
+    given_names, given_units, given_format, given_columns = "", "", "", []
+    if given is not None:
+        keys, values = given
+        angular = keys[0].endswith("_deg")
+        given_names = "".join(f"{key.removesuffix('_deg'):>9} " for key in keys)
+        given_units = "".join(f"{'[deg]' if angular else '[1]':>9} " for _ in keys)
+        given_format = ("%9.3f " if angular else "%9.6f ") * len(keys)
+        given_columns = np.asarray(values).T.tolist()
     header = (
+        f"{' ' * len(given_names)}"
         f"{'':>9} {'':>9} {'':>9}  {'':<9}  {'margin to each limit (>= 0 holds, < 0 violated)'}",
-        f"{'phi':>9} {'theta':>9} {'psi':>9}  {'reachable':<9}  {names}  {'limiting':>8}  violated"
-        + ("  closest pair" if result.collision_pairs else ""),
-        f"{'[deg]':>9} {'[deg]':>9} {'[deg]':>9}  {'':<9}  {units}  {'leg':>8}",
+        f"{given_names}{'phi':>9} {'theta':>9} {'psi':>9}  {'reachable':<9}  {names}  "
+        f"{'limiting':>8}  violated" + ("  closest pair" if result.collision_pairs else ""),
+        f"{given_units}{'[deg]':>9} {'[deg]':>9} {'[deg]':>9}  {'':<9}  {units}  {'leg':>8}",
     )
     out.write("".join(line.rstrip() + "\n" for line in header))
     degrees = np.asarray(degrees)
@@ -168,8 +192,9 @@ def check_table(
         if wide
         else degrees.T.tolist()
     )
-    angle_format = "%s %s %s" if wide else "%9.3f %9.3f %9.3f"
+    angle_format = given_format + ("%s %s %s" if wide else "%9.3f %9.3f %9.3f")
     columns = [
+        *given_columns,
         *angle_columns,
         np.where(result.reachable, "yes", "NO").tolist(),
         *(

@@ -24,9 +24,22 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from ..core.rotations import ANGLE_CONVENTIONS
 from ..errors import InputError
 
-__all__ = ["ANGLE_UNITS", "LENGTH_UNITS", "PLAIN", "Columns", "Table", "parse_table", "split"]
+__all__ = [
+    "ANGLE_UNITS",
+    "LENGTH_UNITS",
+    "ORIENTATION_QUANTITIES",
+    "PLAIN",
+    "Columns",
+    "Table",
+    "conventions_text",
+    "orientation_columns",
+    "orientation_header",
+    "parse_table",
+    "split",
+]
 
 #: Units an angle column may name, with the factor to degrees.
 ANGLE_UNITS: Mapping[str, float] = {"deg": 1.0, "rad": 180.0 / math.pi}
@@ -34,6 +47,35 @@ ANGLE_UNITS: Mapping[str, float] = {"deg": 1.0, "rad": 180.0 / math.pi}
 LENGTH_UNITS: Mapping[str, float] = {"": 1.0, "m": 1.0, "mm": 1e-3}
 #: A unitless column (components of a direction).
 PLAIN: Mapping[str, float] = {"": 1.0}
+#: The orientation columns of every convention (:data:`ANGLE_CONVENTIONS`): angles in degrees or
+#: radians (``u_deg``, ``u_rad``), quaternion components unitless (``qx``).
+ORIENTATION_QUANTITIES: Mapping[str, Mapping[str, float]] = {
+    name: ANGLE_UNITS if convention.angular else PLAIN
+    for convention in ANGLE_CONVENTIONS.values()
+    for name in convention.components
+}
+
+
+def orientation_header(convention: str) -> list[str]:
+    """The orientation columns of ``convention`` as a header spells them (``u_deg, ...``)."""
+    found = ANGLE_CONVENTIONS[convention]
+    return [f"{n}_deg" if found.angular else n for n in found.components]
+
+
+def conventions_text() -> str:
+    """The orientation columns a file may name, for messages (T&T first, spelled in full)."""
+    tt = ", ".join(f"{n}_deg or {n}_rad" for n in ANGLE_CONVENTIONS["tt"].components)
+    others = [
+        f"{','.join(orientation_header(name))} ({name})"
+        for name, c in ANGLE_CONVENTIONS.items()
+        if name != "tt" and c.angular
+    ]
+    quaternions = [
+        f"{','.join(orientation_header(name))} ({name})"
+        for name, c in ANGLE_CONVENTIONS.items()
+        if not c.angular
+    ]
+    return f"{tt}; or {', '.join(others)}, each also _rad; or {', '.join(quaternions)}"
 
 
 def split(line: str) -> list[str]:
@@ -154,14 +196,19 @@ class Columns:
         (unit suffix to the factor to the quantity's reading unit: degrees, metres).
     """
 
-    def __init__(self, quantities: Mapping[str, Mapping[str, float]]) -> None:
+    def __init__(
+        self, quantities: Mapping[str, Mapping[str, float]], expected: str | None = None
+    ) -> None:
         self.quantities = dict(quantities)
+        self._expected = expected
 
     def _spelled(self, quantity: str) -> str:
         units = self.quantities[quantity]
         return " or ".join(f"{quantity}_{u}" if u else quantity for u in units)
 
     def expected(self) -> str:
+        if self._expected is not None:
+            return self._expected
         return ", ".join(self._spelled(q) for q in self.quantities)
 
     def read(self, table: Table) -> dict[str, NDArray[np.float64]]:
@@ -203,3 +250,88 @@ class Columns:
                 raise InputError(msg)
             found[quantity] = (index, units[unit], cell)
         return {q: table.values[:, i] * factor for q, (i, factor, _) in found.items()}
+
+
+def orientation_columns(
+    table: Table,
+    columns: Mapping[str, NDArray[np.float64]],
+    angles: str | None,
+    flag: str = "--angles",
+    *,
+    incomplete: str | None = None,
+) -> tuple[str, NDArray[np.float64]] | None:
+    """The orientation a header names: its convention and its columns, in the convention's order.
+
+    A file's convention must be unambiguous: the columns of two conventions (``phi_deg`` beside
+    ``u_deg``), an incomplete set, or a convention other than the one ``--angles`` names are
+    refused in one line naming the columns.
+
+    Parameters
+    ----------
+    table : Table
+        The file (for its name and header line).
+    columns : mapping
+        :meth:`Columns.read` of the file: quantity name to its column, degrees or unitless.
+    angles : str or None
+        The convention ``--angles`` gave, or None when the flag was not given.
+    flag : str
+        How the flag is named in messages.
+    incomplete : str, optional
+        The message of an incomplete convention (default: the first missing column named).
+
+    Returns
+    -------
+    tuple (str, ndarray of shape (N, k)) or None
+        The convention and its columns (degrees, or the quaternion's components); None when the
+        header names no orientation column.
+
+    Raises
+    ------
+    InputError
+        Two conventions' columns, an incomplete convention, or one that ``--angles`` does not
+        name.
+    """
+    where = f"{table.where}, line {table.header_line}"
+    named = {
+        name: [c for c in convention.components if c in columns]
+        for name, convention in ANGLE_CONVENTIONS.items()
+    }
+    present = [name for name, found in named.items() if found]
+    if not present:
+        return None
+    header = {q: cell for q, cell in zip(_quantities(table), table.header or [], strict=True)}
+    if len(present) > 1:
+        shown = "; ".join(
+            f"{','.join(header[c] for c in named[name])} ({name})" for name in present
+        )
+        msg = f"{where}: columns of {len(present)} angle conventions: {shown}; expected one"
+        raise InputError(msg)
+    convention = present[0]
+    if angles is not None and convention != angles:
+        msg = (
+            f"{where}: columns {','.join(header[c] for c in named[convention])} are "
+            f"{convention} angles but {flag} is {angles} (expected "
+            f"{','.join(orientation_header(angles))}, or {flag} {convention})"
+        )
+        raise InputError(msg)
+    components = ANGLE_CONVENTIONS[convention].components
+    missing = [c for c in components if c not in columns]
+    if missing:
+        msg = incomplete or (
+            f"{where}: no column for {missing[0]} (expected "
+            f"{','.join(orientation_header(convention))} for {convention} angles)"
+        )
+        raise InputError(msg)
+    return convention, np.column_stack([columns[c] for c in components])
+
+
+def _quantities(table: Table) -> list[str]:
+    """The quantity each header cell names (as :meth:`Columns.read` reads it)."""
+    found = []
+    for cell in table.header or []:
+        name = cell.strip().lower()
+        if name in ORIENTATION_QUANTITIES:
+            found.append(name)
+        else:
+            found.append(name.rpartition("_")[0] if "_" in name else name)
+    return found

@@ -30,7 +30,13 @@ from .params import (
     unknown_parameter,
 )
 from .resolution import MAX_POSITION_NORM
-from .validation import coincident_joints_reason, require_usable, unusable_reason
+from .validation import (
+    coincident_joints_reason,
+    machine_size,
+    millimetre_reason,
+    require_usable,
+    unusable_reason,
+)
 
 if TYPE_CHECKING:
     from .collision.params import CollisionScene
@@ -616,6 +622,14 @@ class Manipulator:
             if np.any(length_min < 0.0):
                 msg = f"limits.leg_length_min: expected values >= 0 m, got {length_min.min():g}"
                 raise GeometryError(msg)
+            size = machine_size(base_joints, platform_joints, home)
+            for name, limit in (
+                ("limits.leg_length_min", length_min),
+                ("limits.leg_length_max", length_max),
+            ):
+                unit_reason = millimetre_reason(name, limit, size)
+                if unit_reason is not None:
+                    raise GeometryError(unit_reason)
             legs: dict[str, Any] = {}
         else:
             legs = _architecture_parts(architecture, values)

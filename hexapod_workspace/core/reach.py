@@ -17,6 +17,15 @@ move certificate of :func:`hexapod_workspace.check_path`:
    candidate reach is t₁ − h, and the move from 0 to it is checked again (its own violation, if
    any, gives a smaller candidate), until a check is ok.
 
+The step ``h`` is the accuracy of the reach in t. It is chosen from tolerances in the units of
+the motion, not from an angle of the platform: ``h = min(tol_translation / |d|,
+tol_rotation / |r|)`` (m and rad), and the move certificate's tolerance is set to
+``h·(|r| + |d|/ρ)`` so that its step is exactly ``h``. So a translation limit is within
+``tol_translation`` (default 0.01 mm) of the boundary and a rotation limit within
+``tol_rotation`` (default 0.001°) whatever the distance ρ from the tool centre point to the
+platform joints (an angle tolerance of the platform would give ρ times it in a translation:
+0.47 mm for 0.01° at 2.7 m).
+
 So the move from the pose to the reported reach holds (certified to the tolerance), and the pose
 t₁ just beyond it (within ``h`` plus the tolerance) violates the constraints named in
 ``limited_by``. A start pose that is itself unreachable has reach 0, limited by its violated
@@ -35,11 +44,13 @@ from ..errors import InputError
 from .constraints import check
 from .frames import WorkFrame
 from .manipulator import Manipulator
-from .paths import DEFAULT_PATH_TOLERANCE, check_path
+from .paths import check_path
 from .rotations import matrix_to_tt
 
 __all__ = [
     "AXES",
+    "DEFAULT_TOL_ROTATION",
+    "DEFAULT_TOL_TRANSLATION",
     "DEFAULT_T_MAX",
     "DEFAULT_T_MAX_ROTATION",
     "Reach",
@@ -57,6 +68,12 @@ DEFAULT_T_MAX_ROTATION = math.pi / 2.0
 AXES = ("x", "y", "z", "rx", "ry", "rz")
 #: Re-checks after the first violation (each moves the candidate below a found violation).
 MAX_RETRIES = 30
+#: Default accuracy of a translation limit, m (0.01 mm).
+DEFAULT_TOL_TRANSLATION = 1e-5
+#: Default accuracy of a rotation limit, rad (0.001°).
+DEFAULT_TOL_ROTATION = math.radians(0.001)
+#: The move certificate's tolerance range, rad (:func:`hexapod_workspace.check_path`).
+_PATH_TOLERANCE_RANGE = (1e-9, 0.1)
 
 
 @dataclass(frozen=True)
@@ -74,7 +91,9 @@ class Reach:
     start_reachable : bool
         The pose itself is reachable (if not, both reaches are 0).
     tolerance : float
-        rad of platform rotation, as for :func:`hexapod_workspace.check_path`.
+        rad of platform rotation, the move certificate's (:func:`hexapod_workspace.check_path`).
+    accuracy : float
+        The step h in units of t: the boundary lies within ``plus + accuracy`` (likewise minus).
     """
 
     plus: float
@@ -84,6 +103,7 @@ class Reach:
     t_max: float
     start_reachable: bool
     tolerance: float
+    accuracy: float = math.nan
 
 
 def rotation_vector_matrix(vector: ArrayLike) -> NDArray[np.float64]:
@@ -114,9 +134,8 @@ def _one_sense(
     turn: NDArray[np.float64],
     t_max: float,
     tolerance: float,
+    step: float,
 ) -> tuple[float, list[str]]:
-    rho = float(np.max(np.linalg.norm(manipulator.platform_joints, axis=1)))
-    step = tolerance / (float(np.linalg.norm(turn)) + float(np.linalg.norm(translation)) / rho)
     t_end = t_max
     limited: list[str] = []
     for _ in range(MAX_RETRIES):
@@ -145,7 +164,9 @@ def reach(
     turn: ArrayLike,
     *,
     t_max: float = DEFAULT_T_MAX,
-    tolerance: float = DEFAULT_PATH_TOLERANCE,
+    tolerance: float | None = None,
+    tol_translation: float = DEFAULT_TOL_TRANSLATION,
+    tol_rotation: float = DEFAULT_TOL_ROTATION,
 ) -> Reach:
     """Largest steps from a pose along ±(d, r) (see the module documentation).
 
@@ -163,8 +184,14 @@ def reach(
         r, rotation vector, base frame, rad per unit t (about an axis through p).
     t_max : float
         Search bound, > 0, with t_max·|r| < π.
-    tolerance : float
-        As for :func:`hexapod_workspace.check_path`, rad.
+    tolerance : float, optional
+        An upper bound of the move certificate's tolerance, rad (default: the one the
+        accuracies below need).
+    tol_translation : float
+        Accuracy of the reach in the translation, m (> 0): the boundary lies within
+        ``tol_translation / |d|`` in t of the reach.
+    tol_rotation : float
+        Accuracy of the reach in the rotation, rad (> 0): within ``tol_rotation / |r|`` in t.
 
     Returns
     -------
@@ -173,7 +200,7 @@ def reach(
     Raises
     ------
     InputError
-        Non-finite values, a zero direction, a bad search bound.
+        Non-finite values, a zero direction, a bad search bound or accuracy.
     """
     rotation = np.asarray(rotation, dtype=np.float64)
     if rotation.shape != (3, 3) or not np.all(np.isfinite(rotation)):
@@ -194,13 +221,30 @@ def reach(
             f"{t_max:g}·{float(np.linalg.norm(turn)):g}"
         )
         raise InputError(msg)
+    for name, value in (("tol_translation", tol_translation), ("tol_rotation", tol_rotation)):
+        if not (math.isfinite(value) and value > 0.0):
+            msg = f"{name}: expected a finite value > 0, got {value!r}"
+            raise InputError(msg)
+    speed, spin = float(np.linalg.norm(translation)), float(np.linalg.norm(turn))
+    step = min(
+        tol_translation / speed if speed else math.inf, tol_rotation / spin if spin else math.inf
+    )
+    rho = float(np.max(np.linalg.norm(manipulator.platform_joints, axis=1))) or 1.0
+    low, high = _PATH_TOLERANCE_RANGE
+    path_tolerance = min(step * (spin + speed / rho), high if tolerance is None else tolerance)
+    path_tolerance = max(path_tolerance, low)
+    step = min(step, path_tolerance / (spin + speed / rho))  # the certificate's own step
     start = check(manipulator, matrix_to_tt(rotation), position)
     if not bool(start.reachable[0]):
         violated = start.violated[0]
-        return Reach(0.0, 0.0, violated, list(violated), t_max, False, tolerance)
-    plus = _one_sense(manipulator, rotation, position, translation, turn, t_max, tolerance)
-    minus = _one_sense(manipulator, rotation, position, -translation, -turn, t_max, tolerance)
-    return Reach(plus[0], minus[0], plus[1], minus[1], t_max, True, tolerance)
+        return Reach(0.0, 0.0, violated, list(violated), t_max, False, path_tolerance, step)
+    plus = _one_sense(
+        manipulator, rotation, position, translation, turn, t_max, path_tolerance, step
+    )
+    minus = _one_sense(
+        manipulator, rotation, position, -translation, -turn, t_max, path_tolerance, step
+    )
+    return Reach(plus[0], minus[0], plus[1], minus[1], t_max, True, path_tolerance, step)
 
 
 def axis_limits(
@@ -212,7 +256,9 @@ def axis_limits(
     work: WorkFrame | None = None,
     t_max: float = DEFAULT_T_MAX,
     t_max_rotation: float = DEFAULT_T_MAX_ROTATION,
-    tolerance: float = DEFAULT_PATH_TOLERANCE,
+    tolerance: float | None = None,
+    tol_translation: float = DEFAULT_TOL_TRANSLATION,
+    tol_rotation: float = DEFAULT_TOL_ROTATION,
 ) -> dict[str, Reach]:
     """The ± reach along the six axes of a frame at a pose.
 
@@ -230,8 +276,12 @@ def axis_limits(
         Search bound of the translations, m.
     t_max_rotation : float
         Search bound of the rotations, rad (< π).
-    tolerance : float
+    tolerance : float, optional
         rad, as for :func:`reach`.
+    tol_translation : float
+        Accuracy of the translation limits, m (default 0.01 mm).
+    tol_rotation : float
+        Accuracy of the rotation limits, rad (default 0.001°).
 
     Returns
     -------
@@ -258,7 +308,15 @@ def axis_limits(
         unit = axes[:, k % 3]
         if k < 3:
             limits[name] = reach(
-                manipulator, rotation, position, unit, zero, t_max=t_max, tolerance=tolerance
+                manipulator,
+                rotation,
+                position,
+                unit,
+                zero,
+                t_max=t_max,
+                tolerance=tolerance,
+                tol_translation=tol_translation,
+                tol_rotation=tol_rotation,
             )
         else:
             limits[name] = reach(
@@ -269,5 +327,7 @@ def axis_limits(
                 unit,
                 t_max=t_max_rotation,
                 tolerance=tolerance,
+                tol_translation=tol_translation,
+                tol_rotation=tol_rotation,
             )
     return limits

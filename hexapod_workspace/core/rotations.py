@@ -17,9 +17,24 @@ cosine of each input angle (numpy reduces the argument exactly) before angles ar
 
 Quaternions are ``(x, y, z, w)``, scalar last, as in ROS ``geometry_msgs/Quaternion``.
 All functions take arrays of any leading shape ``(...)`` and broadcast like numpy.
+
+The controllers' conventions (:data:`ANGLE_CONVENTIONS`, docs/configuration.md "Poses in the
+controllers' conventions"), each read into T&T by :func:`convention_to_tt`:
+
+* ``xyz-moving`` (U, V, W), PI's hexapods: ``R = Rx(U) · Ry(V) · Rz(W)``, rotations about the
+  axes moving with the platform, U first, then V, then W;
+* ``xyz-fixed`` (A, B, C), LinuxCNC ``genhexkins``: ``R = Rz(C) · Ry(B) · Rx(A)``, roll, pitch
+  and yaw about the fixed axes, A first;
+* ``symetrie`` (Rx, Ry, Rz), Symétrie's hexapods: their "Euler type II" convention, rotations
+  about the fixed axes X0, then Y0, then Z0, ``R = Rz(Rz) · Ry(Ry) · Rx(Rx)`` (the matrix of
+  ``xyz-fixed``, under Symétrie's names);
+* ``quaternion`` (qx, qy, qz, qw), as ROS.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -27,9 +42,13 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import InputError
 
 __all__ = [
+    "ANGLE_CONVENTIONS",
+    "AngleConvention",
     "approach_to_tilt",
     "approach_vector",
     "axis_angle_to_quaternion",
+    "convention_to_matrix",
+    "convention_to_tt",
     "degrees_to_radians",
     "matrix_to_quaternion",
     "matrix_to_tt",
@@ -43,6 +62,8 @@ __all__ = [
     "tt_to_quaternion",
     "tt_to_zyz",
     "wrap_angle",
+    "xyz_fixed_to_matrix",
+    "xyz_moving_to_matrix",
     "zyz_to_matrix",
     "zyz_to_tt",
 ]
@@ -575,3 +596,169 @@ def quaternion_slerp(first: ArrayLike, second: ArrayLike, s: ArrayLike) -> NDArr
     result = weight_first * first + weight_second * second
     unit: NDArray[np.float64] = result / np.linalg.norm(result, axis=-1, keepdims=True)
     return unit
+
+
+# ---------------------------------------------------------------------------- controllers
+def _axis_rotations(
+    angles: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Rx(a₀), Ry(a₁), Rz(a₂) of ``angles`` (..., 3), each shape (..., 3, 3)."""
+    c, s = np.cos(angles), np.sin(angles)
+    shape = (*angles.shape[:-1], 3, 3)
+    rx, ry, rz = np.zeros(shape), np.zeros(shape), np.zeros(shape)
+    rx[..., 0, 0] = 1.0
+    rx[..., 1, 1], rx[..., 1, 2] = c[..., 0], -s[..., 0]
+    rx[..., 2, 1], rx[..., 2, 2] = s[..., 0], c[..., 0]
+    ry[..., 1, 1] = 1.0
+    ry[..., 0, 0], ry[..., 0, 2] = c[..., 1], s[..., 1]
+    ry[..., 2, 0], ry[..., 2, 2] = -s[..., 1], c[..., 1]
+    rz[..., 2, 2] = 1.0
+    rz[..., 0, 0], rz[..., 0, 1] = c[..., 2], -s[..., 2]
+    rz[..., 1, 0], rz[..., 1, 1] = s[..., 2], c[..., 2]
+    return rx, ry, rz
+
+
+def xyz_moving_to_matrix(angles: ArrayLike) -> NDArray[np.float64]:
+    """Rotation matrices ``Rx(U) · Ry(V) · Rz(W)`` (PI's U, V, W).
+
+    Rotations about the axes that move with the platform: U about x, then V about the y axis
+    the first rotation carried, then W about the z axis the first two carried.
+
+    Parameters
+    ----------
+    angles : array_like, shape (..., 3)
+        (U, V, W) in rad, any finite values.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        Rotation matrices of the mobile frame in the base frame.
+    """
+    rx, ry, rz = _axis_rotations(_last_axis(angles, 3, "angles"))
+    matrix: NDArray[np.float64] = rx @ ry @ rz
+    return matrix
+
+
+def xyz_fixed_to_matrix(angles: ArrayLike) -> NDArray[np.float64]:
+    """Rotation matrices ``Rz(C) · Ry(B) · Rx(A)`` (LinuxCNC's A, B, C; Symétrie's Rx, Ry, Rz).
+
+    Rotations about the fixed base axes: A about x first, then B about y, then C about z.
+
+    Parameters
+    ----------
+    angles : array_like, shape (..., 3)
+        (A, B, C) in rad, any finite values.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        Rotation matrices of the mobile frame in the base frame.
+    """
+    rx, ry, rz = _axis_rotations(_last_axis(angles, 3, "angles"))
+    matrix: NDArray[np.float64] = rz @ ry @ rx
+    return matrix
+
+
+@dataclass(frozen=True)
+class AngleConvention:
+    """One way of writing an orientation.
+
+    Attributes
+    ----------
+    name : str
+        What ``--angles`` takes (``"xyz-moving"``).
+    components : tuple of str
+        The names of its numbers, as CSV columns and JSON keys spell them (``("u", "v", "w")``).
+    angular : bool
+        True for angles (rad in the core, degrees or radians in files), False for the
+        quaternion's unitless components.
+    formula : str
+        The rotation it denotes, in words.
+    to_matrix : callable
+        ``(..., len(components))`` (rad) to rotation matrices ``(..., 3, 3)``.
+    """
+
+    name: str
+    components: tuple[str, ...]
+    angular: bool
+    formula: str
+    to_matrix: Callable[[ArrayLike], NDArray[np.float64]]
+
+
+#: Every convention a pose may be given in, by ``--angles`` name; ``tt`` first (the default).
+ANGLE_CONVENTIONS: dict[str, AngleConvention] = {
+    c.name: c
+    for c in (
+        AngleConvention(
+            "tt", ("phi", "theta", "psi"), True, "Rz(phi) Ry(theta) Rz(-phi) Rz(psi)", tt_to_matrix
+        ),
+        AngleConvention(
+            "xyz-moving", ("u", "v", "w"), True, "Rx(u) Ry(v) Rz(w)", xyz_moving_to_matrix
+        ),
+        AngleConvention(
+            "xyz-fixed", ("a", "b", "c"), True, "Rz(c) Ry(b) Rx(a)", xyz_fixed_to_matrix
+        ),
+        AngleConvention(
+            "symetrie", ("rx", "ry", "rz"), True, "Rz(rz) Ry(ry) Rx(rx)", xyz_fixed_to_matrix
+        ),
+        AngleConvention(
+            "quaternion",
+            ("qx", "qy", "qz", "qw"),
+            False,
+            "unit quaternion, scalar last",
+            quaternion_to_matrix,
+        ),
+    )
+}
+
+
+def _convention(name: str) -> AngleConvention:
+    try:
+        return ANGLE_CONVENTIONS[name]
+    except KeyError:
+        msg = f"angles: expected one of {', '.join(ANGLE_CONVENTIONS)}, got {name!r}"
+        raise InputError(msg) from None
+
+
+def convention_to_matrix(values: ArrayLike, convention: str) -> NDArray[np.float64]:
+    """Rotation matrices of orientations written in ``convention``.
+
+    Parameters
+    ----------
+    values : array_like, shape (..., 3) or (..., 4)
+        Angles in rad (any finite values) or quaternions (x, y, z, w), any non-zero norm.
+    convention : str
+        A key of :data:`ANGLE_CONVENTIONS`.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        Rotation matrices of the mobile frame in the base frame.
+    """
+    found = _convention(convention)
+    _last_axis(values, len(found.components), found.name)
+    return found.to_matrix(values)
+
+
+def convention_to_tt(values: ArrayLike, convention: str) -> NDArray[np.float64]:
+    """T&T angles of orientations written in ``convention``.
+
+    ``tt`` is returned unchanged (no round trip through a matrix); every other convention goes
+    through its rotation matrix and :func:`matrix_to_tt`, so the result is in the canonical
+    ranges and defined at θ = 0 (φ = 0, the whole rotation in ψ).
+
+    Parameters
+    ----------
+    values : array_like, shape (..., 3) or (..., 4)
+        As :func:`convention_to_matrix`.
+    convention : str
+        A key of :data:`ANGLE_CONVENTIONS`.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        (φ, θ, ψ) in rad; φ ∈ (−π, π], θ ∈ [0, π], ψ ∈ (−π, π] except for ``tt`` (as given).
+    """
+    if _convention(convention).name == "tt":
+        return _last_axis(values, 3, "tt")
+    return matrix_to_tt(convention_to_matrix(values, convention))

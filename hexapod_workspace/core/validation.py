@@ -18,6 +18,14 @@ and the CLI's all end here.
 * **An unreachable home pose** (:func:`unusable_reason`): the home pose is where the machine is
   assembled; a model that cannot take it is almost always a unit mistake (millimetres in a file
   of metres, degrees for radians) and is refused with that hint.
+* **Values in millimetres** (:func:`millimetre_reason`, the one unit rule): a length or a speed
+  that fits the machine only once divided by 1000 is refused with the unit hint, whichever
+  parameter it is: the leg length limits and ``limits.actuator_speed_max`` against the size of
+  the machine (the farthest joint centre from the base origin at home, per second for a
+  speed), ``tool.offset``, ``tools.T<n>.offset`` and ``work.origin`` against the same size
+  (:func:`cell_unit_reason`), positions typed or read by the CLI likewise. "Fits" means within
+  :data:`PLAUSIBLE_RATIO` times the size; a value beyond that which is within it once divided
+  by 1000 is a unit mistake, not a machine.
 """
 
 from __future__ import annotations
@@ -25,18 +33,24 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-from ..errors import GeometryError
+from ..errors import ConfigError, GeometryError
 
 if TYPE_CHECKING:
+    from .frames import CellFrames
     from .manipulator import Manipulator
 
 __all__ = [
     "COINCIDENT_TOLERANCE",
+    "PLAUSIBLE_RATIO",
     "SINGULAR_TOLERANCE",
+    "cell_unit_reason",
     "coincident_joints_reason",
     "home_conditioning",
+    "machine_size",
+    "millimetre_reason",
+    "require_plausible_cell",
     "require_usable",
     "unusable_reason",
 ]
@@ -48,6 +62,99 @@ COINCIDENT_TOLERANCE = 1e-6
 SINGULAR_TOLERANCE = 1e-6
 #: Lengths in a file written in millimetres are 1000 times too large.
 _MM = 1000.0
+#: A length (m) or speed (m/s) more than this many times the machine's size (m) does not fit it.
+PLAUSIBLE_RATIO = 10.0
+
+
+def machine_size(
+    base_joints: ArrayLike, platform_joints: ArrayLike, home_position: ArrayLike
+) -> float:
+    """The size of the machine: the farthest joint centre from the base origin at home, m.
+
+    Parameters
+    ----------
+    base_joints, platform_joints : array_like, shape (6, 3)
+        m, base and platform frames.
+    home_position : array_like, shape (3,)
+        m, base frame.
+    """
+    base = np.linalg.norm(np.asarray(base_joints, dtype=np.float64), axis=-1)
+    platform = np.linalg.norm(
+        np.asarray(platform_joints, dtype=np.float64) + np.asarray(home_position), axis=-1
+    )
+    return float(max(base.max(), platform.max()))
+
+
+def millimetre_reason(
+    name: str, values: ArrayLike, size: float, unit: str = "m", per: str = ""
+) -> str | None:
+    """The one unit rule: why ``values`` look like millimetres, or None.
+
+    A value larger than :data:`PLAUSIBLE_RATIO` times the machine's size that is within it once
+    divided by 1000 is refused with the hint.
+
+    Parameters
+    ----------
+    name : str
+        The parameter, column or flag, for the message.
+    values : array_like, shape (...)
+        Its values, in ``unit`` (m, m/s).
+    size : float
+        :func:`machine_size`, m; a size that is not positive and finite checks nothing.
+    unit : str
+        The unit the values should be in.
+    per : str
+        ``"/s"`` for a speed (compared with the size per second).
+
+    Returns
+    -------
+    str or None
+        One line: the parameter, the value given, what would fit, the hint.
+    """
+    array = np.abs(np.atleast_1d(np.asarray(values, dtype=np.float64)))
+    if not (np.isfinite(size) and size > 0.0) or not np.all(np.isfinite(array)):
+        return None
+    limit = PLAUSIBLE_RATIO * size
+    fits = array / _MM <= limit
+    big = np.flatnonzero((array > limit) & fits)
+    if not big.size or not np.all(fits):
+        return None
+    value = float(np.atleast_1d(np.asarray(values, dtype=np.float64))[big[0]])
+    return (
+        f"{name}: expected {unit} (at most {limit:.3g} {unit} for a machine of {size:.3g} m"
+        f"{', per second' if per else ''}), got {value:g}, which fits once divided by 1000: "
+        f"it looks like milli{'metres' if unit == 'm' else unit.replace('m/', 'metres/')}; "
+        f"parameters are in metres{' per second' if per else ''}"
+    )
+
+
+def cell_unit_reason(manipulator: Manipulator, cell: CellFrames) -> str | None:
+    """:func:`millimetre_reason` of the cell's lengths and speeds against the machine's size:
+    ``tool.offset``, ``tools.T<n>.offset``, ``work.origin`` (m) and, for actuators that slide
+    (``ups``, ``pus``: m/s), ``limits.actuator_speed_max``."""
+    size = machine_size(
+        manipulator.base_joints, manipulator.platform_joints, manipulator.home_position
+    )
+    checks: list[tuple[str, ArrayLike, str, str]] = [
+        ("tool.offset", cell.tool.offset if cell.tool.number == 0 else np.zeros(3), "m", ""),
+        *((f"tools.T{n}.offset", t.offset, "m", "") for n, t in sorted(cell.tools.items())),
+        ("work.origin", cell.work.origin, "m", ""),
+    ]
+    if manipulator.architecture in ("ups", "pus"):
+        checks.append(("limits.actuator_speed_max", cell.actuator_speed_max, "m/s", "/s"))
+    for name, values, unit, per in checks:
+        reason = millimetre_reason(name, values, size, unit, per)
+        if reason is not None:
+            return reason
+    return None
+
+
+def require_plausible_cell(manipulator: Manipulator, cell: CellFrames) -> CellFrames:
+    """Return ``cell``, or raise :class:`ConfigError` with :func:`cell_unit_reason`."""
+    reason = cell_unit_reason(manipulator, cell)
+    if reason is not None:
+        raise ConfigError(reason)
+    return cell
 
 
 def coincident_joints_reason(name: str, joints: NDArray[np.float64]) -> str | None:

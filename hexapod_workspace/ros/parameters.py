@@ -41,7 +41,7 @@ from hexapod_workspace.core.manipulator import (
     Manipulator,
     required_parameters,
 )
-from hexapod_workspace.core.validation import require_usable
+from hexapod_workspace.core.validation import require_plausible_cell, require_usable
 from hexapod_workspace.errors import ConfigError
 
 from .recorder import Rotation
@@ -559,6 +559,7 @@ def state_from(values: dict[str, Any]) -> State:
             if name in CELL_DESCRIPTIONS or TOOL_TABLE_NAME.match(name)
         }
     )
+    require_plausible_cell(platform, cell)  # the CLI's unit rule: values in millimetres
     if cell.work.frame_id == platform.frame_id:
         msg = (
             f"work.frame_id: expected a name other than the base frame frame_id, got "
