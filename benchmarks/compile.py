@@ -12,7 +12,7 @@ Then, in one process with a cold cache, the compile time of every entry point of
 of the model (``kernels.ALL_SWITCHES``), from numba's own per-signature timers: where the time
 goes.
 
-Usage: python benchmarks/compile.py [--skip-variants]
+Usage: python benchmarks/compile.py [--skip-variants] [--skip-every]
 """
 
 from __future__ import annotations
@@ -60,12 +60,29 @@ def run(command: list[str], environment: dict[str, str]) -> tuple[float, float, 
     return usage.ru_utime + usage.ru_stime, wall, process.returncode, stderr
 
 
+def calibration() -> float:
+    """CPU seconds of a fixed pure-Python loop (10⁷ additions), the best of three: this kind of
+    machine is a virtual one whose speed varies by up to 2x from hour to hour, so every figure
+    is printed beside it, to compare runs by."""
+    best = float("inf")
+    for _ in range(3):
+        started = time.process_time()
+        total = 0
+        for value in range(10_000_000):
+            total += value
+        best = min(best, time.process_time() - started)
+    return best
+
+
 def python(code: str) -> list[str]:
     return [sys.executable, "-c", textwrap.dedent(code)]
 
 
-def cold_figures(scratch: Path) -> list[tuple[str, float, float, int, str]]:
-    base = dict(os.environ)
+def cold_figures(scratch: Path, every: bool = True) -> list[tuple[str, float, float, int, str]]:
+    # As a user's install runs: Python's bytecode cached (pip compiles it at install time; a
+    # development shell's PYTHONDONTWRITEBYTECODE=1 would add ~0.16 s of source compilation of
+    # this package's modules to every warm figure).
+    base = {name: value for name, value in os.environ.items() if name != "PYTHONDONTWRITEBYTECODE"}
     csv = scratch / "small.csv"
     csv.write_text(
         "x_m,y_m,z_m,phi_deg,theta_deg,psi_deg\n"
@@ -91,6 +108,8 @@ def cold_figures(scratch: Path) -> list[tuple[str, float, float, int, str]]:
             """
         ),
     }
+    if not every:
+        del cases["warm_up of every kernel, every variant"]
     rows = []
     for index, (name, command) in enumerate(cases.items()):
         cache = scratch / f"cache{index}"
@@ -119,7 +138,9 @@ for key in kernels.ALL_SWITCHES:
     kernels._run_variant(kernels._variant(key))
     total = time.process_time() - started
     entry = {}
-    for name, dispatcher in kernels._variant(key)._asdict().items():
+    variant = kernels._variant(key)
+    for name in ("check_angles", "check_one", "margins_rotations", "search_rays", "torsion_scan"):
+        dispatcher = getattr(variant, name)  # (variant.collide is the switch, not a kernel)
         signatures = dispatcher.signatures
         timers = dispatcher.get_metadata(signatures[0]).get("timers", {}) if signatures else {}
         entry[name] = [timers.get("compiler_lock", 0.0), timers.get("llvm_lock", 0.0),
@@ -162,10 +183,16 @@ def variant_table(scratch: Path) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--skip-variants", action="store_true", help="no per-kernel table")
+    parser.add_argument(
+        "--skip-every",
+        action="store_true",
+        help="not the figure of every variant's warm-up (minutes)",
+    )
     options = parser.parse_args()
     print(f"cold start, {os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f}")
+    print(f"this machine's speed now: a 10^7-step Python loop in {calibration():.2f} s CPU")
     with tempfile.TemporaryDirectory(prefix="hexapod-compile-") as scratch:
-        rows = cold_figures(Path(scratch))
+        rows = cold_figures(Path(scratch), every=not options.skip_every)
         print()
         print("| figure | CPU s | wall s | goal (CPU s) | dfebf16 (CPU s) | met |")
         print("|---|---|---|---|---|---|")
@@ -179,7 +206,10 @@ def main() -> None:
             print(f"\nthe CLI's notice: {notices[0]}")
         if not options.skip_variants:
             variant_table(Path(scratch))
-    print(f"\nload average at the end: {os.getloadavg()[0]:.1f}")
+    print(
+        f"\nload average at the end: {os.getloadavg()[0]:.1f}; "
+        f"the 10^7-step loop: {calibration():.2f} s"
+    )
 
 
 if __name__ == "__main__":

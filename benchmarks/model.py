@@ -23,6 +23,7 @@ Usage: python benchmarks/model.py [--poses N] [--rounds R] [--baseline REV] [--c
 from __future__ import annotations
 
 import argparse
+import contextlib
 import functools
 import os
 import sys
@@ -162,14 +163,25 @@ def main() -> None:
         default="cpu",
         help="this process's CPU time (default) or wall time",
     )
+    parser.add_argument(
+        "--keep",
+        metavar="DIR",
+        help="extract the baseline into DIR/REV and keep it there with its compiled kernels, so "
+        "a later run with the same DIR does not compile it again (default: a temporary directory)",
+    )
     options = parser.parse_args()
     if options.rounds < 1 or options.poses < 1:
         parser.error(f"--rounds and --poses: expected ≥ 1, got {options.rounds}, {options.poses}")
     clock = time.process_time if options.clock == "cpu" else time.perf_counter
     os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})  # one core
     loads = [os.getloadavg()[0]]
-    with tempfile.TemporaryDirectory() as directory:
-        old = load_baseline(Path(directory), options.baseline)
+    with contextlib.ExitStack() as stack:
+        if options.keep:
+            directory = Path(options.keep) / options.baseline
+            directory.mkdir(parents=True, exist_ok=True)
+        else:
+            directory = Path(stack.enter_context(tempfile.TemporaryDirectory()))
+        old = load_baseline(directory, options.baseline)
         if old is None:
             sys.exit(f"cannot extract the baseline {options.baseline} (git archive)")
         from hexapod_workspace_baseline.core import kernels as old_kernels

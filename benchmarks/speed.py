@@ -47,7 +47,13 @@ POSITION = np.array([0.0, 0.0, -1.3])
 
 
 def load_baseline(directory: Path, commit: str = BASELINE_COMMIT):
-    """The package as of ``commit``, imported as ``hexapod_workspace_baseline`` (or None)."""
+    """The package as of ``commit``, imported as ``hexapod_workspace_baseline`` (or None).
+
+    A ``directory`` that already holds it (kept from an earlier run, with its compiled cache)
+    is imported as it is."""
+    if (directory / "hexapod_workspace_baseline").is_dir():
+        sys.path.insert(0, str(directory))
+        return importlib.import_module("hexapod_workspace_baseline")
     try:
         archive = subprocess.run(
             ["git", "-C", str(ROOT), "archive", commit, "hexapod_workspace"],

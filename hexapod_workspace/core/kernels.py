@@ -168,10 +168,24 @@ def _variant(key: Switches) -> Kernels:
     return kernels
 
 
+#: id(model) -> (model, its variant): the packed models are cached per manipulator, so the
+#: one-pose check looks its variant up by an int instead of reading four switches (0.3 µs of a
+#: 2.5 µs call). The model is held, so its id is not reused while it is here; bounded.
+_BY_MODEL: dict[int, tuple[NDArray[np.float64], Kernels]] = {}
+_BY_MODEL_MAX = 64
+
+
 def for_model(model: NDArray[np.float64]) -> Kernels:
     """The entry points compiled for ``model``'s variant (built once per variant per process;
     compiled, or loaded from the cache, on first call)."""
-    return _variant(switches(model))
+    hit = _BY_MODEL.get(id(model))
+    if hit is not None and hit[0] is model:
+        return hit[1]
+    variant = _variant(switches(model))
+    if len(_BY_MODEL) >= _BY_MODEL_MAX:
+        _BY_MODEL.clear()
+    _BY_MODEL[id(model)] = (model, variant)
+    return variant
 
 
 def vector(values: ArrayLike) -> NDArray[np.float64]:
