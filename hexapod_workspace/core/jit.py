@@ -207,9 +207,10 @@ def inline(function: _F) -> _F:
 
 _CORE_PACKAGE = __name__.rpartition(".")[0] + "."
 
-#: What the first compilation costs, measured by ``benchmarks/compile.py`` on a 2-core machine
-#: (CPU seconds, cold cache): the notice quotes it instead of a guess.
-MEASURED_FIRST_CHECK_S = 7
+#: What the first compilation of a 6-UPS check costs, measured by ``benchmarks/compile.py`` on a
+#: 2-core virtual machine (CPU seconds, cold cache; the range of one day's runs, the machine's
+#: speed varying): the notice quotes it instead of a guess.
+MEASURED_FIRST_CHECK_S = (8, 14)
 
 
 class _CompileAnnouncer(numba.core.event.Listener):  # type: ignore[misc]  # numba: no stubs
@@ -230,8 +231,9 @@ class _CompileAnnouncer(numba.core.event.Listener):  # type: ignore[misc]  # num
         where = CACHE_DIRECTORY if CACHE_DIRECTORY is not None else "nowhere writable: not cached"
         self.announce(
             "compiling the numerical kernels for this machine model, once after install "
-            f"(measured: {MEASURED_FIRST_CHECK_S} s of CPU for a 6-UPS check, up to a minute "
-            f"for every kernel of a model with a scene; cache: {where})"
+            f"(measured: {MEASURED_FIRST_CHECK_S[0]}-{MEASURED_FIRST_CHECK_S[1]} s of CPU for a "
+            "6-UPS check, about 2 minutes for every kernel of a model with a scene; "
+            f"cache: {where})"
         )
 
     def on_end(self, event: numba.core.event.Event) -> None:
