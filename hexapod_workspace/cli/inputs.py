@@ -284,7 +284,9 @@ def plausible_positions(
     size = machine_size(
         manipulator.base_joints, manipulator.platform_joints, manipulator.home_position
     )
-    reason = millimetre_reason(where, np.linalg.norm(np.atleast_2d(positions), axis=-1), size)
+    with np.errstate(over="ignore"):  # a position of 1e300 m: inf, refused by its own check
+        distances = np.linalg.norm(np.atleast_2d(positions), axis=-1)
+    reason = millimetre_reason(where, distances, size)
     if reason is not None:
         raise CliError(reason.replace("got ", "got a distance from the base origin of ", 1))
 
