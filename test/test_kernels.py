@@ -537,3 +537,25 @@ def test_kernel_sources_name_every_module_with_compiled_code():
             decorated.add(path.resolve())
     assert decorated
     assert decorated <= {source.resolve() for source in jit.KERNEL_SOURCES}
+
+
+def test_a_child_process_of_another_copy_uses_its_own_cache(tmp_path, monkeypatch):
+    """The cache setting this process made (NUMBA_CACHE_DIR and its owner) is inherited by a
+    child of the same tree, which shares it; a child running another copy of the package (the
+    colcon install space, started from a test of the source tree) uses the copy's own cache,
+    where its kernels were compiled; a directory the user set after that is the user's. (The
+    child's decision, taken with the inherited environment and the copy's folder.)"""
+    from hexapod_workspace.core import jit
+
+    inherited = dict(os.environ)
+    assert jit.CACHE_DIRECTORY is not None
+    assert inherited["NUMBA_CACHE_DIR"] == str(jit.CACHE_DIRECTORY)
+    assert inherited["HEXAPOD_WORKSPACE_CACHE_OWNER"].startswith(str(jit._HERE) + os.pathsep)
+    assert jit._cache_directory() == jit.CACHE_DIRECTORY  # the same tree
+
+    core = tmp_path / "install" / "hexapod_workspace" / "core"  # the other copy
+    monkeypatch.setattr(jit, "_HERE", core)
+    assert jit._cache_directory() == core / "__pycache__" / jit.CACHE_NAME
+    users = tmp_path / "users"
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(users))
+    assert jit._cache_directory() == users / jit.CACHE_NAME

@@ -2,18 +2,24 @@
 and the compile-time switches.
 
 **The cache.** numba keys a cached kernel on the source file of its entry point only (its
-modification time and size), so a changed helper in another module (a margin kernel compiled
-into a search kernel) would be loaded stale from the cache. The kernels are therefore cached in
-a directory named by a hash of the *contents* of every module whose code ends up in a kernel
-(:data:`KERNEL_SOURCES`): a change to any of them selects a new, empty directory. This uses
-numba's public configuration only (``NUMBA_CACHE_DIR``, set before numba is imported, or
+modification time and size), so a changed helper in another module (a margin kernel compiled into a
+search kernel) would be loaded stale from the cache. The kernels are therefore cached in a
+directory named by a hash of the *contents* of every module whose code ends up in a kernel
+(:data:`KERNEL_SOURCES`): a change to any of them selects a new, empty directory. This uses numba's
+public configuration only (``NUMBA_CACHE_DIR``, set before numba is imported, or
 ``numba.config.CACHE_DIR`` when it already was). The directory lies next to the core modules
 (``__pycache__/numba-<hash>``) when that is writable, otherwise in the user cache directory
 (``$XDG_CACHE_HOME/hexapod_workspace/numba-<hash>``, default ``~/.cache/...``), so a read-only
-install (colcon install space, system site-packages) compiles once per user. A directory given
-in ``NUMBA_CACHE_DIR`` is used as the parent of ``numba-<hash>``. This module must be imported
-before numba (every kernel module imports it first). Other numba users in the same process
-share the directory (numba has one cache setting per process).
+install (colcon install space, system site-packages) compiles once per user. A directory given in
+``NUMBA_CACHE_DIR`` is used as the parent of ``numba-<hash>``. The setting this module makes is
+inherited by child processes (numba reads it from the environment), together with
+``HEXAPOD_WORKSPACE_CACHE_OWNER``, the core folder that made it and the value: a child of the same
+tree shares the directory, a child running another copy of the package (the colcon install space
+started from a test of the source tree) ignores it and uses its own, which is where its kernels
+were compiled (numba keys a cached kernel by the full path of its source file, so the other tree's
+directory holds none of them). This module must be imported before numba (every kernel module
+imports it first). Other numba users in the same process share the directory (numba has one cache
+setting per process).
 
 **The switches.** A kernel is compiled for one *variant* of the model: fixed or moving base
 joints (``moving``), slides or cranks (``cranks``), a collision scene (``collide``), an evaluated
@@ -88,6 +94,12 @@ def _sources_hash() -> str:
 CACHE_NAME = f"numba-{_sources_hash()}"
 
 
+#: ``<core folder><os.pathsep><directory>``: the copy of the package whose set-up put
+#: ``NUMBA_CACHE_DIR`` in the environment, and the value it put there (a value set after that,
+#: by the user, is the user's and is kept).
+_OWNER_VARIABLE = "HEXAPOD_WORKSPACE_CACHE_OWNER"
+
+
 def _writable(directory: Path) -> bool:
     """Whether files can be created in ``directory`` (created if missing)."""
     try:
@@ -110,6 +122,9 @@ def _prune(parent: Path) -> None:
 def _cache_directory() -> Path | None:
     """Where numba caches the kernels (None: nowhere writable, no cache)."""
     configured = os.environ.get("NUMBA_CACHE_DIR")
+    owner, _, directory = os.environ.get(_OWNER_VARIABLE, "").partition(os.pathsep)
+    if configured and configured == directory and owner != str(_HERE):
+        configured = None  # set by another copy of the package for itself (module docstring)
     if configured:
         given = Path(configured)
         # Inherited from a parent process that ran this set-up: already ours.
@@ -129,6 +144,7 @@ def _cache_directory() -> Path | None:
 CACHE_DIRECTORY = _cache_directory()
 if CACHE_DIRECTORY is not None:
     os.environ["NUMBA_CACHE_DIR"] = str(CACHE_DIRECTORY)  # read by numba at import
+    os.environ[_OWNER_VARIABLE] = f"{_HERE}{os.pathsep}{CACHE_DIRECTORY}"
     if "numba" in sys.modules:  # imported earlier by someone else: its runtime setting
         import numba
 

@@ -46,6 +46,7 @@ import rclpy
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.lifecycle import LifecycleState, TransitionCallbackReturn
 
+from hexapod_workspace.core import jit
 from hexapod_workspace.errors import ConfigError, InputError
 
 from .parameters import state_from
@@ -181,7 +182,11 @@ class ManagedTransitions:
         if settings.recording_enabled:
             node.recorder.open(settings.recording_directory, settings.recording_rotation)
         node.worker.start()  # it warms its own kernels up meanwhile
-        node.get_logger().info(f"configured: pose-check kernels ready in {node.warm_up():.1f} s")
+        seconds = node.warm_up()
+        node.get_logger().info(
+            f"configured: pose-check kernels ready in {seconds:.1f} s "
+            f"(compiled-code cache: {jit.CACHE_DIRECTORY or 'none, nothing is writable'})"
+        )
         return TransitionCallbackReturn.SUCCESS
 
     def on_activate(self, state: LifecycleState) -> TransitionCallbackReturn:

@@ -173,15 +173,22 @@ def _result_qos(depth: int = 1) -> QoSProfile:
     )
 
 
-def warm_up_kernels(*manipulators: Manipulator, checks_only: bool = False) -> float:
+def warm_up_kernels(
+    *manipulators: Manipulator, checks_only: bool = False, report_singularity: bool = False
+) -> float:
     """Compile (first run) or load the core's kernels, so that the first pose check and the
     first planned path are as fast as the others; returns the seconds taken. The kernels of
     each manipulator's variant (checked with and without the reported singularity margin); none
     given: every variant. ``checks_only``: only what a pose check of the manipulators as
-    configured needs (``kernels.CHECKS``), which the node compiles before it answers."""
+    configured needs (``kernels.CHECKS``, with the singularity margin evaluated when
+    ``report_singularity``: ``check.report_singularity``), which the node compiles before it
+    answers."""
     started = time.perf_counter()
     if checks_only:
-        models = [kernels.model_vector(manipulator) for manipulator in manipulators]
+        models = [
+            kernels.model_vector(manipulator, report_singularity=report_singularity)
+            for manipulator in manipulators
+        ]
         kernels.warm_up(*models, names=kernels.CHECKS)
         return time.perf_counter() - started
     models = [
@@ -310,7 +317,8 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         node already answers: after a plain colcon build the cache is empty, and a first
         answer should not wait for every kernel."""
         manipulators = [self.state.manipulator] if self.state is not None else []
-        seconds = warm_up_kernels(*manipulators, checks_only=True)
+        report = self.state is not None and self.state.settings.report_singularity
+        seconds = warm_up_kernels(*manipulators, checks_only=True, report_singularity=report)
         threading.Thread(
             target=warm_up_kernels, args=manipulators, name="kernel-warm-up", daemon=True
         ).start()

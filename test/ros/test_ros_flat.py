@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from ros_support import require_ros, running_node
+from ros_support import INSTALL, require_ros, running_node
 
 require_ros()
 
@@ -163,6 +163,9 @@ def test_flat_calls_are_recorded_and_read_back(ros_client, tmp_path, model):
         ros_client.drop_client(service)
         assert node.stop() == 0, node.output()
     assert answer.success, answer.message
+    # the node (a child of this process, which set NUMBA_CACHE_DIR for the source tree) loads
+    # the kernels the install space was built with, from the install space's cache
+    assert f"(compiled-code cache: {INSTALL}/" in node.output(), node.output()
     (log,) = (tmp_path / "logs").glob("*.mcap")
     request_topic, response_topic = logs.service_topics(service)
     decoded = {topic: (msgtype, m) for topic, msgtype, m in read_with_rosbags_documented(log)}
