@@ -120,6 +120,11 @@ def test_orientation_json_fields(tmp_path):
     for key in ("psi_min_deg", "psi_max_deg", "volume", "slices", "position", "elapsed_s"):
         assert key in document
     assert document["psi_min_deg"] < 0 < document["psi_max_deg"]
+    for end in ("min", "max"):  # the witnesses of the extremes, reachable by `check`
+        witness = document[f"psi_{end}_witness_deg"]
+        assert len(witness) == 3 and witness[2] == document[f"psi_{end}_deg"]
+        code, verdict, err = run_main("check", "--pose", *map(repr, witness))
+        assert code == 0, (witness, verdict, err)
     first = document["slices"][0]
     assert set(first) == {"psi_deg", "center_deg", "phi_deg", "theta_deg"}
     assert len(first["center_deg"]) == 2

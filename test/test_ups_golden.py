@@ -5,6 +5,13 @@ checkout of commit 3c6da1e (see its docstring): the packaged example and the sam
 a leg diameter, 4,000 seeded poses, projected workspaces (both methods), orientation workspaces,
 torsion ranges at the paper's two positions, and a 39-move toolpath. Verdicts and integer
 answers must be identical, margins and boundaries within 1e-12.
+
+Two entries were replaced since, by today's code: ``example_off_volume`` and
+``diameter_off_volume`` (ψmin, ψmax, volume of the orientation workspace at (0.2, 0.2, −0.95) m).
+The search of the torsion extremes at 3c6da1e, a four-direction compass search, stalled on the
+ridge where two constraints meet: ψmax 2.08e-5 rad (21 tolerances) and ψmin 1.9e-6 rad short of
+the poses it now reaches in 16 directions, each extreme with a witness pose that ``check`` finds
+reachable (issue #35 item 9; test_workspaces.py samples beyond the extremes).
 """
 
 from __future__ import annotations

@@ -405,3 +405,49 @@ def test_leg_length_boundary_closed_form(example, tz_off):
         assert tz_off.theta[k] <= closed <= tz_off.theta[k] + tz_off.tolerance + 1e-12
         checked += 1
     assert checked >= 5
+
+
+def _machine(example, symmetric, name):
+    from hexapod_workspace import Manipulator
+    from hexapod_workspace._resources import data_path
+
+    if name == "ups-off-axis":
+        return example, OFF_AXIS
+    if name == "ups-symmetric":  # its torsion extremes lie on theta = 0 (120 deg symmetry)
+        return symmetric, ON_AXIS
+    model = Manipulator.from_params_file(data_path("config", f"example_{name}.yaml"))
+    return model, model.position
+
+
+@pytest.mark.parametrize("name", ["ups-off-axis", "ups-symmetric", "pus", "rus"])
+def test_torsion_extremes_have_witnesses_and_nothing_reachable_beyond(example, symmetric, name):
+    """Each torsion extreme of the 3-D workspace comes with a witness pose that ``check``
+    finds reachable, and dense sampling finds nothing reachable beyond the extreme by more
+    than the tolerance: a 0.002 deg grid 0.2 deg around the witness, a 0.25 deg grid of
+    the whole disk theta <= 80 deg."""
+    model, position = _machine(example, symmetric, name)
+    solid = orientation_workspace(
+        model, position, n_rays=48, psi_step=math.radians(5.0), tolerance=1e-6
+    )
+    tol = solid.tolerance
+    for value, witness, sign in (
+        (solid.psi_max, solid.psi_max_witness, 1.0),
+        (solid.psi_min, solid.psi_min_witness, -1.0),
+    ):
+        assert witness is not None and witness[2] == value
+        assert reachable(model, witness, position).all(), (name, np.degrees(witness))
+        x0, y0 = witness[1] * math.cos(witness[0]), witness[1] * math.sin(witness[0])
+        near = np.radians(np.arange(-0.2, 0.2001, 0.002))
+        coarse = np.radians(np.arange(-80.0, 80.0, 0.25))
+        points = [np.meshgrid(x0 + near, y0 + near), np.meshgrid(coarse, coarse)]
+        x = np.concatenate([p[0].ravel() for p in points])
+        y = np.concatenate([p[1].ravel() for p in points])
+        keep = np.hypot(x, y) <= math.radians(80.0)
+        beyond = np.column_stack(
+            [
+                np.arctan2(y[keep], x[keep]),
+                np.hypot(x[keep], y[keep]),
+                np.full(int(keep.sum()), value + sign * 2.0 * tol),
+            ]
+        )
+        assert not reachable(model, beyond, position).any(), name

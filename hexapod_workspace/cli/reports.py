@@ -49,6 +49,18 @@ def _degrees(values: Any) -> Any:
     return converted.tolist() if isinstance(converted, np.ndarray) else float(converted)
 
 
+def _optional_degrees(values: NDArray[np.float64] | None) -> list[float] | None:
+    """Radians to a list of degrees; None stays None."""
+    return None if values is None else [float(v) for v in np.degrees(values)]
+
+
+def _triple(values: NDArray[np.float64] | None) -> str:
+    """A T&T pose (rad) as ``(φ, θ, ψ)`` in degrees, 4 decimals; ``(unknown)`` for None."""
+    if values is None:
+        return "(unknown)"
+    return "(" + ", ".join(f"{v:.4f}" for v in np.degrees(values)) + ")"
+
+
 def _number(value: float, width: int, decimals: int) -> str:
     """A number in a fixed-width column: fixed-point when it fits, else scientific."""
     text = f"{value:{width}.{decimals}f}"
@@ -295,6 +307,9 @@ def orientation_json(workspace: OrientationWorkspace) -> dict[str, Any]:
         "reference_reachable": True,
         "psi_min_deg": _degrees(workspace.psi_min),
         "psi_max_deg": _degrees(workspace.psi_max),
+        # the reachable poses [φ, θ, ψ] that attain the torsion extremes (``check`` them)
+        "psi_min_witness_deg": _optional_degrees(workspace.psi_min_witness),
+        "psi_max_witness_deg": _optional_degrees(workspace.psi_max_witness),
         "volume": workspace.volume,
         "volume_unit": "rad^3",
         "n_rays": workspace.n_rays,
@@ -328,6 +343,8 @@ def orientation_text(workspace: OrientationWorkspace, out: IO[str]) -> None:
         f"tolerance {math.degrees(workspace.tolerance):.2e} deg, {workspace.elapsed:.2f} s\n"
         f"  torsion range: {math.degrees(workspace.psi_min):.4f} .. "
         f"{math.degrees(workspace.psi_max):.4f} deg\n"
+        f"    psi_min reached at (phi, theta, psi) = {_triple(workspace.psi_min_witness)} deg\n"
+        f"    psi_max reached at (phi, theta, psi) = {_triple(workspace.psi_max_witness)} deg\n"
         f"  volume (cylindrical coordinates): {workspace.volume:.5f} rad^3\n"
         f"  psi = {math.degrees(zero.psi):g} slice: area {areas[middle]:.5f} rad^2, tilt "
         f"{math.degrees(zero.theta.min()):.3f} .. {math.degrees(zero.theta.max()):.3f} deg over "

@@ -58,7 +58,15 @@ __all__ = [
 ]
 
 #: Pattern-search rounds when refining ψmax / ψmin.
-PSI_LIMIT_ROUNDS = 24
+PSI_LIMIT_ROUNDS = 400
+#: Directions of the pattern search for the torsion extremes (:meth:`_Slicer.torsion_limit`).
+PSI_PATTERN = 16
+_PATTERN = np.column_stack(
+    [
+        np.cos(2.0 * np.pi * np.arange(PSI_PATTERN) / PSI_PATTERN),
+        np.sin(2.0 * np.pi * np.arange(PSI_PATTERN) / PSI_PATTERN),
+    ]
+)
 #: Longest scan step of :func:`torsion_range`, rad.
 TORSION_MAX_STEP = 0.25
 
@@ -118,6 +126,16 @@ class OrientationWorkspace:
     psi_min_point, psi_max_point : ndarray, shape (2,), optional
         Where in the cylindrical xy-plane (rad) ψmin and ψmax are attained.
     """
+
+    @property
+    def psi_min_witness(self) -> NDArray[np.float64] | None:
+        """The pose [φ, θ, ψmin] (rad, T&T) that attains ψmin: reachable (``check``)."""
+        return _witness(self.psi_min_point, self.psi_min)
+
+    @property
+    def psi_max_witness(self) -> NDArray[np.float64] | None:
+        """The pose [φ, θ, ψmax] (rad, T&T) that attains ψmax: reachable (``check``)."""
+        return _witness(self.psi_max_point, self.psi_max)
 
     position: NDArray[np.float64]
     slices: list[OrientationSlice]
@@ -195,6 +213,14 @@ def _xy_to_angles(
     return np.column_stack([phi, theta, np.broadcast_to(psi, theta.shape)])
 
 
+def _witness(point: NDArray[np.float64] | None, psi: float) -> NDArray[np.float64] | None:
+    """The T&T pose (3,) of the cylindrical point ``point`` (2,) at torsion ``psi``."""
+    if point is None:
+        return None
+    witness: NDArray[np.float64] = _xy_to_angles(point[:1], point[1:2], psi)[0]
+    return witness
+
+
 def _ray_ends(center: NDArray[np.float64], directions: NDArray[np.float64]) -> NDArray[np.float64]:
     """Parameter where each ray c + s·u leaves the disk θ ≤ π; shape (n,)."""
     cu = directions @ center
@@ -252,17 +278,26 @@ class _Slicer:
     def torsion_limit(
         self, last: OrientationSlice, sign: float
     ) -> tuple[float, NDArray[np.float64]]:
-        """ψmax (sign +1) or ψmin (−1) beyond the last non-empty slice, and where it is."""
+        """ψmax (sign +1) or ψmin (−1) beyond the last non-empty slice, and where it is.
+
+        Every candidate is a point of the slice and each value is the reachable end of a ray in
+        ψ from a point reachable at the slice's torsion (:meth:`_torsion_tops`), so the point
+        returned with the value is a witness: the pose (φ, θ, value) is reachable. The slice's
+        own boundary points (the certified ray ends, reachable) are among the candidates, so a
+        reachable start exists whatever the slice's shape.
+        """
         _, centroid = _polygon_area_centroid(last.xy())
-        candidates = np.vstack([last.center, centroid, 0.5 * (last.xy() + centroid)])
+        candidates = np.vstack([last.center, centroid, 0.5 * (last.xy() + centroid), last.xy()])
         top = self._torsion_tops(candidates, last.psi, sign)
         best = int(np.argmax(sign * top))
         point, value = candidates[best], top[best]
-        # Shrinking pattern search over (x, y) for the extreme torsion.
+        # Shrinking pattern search over (x, y) for the extreme torsion, in PSI_PATTERN
+        # directions: the torsion top is the lowest of the constraints' tops, so its maximum
+        # lies on a ridge where two of them meet, along which a four-direction (compass) search
+        # stalls short of the top.
         step = 0.25 * float(np.sqrt(max(last.area(), 1e-12)))
-        pattern = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
         for _ in range(PSI_LIMIT_ROUNDS):
-            trial = point + step * pattern
+            trial = point + step * _PATTERN
             tops = self._torsion_tops(trial, last.psi, sign)
             k = int(np.argmax(sign * tops))
             if sign * tops[k] > sign * value:
@@ -276,15 +311,16 @@ class _Slicer:
     def _torsion_tops(
         self, points: NDArray[np.float64], psi_start: float, sign: float
     ) -> NDArray[np.float64]:
-        """For points (n, 2) feasible at psi_start, the torsion where feasibility ends going
-        in direction ``sign``; points infeasible at psi_start get psi_start."""
+        """For points (n, 2), the last reachable torsion going from psi_start in direction
+        ``sign`` (reachable: the ray's certified feasible end); a point unreachable at
+        psi_start gets −sign·∞, so that it is never taken for an extreme."""
 
         origins = np.column_stack([points, np.full(points.shape[0], psi_start)])
         found = self.search.rays(
             "cylindrical", origins, [0.0, 0.0, sign], math.pi - sign * psi_start, self.tolerance
         )
-        reach = np.where(found.start_feasible, found.feasible, 0.0)
-        return psi_start + sign * reach
+        tops = psi_start + sign * found.feasible
+        return np.where(found.start_feasible, tops, -sign * np.inf)
 
 
 def orientation_workspace(
