@@ -139,8 +139,8 @@ for key in kernels.ALL_SWITCHES:
     total = time.process_time() - started
     entry = {}
     variant = kernels._variant(key)
-    for name in ("check_angles", "check_one", "margins_rotations", "search_rays", "torsion_scan"):
-        dispatcher = getattr(variant, name)  # (variant.collide is the switch, not a kernel)
+    for name in kernels.ENTRY_POINTS:
+        dispatcher = getattr(variant, name)
         signatures = dispatcher.signatures
         timers = dispatcher.get_metadata(signatures[0]).get("timers", {}) if signatures else {}
         entry[name] = [timers.get("compiler_lock", 0.0), timers.get("llvm_lock", 0.0),
@@ -161,7 +161,7 @@ def variant_table(scratch: Path) -> None:
         print(done.stderr[-2000:], file=sys.stderr)
         return
     rows = json.loads(done.stdout.splitlines()[-1])
-    names = ("check_angles", "check_one", "margins_rotations", "search_rays", "torsion_scan")
+    names = tuple(rows[0][2])  # the entry points, in the child's kernels.ENTRY_POINTS order
     print()
     print("Compile time of each entry point, per variant (one process, cold cache, CPU s;")
     print("numba's timers: the whole compilation, LLVM's part in brackets; a kernel's callees")

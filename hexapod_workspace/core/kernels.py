@@ -51,6 +51,7 @@ __all__ = [
     "CACHE_DIRECTORY",
     "CHECKS",
     "COLLISION_ON",
+    "ENTRY_POINTS",
     "FAST_TRIG_LIMIT",
     "KIND_CYLINDRICAL",
     "KIND_TT",
@@ -80,6 +81,10 @@ class Kernels(NamedTuple):
     torsion_scan: Any
     #: None (no scene) or the first-class collision function.
     collide: Any
+
+
+#: The compiled entry points of a variant, in :class:`Kernels` order (``collide`` is not one).
+ENTRY_POINTS: tuple[str, ...] = Kernels._fields[:-1]
 
 
 def switches(model: NDArray[np.float64]) -> Switches:
@@ -224,7 +229,9 @@ def cache_is_warm(model: NDArray[np.float64] | None = None) -> bool:
     keys = ALL_SWITCHES if model is None else (switches(model),)
     warm = _warm_keys()
     for key in keys:
-        compiled = key in _VARIANTS and all(k.signatures for k in _VARIANTS[key][:5])
+        compiled = key in _VARIANTS and all(
+            getattr(_VARIANTS[key], name).signatures for name in ENTRY_POINTS
+        )
         if not compiled and _key_text(key) not in warm:
             return False
     return True
@@ -253,7 +260,7 @@ def _run_variant(kernels: Kernels, names: Iterable[str] | None = None) -> None:
     """Run each entry point of one variant (or those ``names``) once on a tiny problem of the
     argument types production uses (the model's own flags off: the compiled code is the
     variant's)."""
-    wanted = set(Kernels._fields if names is None else names)
+    wanted = set(ENTRY_POINTS if names is None else names)
     model = _tiny_model((OFF, OFF, OFF, OFF))
     model.setflags(write=False)  # as model_vector's
     position = np.array([0.0, 0.0, 1.0])
