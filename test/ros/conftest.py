@@ -9,6 +9,7 @@ both (:func:`ros_support.running_node`).
 from __future__ import annotations
 
 import os
+import threading
 from collections.abc import Iterator
 from typing import Any
 
@@ -35,6 +36,27 @@ def ros_domain() -> Iterator[int]:
                     os.environ.pop(key, None)
                 else:
                     os.environ[key] = value
+
+
+#: The longest a module's teardown waits for a node's background kernel warm-up (s).
+WARM_UP_JOIN_TIMEOUT = 900.0
+
+
+@pytest.fixture(scope="module", autouse=True)
+def kernel_warm_up_finished() -> Iterator[None]:
+    """At the end of a module, wait for the background warm-up of the nodes it built in this
+    process (``WorkspaceNode.warm_up``'s "kernel-warm-up" thread, which compiles every kernel
+    of the model into the source tree's cache for minutes), so that the next module's tests run
+    without numba compiling beside them in another thread. A CI run crashed with SIGSEGV in
+    the garbage collector, in the module after the in-process nodes; compilation in a second
+    thread is the suspect (not proven), and this keeps it out of the other modules' way."""
+    yield
+    for thread in threading.enumerate():
+        if thread.name == "kernel-warm-up":
+            thread.join(timeout=WARM_UP_JOIN_TIMEOUT)
+            assert not thread.is_alive(), (
+                f"kernel warm-up still running after {WARM_UP_JOIN_TIMEOUT} s"
+            )
 
 
 @pytest.fixture(scope="module")
