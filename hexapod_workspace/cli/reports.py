@@ -51,7 +51,7 @@ def _degrees(values: Any) -> Any:
 
 def _optional_degrees(values: NDArray[np.float64] | None) -> list[float] | None:
     """Radians to a list of degrees; None stays None."""
-    return None if values is None else [float(v) for v in np.degrees(values)]
+    return None if values is None else _degrees(values)
 
 
 def _triple(values: NDArray[np.float64] | None) -> str:
