@@ -24,6 +24,7 @@ from hexapod_workspace.core.rotations import tt_to_matrix
 __all__ = [
     "BatchedMargins",
     "batched_margins",
+    "free_lengths_literal",
     "paper_projected_workspace",
     "point_segment_distance",
     "pose_margins_literal",
@@ -103,6 +104,32 @@ def segment_distance_squared_batch(
     return np.maximum(np.minimum.reduce(candidates), 0.0)
 
 
+def free_lengths_literal(
+    manipulator: Manipulator, legs: list[NDArray], i: int, j: int
+) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """The segments of legs i and j whose distance is their interference: the whole legs
+    A_kB_k, or, for legs that share a joint, what is left once ``paired_joint_length`` (c, m)
+    is taken off each leg at every shared end (measured along the leg from the joint centre;
+    nothing is left past the other end). From the definition in arc length, not the kernels'
+    fractions."""
+    c = manipulator.paired_joint_length
+    base_shared = bool(
+        np.linalg.norm(manipulator.base_joints[i] - manipulator.base_joints[j]) < 1e-6
+    )
+    platform_shared = bool(
+        np.linalg.norm(manipulator.platform_joints[i] - manipulator.platform_joints[j]) < 1e-6
+    )
+    ends = []
+    for k in (i, j):
+        length = float(np.linalg.norm(legs[k]))
+        unit = legs[k] / length
+        near = min(c, length) if base_shared else 0.0
+        far = max(length - c, near) if platform_shared else length
+        start = manipulator.base_joints[k]
+        ends.extend([start + near * unit, start + far * unit])
+    return ends[0], ends[1], ends[2], ends[3]
+
+
 def _rotation(phi: float, theta: float, psi: float) -> NDArray:
     def rz(angle: float) -> NDArray:
         c, s = math.cos(angle), math.sin(angle)
@@ -156,11 +183,9 @@ def pose_margins_literal(
         for i in range(6)
     )
     if manipulator.leg_diameter > 0.0:
-        ends = [
-            (manipulator.base_joints[i], manipulator.base_joints[i] + legs[i]) for i in range(6)
-        ]
         interference = min(
-            segment_distance_literal(*ends[i], *ends[j]) - manipulator.leg_diameter
+            segment_distance_literal(*free_lengths_literal(manipulator, legs, i, j))
+            - manipulator.leg_diameter
             for i in range(6)
             for j in range(i + 1, 6)
         )
@@ -271,6 +296,8 @@ class BatchedMargins:
         self.beta = manipulator.platform_joint_max_angle
         self.diameter = manipulator.leg_diameter
         self.interference = interference and manipulator.leg_diameter > 0.0
+        # Whole legs only: legs that share a joint go through pose_margins_literal.
+        assert not self.interference or manipulator.paired_joint_length == 0.0
         # Interference: r_ij = A_i − A_j is constant (the base joints do not move).
         r = manipulator.base_joints[PAIRS_I] - manipulator.base_joints[PAIRS_J]  # (15, 3)
         self.r = r

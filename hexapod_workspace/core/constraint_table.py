@@ -43,8 +43,9 @@ constraint           speed turn  spin  actuate crank ends why
                                                           with the slide (pus) or turns with the
                                                           crank at K (rus)
 ``platform_joint``   0     1     1     0       0     0    R·jB_i turns at Ω, n_i at ≤ N
-``leg_interference`` 0     0     0     0       0     2    each segment's ends move by ≤ E
-                                                          (Hausdorff), two segments move
+``leg_interference`` 0     2c    0     0       0     2    each segment's ends move by ≤ E
+                                                          (+ c·N for a free length), two
+                                                          segments move; c below
 ``singularity``      0     √12   √12   0       0     0    Weyl's inequality, below
 ``actuator``         0     0     0     1       0     0    pus/rus: |dq_i| ≤ Q
 ``ik``               1     0     0     0       0     0    pus/rus: 1-Lipschitz in B_i (below)
@@ -72,6 +73,16 @@ with ``τ(a) + τ(b) − 2τ_f ≥ rate_τ(τ_f)·w`` holds: the stretches [a, a
 interval. That is a quadratic inequality in τ_f; the certificate takes the largest admissible
 value, and no floor (the rows that need one unbounded) when the interval may contain a pose
 without a solution (ik's lower bound < 0) or none is admissible.
+
+*Paired joints.* Two 6-UPS legs that share a joint (``geometry.paired_joint_length`` = c > 0)
+are compared along their free lengths, the segments A_i + s·L_i, s ∈ [α_i, β_i], with
+α_i = min(c/ℓ_i, 1) where they share the base joint (else 0) and β_i = max(1 − c/ℓ_i, α_i)
+where they share the platform joint (else 1). The free segment's ends are X = A_i + c·n_i
+(or B_i once ℓ_i ≤ c), moving at c·|dn_i| ≤ c·N (or ≤ E), and Y = B_i − c·n_i (or X), moving
+at ≤ E + c·N: both ends move at most at E + c·N, and the Hausdorff argument of the row gives
+``2E + 2c·N``, hence turn = 2c (0 when no legs share a joint: the row is unchanged). The ends
+are continuous in the pose (min and max of continuous functions), so the bound holds across
+the switch at ℓ_i = c.
 
 *Collision.* ``collision = min over the checked pairs of sd − collision.clearance`` (signed
 distances of the scene's bodies, :mod:`hexapod_workspace.core.collision.scene`), present only
@@ -231,6 +242,12 @@ def _actuator_report(manipulator: Manipulator) -> tuple[str, float]:
     return "mm", 1e3
 
 
+def _paired_turn(manipulator: Manipulator) -> float:
+    """The ``turn`` coefficient of ``leg_interference``: 2c, c = ``paired_joint_length`` (m; 0
+    when no legs share a joint): the free lengths' ends turn with the legs (*Paired joints*)."""
+    return 2.0 * manipulator.paired_joint_length
+
+
 def _value(coefficient: float | Callable[[Manipulator], float], manipulator: Manipulator) -> float:
     return float(coefficient(manipulator) if callable(coefficient) else coefficient)
 
@@ -357,7 +374,10 @@ CONSTRAINTS: tuple[Constraint, ...] = (
     Constraint(
         name="leg_interference",
         unit="m",
-        margin="min_{i<j} (dist(A_iB_i, A_jB_j) − D); +inf when D = 0 (check disabled)",
+        margin=(
+            "min_{i<j} (dist(A_iB_i, A_jB_j) − D), legs that share a joint along their free "
+            "lengths; +inf when D = 0 (check disabled)"
+        ),
         label="leg interference",
         column="interfer.",
         report_unit="mm",
@@ -365,7 +385,7 @@ CONSTRAINTS: tuple[Constraint, ...] = (
         scale=_diameter,
         scale_text="the leg diameter D (1 m when the check is disabled)",
         speed=0.0,
-        turn=0.0,
+        turn=_paired_turn,
         spin=0.0,
         ends=2.0,
     ),

@@ -31,10 +31,11 @@ from .params import (
 )
 from .resolution import MAX_POSITION_NORM
 from .validation import (
-    coincident_joints_reason,
     machine_size,
     millimetre_reason,
+    paired_joints_reason,
     require_usable,
+    shared_joint_pairs,
     unusable_reason,
 )
 
@@ -62,6 +63,7 @@ PARAMETER_DEFAULTS: dict[str, Any] = {
     "limits.base_joint_max_angle": None,
     "limits.platform_joint_max_angle": None,
     "limits.leg_diameter": 0.0,
+    "geometry.paired_joint_length": 0.0,
     "limits.singularity_min": 0.0,
     "pose.position": None,
     "geometry.architecture": "ups",
@@ -78,7 +80,7 @@ PARAMETER_DEFAULTS: dict[str, Any] = {
 #: The parameters only one architecture has (the others refuse them when given), and the
 #: required ones (``None`` in :data:`PARAMETER_DEFAULTS` or listed here) of each.
 ARCHITECTURE_PARAMETERS: dict[str, tuple[str, ...]] = {
-    "ups": ("limits.leg_length_min", "limits.leg_length_max"),
+    "ups": ("limits.leg_length_min", "limits.leg_length_max", "geometry.paired_joint_length"),
     "pus": (
         "geometry.rail_directions",
         "geometry.leg_lengths",
@@ -467,6 +469,10 @@ class Manipulator:
         Maximum angle between a joint axis and its leg, rad, in (0, π).
     leg_diameter : float
         D, m; legs must stay at least D apart (segment distance); 0 disables the check.
+    paired_joint_length : float
+        c, m (ups): along each leg, from a joint centre it shares with another leg, the length
+        the joint occupies; the interference of two legs that share a joint is measured on the
+        rest of them (their free lengths). 0 when no legs share a joint or D = 0.
     home_position : ndarray, shape (3,)
         Home position OC, base frame, m; the default joint axes are the leg directions there.
     position : ndarray, shape (3,)
@@ -528,6 +534,7 @@ class Manipulator:
     actuator_max: NDArray[np.float64] | None = None
     transmission_min: float = 0.1
     collision: CollisionScene | None = None
+    paired_joint_length: float = 0.0
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -603,13 +610,9 @@ class Manipulator:
         platform_joints = _joint_array(
             "geometry.platform_joints", values["geometry.platform_joints"]
         )
-        for name, joints in (
-            ("geometry.base_joints", base_joints),
-            ("geometry.platform_joints", platform_joints),
-        ):
-            coincident = coincident_joints_reason(name, joints)
-            if coincident is not None:
-                raise GeometryError(coincident)
+        paired = paired_joints_reason(base_joints, platform_joints, architecture)
+        if paired is not None:
+            raise GeometryError(paired)
         home = _vector3("geometry.home_position", values["geometry.home_position"])
         position = _vector3("pose.position", values["pose.position"])
         if architecture == "ups":
@@ -654,6 +657,14 @@ class Manipulator:
         if diameter[0] < 0.0:
             msg = f"limits.leg_diameter: expected a value >= 0 m, got {diameter[0]:g}"
             raise GeometryError(msg)
+        paired_length = _paired_joint_length(
+            values["geometry.paired_joint_length"],
+            base_joints,
+            platform_joints,
+            float(diameter[0]),
+            length_min,
+            machine_size(base_joints, platform_joints, home),
+        )
 
         base_axes = _axes("geometry.base_joint_axes", values["geometry.base_joint_axes"])
         platform_axes = _axes(
@@ -675,6 +686,7 @@ class Manipulator:
             base_joint_max_angle=_frozen(angles["limits.base_joint_max_angle"]),
             platform_joint_max_angle=_frozen(angles["limits.platform_joint_max_angle"]),
             leg_diameter=float(diameter[0]),
+            paired_joint_length=paired_length,
             home_position=_frozen(home),
             position=_frozen(position),
             frame_id=frame_id,
@@ -794,6 +806,7 @@ class Manipulator:
             "limits.base_joint_max_angle": floats(self.base_joint_max_angle),
             "limits.platform_joint_max_angle": floats(self.platform_joint_max_angle),
             "limits.leg_diameter": float(self.leg_diameter),
+            "geometry.paired_joint_length": float(self.paired_joint_length),
             "limits.singularity_min": float(self.singularity_min),
             "pose.position": floats(self.position),
             "geometry.architecture": self.architecture,
@@ -856,6 +869,7 @@ class Manipulator:
             and self.architecture == other.architecture
             and self.transmission_min == other.transmission_min
             and self.leg_diameter == other.leg_diameter
+            and self.paired_joint_length == other.paired_joint_length
             and self.singularity_min == other.singularity_min
             and self.frame_id == other.frame_id
             and self.axes_from_home == other.axes_from_home
@@ -863,6 +877,83 @@ class Manipulator:
         )
 
     __hash__ = None  # type: ignore[assignment]
+
+    @property
+    def shared_base_pairs(self) -> NDArray[np.bool_]:
+        """Leg pairs i < j (``numpy.triu_indices(6, 1)`` order, shape (15,)) that share a base
+        joint."""
+        return shared_joint_pairs(self.base_joints)
+
+    @property
+    def shared_platform_pairs(self) -> NDArray[np.bool_]:
+        """Leg pairs i < j (shape (15,)) that share a platform joint."""
+        return shared_joint_pairs(self.platform_joints)
+
+
+def _paired_joint_length(
+    value: Any,
+    base_joints: NDArray[np.float64],
+    platform_joints: NDArray[np.float64],
+    diameter: float,
+    length_min: NDArray[np.float64],
+    size: float,
+) -> float:
+    """``geometry.paired_joint_length`` validated against the joints that legs share (m).
+
+    Required (> 0) when legs share a joint and the interference check is on; refused when no
+    legs share one (it would change nothing: a value the user meant for another machine); less
+    than the shortest leg's length once per shared end, so that every leg keeps a free length.
+    """
+    name = "geometry.paired_joint_length"
+    length = _length(name, _numbers(name, value))
+    if length.size != 1:
+        msg = f"{name}: expected one number, got {length.size}"
+        raise GeometryError(msg)
+    c = float(length[0])
+    if c < 0.0:
+        msg = f"{name}: expected a value >= 0 m, got {c:g}"
+        raise GeometryError(msg)
+    unit_reason = millimetre_reason(name, c, size)
+    if unit_reason is not None:
+        raise GeometryError(unit_reason)
+    base, platform = shared_joint_pairs(base_joints), shared_joint_pairs(platform_joints)
+    pair_i, pair_j = np.triu_indices(6, 1)
+    if not (base.any() or platform.any()):
+        if c > 0.0:
+            gaps = [
+                float(np.min(np.linalg.norm(joints[pair_i] - joints[pair_j], axis=-1)))
+                for joints in (base_joints, platform_joints)
+            ]
+            msg = (
+                f"{name}: given ({c:g} m), but no two legs share a joint (the closest joint "
+                f"centres are {min(gaps):.3g} m apart); remove it"
+            )
+            raise GeometryError(msg)
+        return 0.0
+    if diameter > 0.0 and c == 0.0:
+        first = int(np.flatnonzero(base | platform)[0])
+        where = "base" if base[first] else "platform"
+        msg = (
+            f"{name}: required when legs share a joint and limits.leg_diameter > 0 (legs "
+            f"{pair_i[first] + 1} and {pair_j[first] + 1} share a {where} joint): the length "
+            "of each leg from the shared joint centre that the joint occupies, m; their "
+            "interference is measured on the rest"
+        )
+        raise GeometryError(msg)
+    ends = np.zeros(6)
+    for shared in (base, platform):
+        legs = np.unique(np.concatenate([pair_i[shared], pair_j[shared]]))
+        ends[legs] += 1.0
+    short = np.flatnonzero(ends * c >= length_min)
+    if short.size:
+        k = int(short[0])
+        msg = (
+            f"{name}: expected less than {length_min[k] / ends[k]:g} m (leg {k + 1}: "
+            f"limits.leg_length_min {length_min[k]:g} m over its {int(ends[k])} shared "
+            f"joint(s), so that it keeps a free length), got {c:g}"
+        )
+        raise GeometryError(msg)
+    return c
 
 
 def _with_scene(manipulator: Manipulator, flat: Mapping[str, Any]) -> Manipulator:

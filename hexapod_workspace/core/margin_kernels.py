@@ -61,6 +61,7 @@ from .model_layout import (
     ORDER,
     PAIR_I,
     PAIR_J,
+    PAIRED_LENGTH,
     QCENTRE,
     QCOS,
     QMAX,
@@ -72,6 +73,8 @@ from .model_layout import (
     RPAIR,
     RR,
     SCALE,
+    SHARED_BASE,
+    SHARED_PLATFORM,
     SINGULARITY_MIN,
     SINGULARITY_ON,
     TAU_MIN,
@@ -254,24 +257,27 @@ def _pose(
         xj = lx[j]
         yj = ly[j]
         zj = lz[j]
-        c = xi * rx + yi * ry + zi * rz
-        f = xj * rx + yj * ry + zj * rz
         a = sq[i]
         e = sq[j]
-        gap = rr + min(c, 0.0) - max(f, 0.0)
-        if gap > 0.0 and gap * gap >= rr * (best_squared + 1e-12 * (rr + a + e)):
-            continue
-        b = xi * xj + yi * yj + zi * zj
-        denom = a * e - b * b
-        if denom > 1e-14 * a * e:
-            s = min(max((b * f - c * e) / denom, 0.0), 1.0)
-            t = min(max((b * s + f) * inverse_sq[j], 0.0), 1.0)
-            s = min(max((b * t - c) * inverse_sq[i], 0.0), 1.0)
+        if model[SHARED_BASE + pair] + model[SHARED_PLATFORM + pair] != 0.0:
+            squared = _free_squared(model, pair, rx, ry, rz, xi, yi, zi, xj, yj, zj, a, e)[0]
         else:
-            # Parallel or point-like segments (or NaN): start from s = 0.
-            t = 0.0 if e <= 1e-300 else _clamp01(f / e)
-            s = 0.0 if a <= 1e-300 else _clamp01((b * t - c) / a)
-        squared = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
+            c = xi * rx + yi * ry + zi * rz
+            f = xj * rx + yj * ry + zj * rz
+            gap = rr + min(c, 0.0) - max(f, 0.0)
+            if gap > 0.0 and gap * gap >= rr * (best_squared + 1e-12 * (rr + a + e)):
+                continue
+            b = xi * xj + yi * yj + zi * zj
+            denom = a * e - b * b
+            if denom > 1e-14 * a * e:
+                s = min(max((b * f - c * e) / denom, 0.0), 1.0)
+                t = min(max((b * s + f) * inverse_sq[j], 0.0), 1.0)
+                s = min(max((b * t - c) * inverse_sq[i], 0.0), 1.0)
+            else:
+                # Parallel or point-like segments (or NaN): start from s = 0.
+                t = 0.0 if e <= 1e-300 else _clamp01(f / e)
+                s = 0.0 if a <= 1e-300 else _clamp01((b * t - c) / a)
+            squared = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
         # Compare distances, not their squares, where it matters: pairs whose squares differ
         # in the last bit can have equal distances, and then the lower pair index limits.
         if squared <= best_squared or squared != squared:
@@ -1255,6 +1261,79 @@ def _pair_squared(
 
 
 @_inline
+def _free_squared(
+    model: NDArray[np.float64],
+    pair: int,
+    rx: float,
+    ry: float,
+    rz: float,
+    xi: float,
+    yi: float,
+    zi: float,
+    xj: float,
+    yj: float,
+    zj: float,
+    a: float,
+    e: float,
+) -> tuple[float, float]:
+    """Squared distance of the free lengths of two legs that share a joint (pair ``pair``),
+    and 1.0 when they are parallel or point-like (else 0.0).
+
+    The free length of leg i is A_i + s·L_i for s in [α_i, β_i]: α_i = min(c/ℓ_i, 1) where the
+    pair shares its base joint (else 0), β_i = max(1 − c/ℓ_i, α_i) where it shares its platform
+    joint (else 1), c = ``model[PAIRED_LENGTH]``, ℓ_i = |L_i| (r = A_i − A_j, a = ℓ_i²,
+    e = ℓ_j²). Ericson's clamped closest points of the two free segments, with the fallback of
+    :func:`_pose` for parallel or point-like ones. The ends move at most c·N faster than the
+    leg's ends (the rate bound of ``leg_interference`` in the constraint table)."""
+    c = model[PAIRED_LENGTH]
+    li = math.sqrt(a)
+    lj = math.sqrt(e)
+    base = model[SHARED_BASE + pair] != 0.0
+    ai = min(c / li, 1.0) if base else 0.0
+    aj = min(c / lj, 1.0) if base else 0.0
+    platform = model[SHARED_PLATFORM + pair] != 0.0
+    bi = max(1.0 - c / li, ai) if platform else 1.0
+    bj = max(1.0 - c / lj, aj) if platform else 1.0
+    # The free segments: starts S_i = A_i + α_i·L_i (u = S_i − S_j) and vectors (β − α)·L.
+    ux = rx + ai * xi - aj * xj
+    uy = ry + ai * yi - aj * yj
+    uz = rz + ai * zi - aj * zj
+    dix, diy, diz = (bi - ai) * xi, (bi - ai) * yi, (bi - ai) * zi
+    djx, djy, djz = (bj - aj) * xj, (bj - aj) * yj, (bj - aj) * zj
+    a2 = dix * dix + diy * diy + diz * diz
+    e2 = djx * djx + djy * djy + djz * djz
+    b = dix * djx + diy * djy + diz * djz
+    c2 = dix * ux + diy * uy + diz * uz
+    f = djx * ux + djy * uy + djz * uz
+    denom = a2 * e2 - b * b
+    if denom > 1e-14 * a2 * e2:
+        s = _clamp01((b * f - c2 * e2) / denom)
+        t = _clamp01((b * s + f) / e2)
+        s = _clamp01((b * t - c2) / a2)
+        regular = 0.0
+    else:
+        t = 0.0 if e2 <= 1e-300 else _clamp01(f / e2)
+        s = 0.0 if a2 <= 1e-300 else _clamp01((b * t - c2) / a2)
+        regular = 1.0
+    rr = ux * ux + uy * uy + uz * uz
+    squared = rr + s * (s * a2 + 2.0 * (c2 - t * b)) + t * (t * e2 - 2.0 * f)
+    return squared, regular
+
+
+@_inline
+def _keep_pair(
+    minima: NDArray[np.float64], n: int, squared: float, irregular: float, pf: float
+) -> None:
+    """Pose n: a pair's squared distance into the running minimum and its pair (first pair on
+    ties), ``irregular`` (parallel or point-like legs) into the flag of the exact path."""
+    distance = max(squared, 0.0)
+    smallest = minima[_BEST * BLOCK + n]
+    minima[_PAIR * BLOCK + n] = pf if distance < smallest else minima[_PAIR * BLOCK + n]
+    minima[_BEST * BLOCK + n] = min(distance, smallest)
+    minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], irregular)
+
+
+@_inline
 def _pair_at(
     leg_i: NDArray[np.float64],
     leg_j: NDArray[np.float64],
@@ -1291,11 +1370,7 @@ def _pair_at(
         leg_i[_INV * BLOCK + n],
         leg_j[_INV * BLOCK + n],
     )
-    distance = max(squared, 0.0)
-    smallest = minima[_BEST * BLOCK + n]
-    minima[_PAIR * BLOCK + n] = pf if distance < smallest else minima[_PAIR * BLOCK + n]
-    minima[_BEST * BLOCK + n] = min(distance, smallest)
-    minima[_FIX * BLOCK + n] = max(minima[_FIX * BLOCK + n], regular)
+    _keep_pair(minima, n, squared, regular, pf)
 
 
 @_helper
@@ -1316,6 +1391,40 @@ def _pair_plane(
     rr, pf = model[RR + pair], float(pair)
     for n in range(count):
         _pair_at(leg_i, leg_j, minima, n, rx, ry, rz, rr, pf)
+
+
+@_helper
+def _paired_plane(
+    model: NDArray[np.float64],
+    leg_i: NDArray[np.float64],
+    leg_j: NDArray[np.float64],
+    minima: NDArray[np.float64],
+    count: int,
+    pair: int,
+) -> None:
+    """:func:`_pair_plane` for two legs that share a joint: the distance of their free lengths
+    (:func:`_free_squared`)."""
+    rx = model[RPAIR + 3 * pair]
+    ry = model[RPAIR + 3 * pair + 1]
+    rz = model[RPAIR + 3 * pair + 2]
+    pf = float(pair)
+    for n in range(count):
+        squared, irregular = _free_squared(
+            model,
+            pair,
+            rx,
+            ry,
+            rz,
+            leg_i[_LX * BLOCK + n],
+            leg_i[_LY * BLOCK + n],
+            leg_i[_LZ * BLOCK + n],
+            leg_j[_LX * BLOCK + n],
+            leg_j[_LY * BLOCK + n],
+            leg_j[_LZ * BLOCK + n],
+            leg_i[_SQ * BLOCK + n],
+            leg_j[_SQ * BLOCK + n],
+        )
+        _keep_pair(minima, n, squared, irregular, pf)
 
 
 @_helper
@@ -1622,6 +1731,8 @@ def _check_block(
                         count,
                         pair,
                     )
+                elif model[SHARED_BASE + pair] + model[SHARED_PLATFORM + pair] != 0.0:
+                    _paired_plane(model, leg_i, leg_j, minima, count, pair)
                 else:
                     _pair_plane(model, leg_i, leg_j, minima, count, pair)
                 pair += 1

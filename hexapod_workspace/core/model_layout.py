@@ -75,7 +75,13 @@ RAY_DRIVE = TAU_MIN + 1  # (actuate·g + crank/r_min + ends)·ρ, g = 1 (pus) or
 # rows after it are +inf for every pose; check() neither allocates nor fills them).
 ROWS_USED = RAY_DRIVE + N_CONSTRAINTS
 COLLISION_ON = ROWS_USED + 1  # 1.0 when a collision block follows MODEL_SIZE
-MODEL_SIZE = COLLISION_ON + 1
+# Paired joints (ups): per pair, 1.0 where the two legs share their base (platform) joint; the
+# interference of such a pair is measured between the legs' free lengths, PAIRED_LENGTH (c, m)
+# left out at each shared end (constraint_table, leg_interference).
+SHARED_BASE = COLLISION_ON + 1  # (15)
+SHARED_PLATFORM = SHARED_BASE + 15  # (15)
+PAIRED_LENGTH = SHARED_PLATFORM + 15  # c, m
+MODEL_SIZE = PAIRED_LENGTH + 1
 
 #: Leg pairs (i < j) in the order of numpy.triu_indices(6, 1).
 PAIR_I = np.array([i for i in range(6) for j in range(i + 1, 6)], dtype=np.int64)
@@ -123,6 +129,9 @@ def model_vector(manipulator: Manipulator, report_singularity: bool = False) -> 
     model[RR : RR + 15] = np.einsum("pk,pk->p", r, r)
     model[DIAMETER] = manipulator.leg_diameter
     model[INTERFERENCE] = 1.0 if manipulator.leg_diameter > 0.0 else 0.0
+    model[SHARED_BASE : SHARED_BASE + 15] = manipulator.shared_base_pairs
+    model[SHARED_PLATFORM : SHARED_PLATFORM + 15] = manipulator.shared_platform_pairs
+    model[PAIRED_LENGTH] = manipulator.paired_joint_length
     alpha, beta = manipulator.base_joint_max_angle, manipulator.platform_joint_max_angle
     model[ALPHA_EQUAL] = 1.0 if np.all(alpha == alpha[0]) else 0.0
     model[BETA_EQUAL] = 1.0 if np.all(beta == beta[0]) else 0.0

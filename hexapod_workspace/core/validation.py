@@ -4,10 +4,15 @@ One set of rules for every door a model comes in by (the CLI's ``--config`` file
 parameters at start, a ``set_parameters`` call): the node's start-up and run-time validation
 and the CLI's all end here.
 
-* **Coincident joints** (:func:`coincident_joints_reason`): two base joints, or two platform
-  joints, closer than :data:`COINCIDENT_TOLERANCE`. Each leg of a 6-UPS hexapod has its own
-  universal and spherical joint; two legs sharing a joint centre make the leg-interference
-  distance zero for every pose and, when more than two share it, the platform singular.
+* **Paired joints** (:func:`shared_joint_pairs`, :func:`paired_joints_reason`): two joint
+  centres closer than :data:`COINCIDENT_TOLERANCE` are one joint shared by two legs, as
+  builders draw the 6-3, 3-3 and zig-zag designs and LinuxCNC's default ``genhexkins``
+  machine. 6-UPS legs may share joints (the interference of two legs that share one is
+  measured along their free lengths, ``geometry.paired_joint_length``:
+  :mod:`~hexapod_workspace.core.constraint_table`); refused are four or more legs through one
+  point (their lines are always linearly dependent: the platform is singular at every pose),
+  two legs that share both joints (one leg twice), and shared joints of the pus and rus legs,
+  whose base-side ends move (not modelled).
 * **Zero-length legs** at the home pose (checked by the model builder itself).
 * **A platform singular at the home pose** (:func:`home_conditioning`): the 6×6 matrix whose
   rows are the legs' normalised Plücker coordinates ``(n_i, (R·b_i × n_i) / ρ)`` (identity
@@ -50,8 +55,10 @@ __all__ = [
     "home_conditioning",
     "machine_size",
     "millimetre_reason",
+    "paired_joints_reason",
     "require_plausible_cell",
     "require_usable",
+    "shared_joint_pairs",
     "unusable_reason",
 ]
 
@@ -157,8 +164,77 @@ def require_plausible_cell(manipulator: Manipulator, cell: CellFrames) -> CellFr
     return cell
 
 
+def shared_joint_pairs(joints: ArrayLike) -> NDArray[np.bool_]:
+    """Which leg pairs share a joint centre (closer than :data:`COINCIDENT_TOLERANCE`).
+
+    Parameters
+    ----------
+    joints : array_like, shape (6, 3)
+        Base or platform joint centres, m.
+
+    Returns
+    -------
+    ndarray of bool, shape (15,)
+        Per pair i < j in the order of ``numpy.triu_indices(6, 1)`` (the interference pairs).
+    """
+    array = np.asarray(joints, dtype=np.float64)
+    i, j = np.triu_indices(6, 1)
+    shared: NDArray[np.bool_] = np.linalg.norm(array[i] - array[j], axis=-1) < COINCIDENT_TOLERANCE
+    return shared
+
+
+def paired_joints_reason(
+    base_joints: NDArray[np.float64], platform_joints: NDArray[np.float64], architecture: str
+) -> str | None:
+    """Why shared joint centres make no machine, or None (see the module's *Paired joints*).
+
+    Parameters
+    ----------
+    base_joints, platform_joints : ndarray, shape (6, 3)
+        Joint centres, m (base and platform frames).
+    architecture : str
+        ``"ups"``, ``"pus"`` or ``"rus"``.
+    """
+    if architecture != "ups":
+        for name, joints in (
+            ("geometry.base_joints", base_joints),
+            ("geometry.platform_joints", platform_joints),
+        ):
+            reason = coincident_joints_reason(name, joints)
+            if reason is not None:
+                return (
+                    f"{reason}; paired joints are modelled for geometry.architecture ups only "
+                    f"(got {architecture}, whose base-side joints move)"
+                )
+        return None
+    for name, joints in (
+        ("geometry.base_joints", base_joints),
+        ("geometry.platform_joints", platform_joints),
+    ):
+        for k in range(6):
+            group = np.flatnonzero(
+                np.linalg.norm(joints - joints[k], axis=-1) < COINCIDENT_TOLERANCE
+            )
+            if group.size > 3:
+                legs = ", ".join(str(int(g) + 1) for g in group[:-1])
+                return (
+                    f"{name}: expected at most three legs per joint centre, joints {legs} and "
+                    f"{int(group[-1]) + 1} coincide at {np.round(joints[k], 9).tolist()} m (four "
+                    "or more leg lines through one point are linearly dependent: the platform "
+                    "would be singular at every pose)"
+                )
+    both = np.flatnonzero(shared_joint_pairs(base_joints) & shared_joint_pairs(platform_joints))
+    if both.size:
+        i, j = (int(v[both[0]]) + 1 for v in np.triu_indices(6, 1))
+        return (
+            f"geometry.platform_joints: legs {i} and {j} share both their base and their "
+            "platform joint: expected six distinct legs, got one leg twice"
+        )
+    return None
+
+
 def coincident_joints_reason(name: str, joints: NDArray[np.float64]) -> str | None:
-    """Why six joint centres are degenerate (two at one point), or None.
+    """Why six joint centres are not six distinct ones (two at one point), or None.
 
     Parameters
     ----------

@@ -98,6 +98,12 @@ MODEL_DESCRIPTIONS = {
     "limits.leg_diameter": (
         "Leg diameter D, m: legs (segments A_iB_i) must stay D apart; 0 disables the check."
     ),
+    "geometry.paired_joint_length": (
+        "ups: where legs share a joint (paired joints: 6-3, 3-3, LinuxCNC's default), the "
+        "length of each leg from the shared joint centre that the joint occupies, m; their "
+        "interference is measured on the rest. Required then with limits.leg_diameter > 0; "
+        "0 = no legs share a joint."
+    ),
     "limits.singularity_min": (
         "Smallest allowed singular value of the homogenised Plucker matrix of the legs, in "
         "[0, 1]; 0 disables the singularity margin."
@@ -140,6 +146,7 @@ MODEL_DESCRIPTIONS = {
 #: Ranges of the model's scalar parameters (the model validation says the same).
 _FLOAT_RANGES = {
     "limits.leg_diameter": (0.0, 10.0),
+    "geometry.paired_joint_length": (0.0, 10.0),
     "limits.singularity_min": (0.0, 1.0),
     "limits.transmission_min": (0.0, 1.0),
 }

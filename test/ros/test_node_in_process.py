@@ -189,11 +189,12 @@ def test_no_model_parameter_uses_the_example_and_says_so(ros_context, capfd):
 DEGENERATE = [
     (
         {"geometry.base_joints": [0.0] * 18},
-        "geometry.base_joints: expected six distinct joint centres, joints 1 and 2 coincide",
+        "geometry.base_joints: expected at most three legs per joint centre, joints 1, 2, 3, 4, "
+        "5 and 6 coincide",
     ),
     (
         {"geometry.platform_joints": [0.1, 0.0, 0.1] * 6},
-        "geometry.platform_joints: expected six distinct joint centres",
+        "geometry.platform_joints: expected at most three legs per joint centre",
     ),
     (
         # home + b_1 = a_1: leg 1 has zero length at the home pose

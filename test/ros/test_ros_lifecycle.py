@@ -82,7 +82,7 @@ def test_node_stops_cleanly_while_goals_compute_and_queue(ros_client, tmp_path):
         ({"limits.leg_lenght_max": [1.30]}, "limits.leg_lenght_max: unknown parameter"),
         ({"limit.leg_length_max": [1.30]}, "limit: unknown section"),
         # a degenerate machine: six legs from one point
-        ({"geometry.base_joints": [0.0] * 18}, "joints 1 and 2 coincide"),
+        ({"geometry.base_joints": [0.0] * 18}, "joints 1, 2, 3, 4, 5 and 6 coincide"),
     ],
     ids=[
         "lengths",
