@@ -27,7 +27,7 @@ import numpy as np
 from .. import __version__
 from ..core import kernels, resolution
 from ..errors import HexapodWorkspaceError
-from . import atlas, cam, check_path, commands, reach, scene
+from . import atlas, cam, check_path, commands, linuxcnc, reach, scene
 from .inputs import (
     PLOT_FORMATS,
     CliError,
@@ -481,6 +481,14 @@ for _command in (
         reach.AXIS_LIMITS_DESCRIPTION,
         reach.axis_limits_arguments,
         reach.cmd_axis_limits,
+    ),
+    Command(
+        "import-genhexkins",
+        linuxcnc.IMPORT_HELP,
+        linuxcnc.IMPORT_DESCRIPTION,
+        linuxcnc.import_arguments,
+        linuxcnc.cmd_import_genhexkins,
+        uses=("json",),
     ),
 ):
     register(_command)
