@@ -24,6 +24,7 @@ from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core.constraint_table import INDEX, rate_bounds
 from hexapod_workspace.core.constraints import pose_margins
 from hexapod_workspace.core.rotations import tt_to_matrix
+from hexapod_workspace.core.scene_view import scene_view
 
 INCH = 0.0254
 #: genhexkins.base.N / genhexkins.platform.N of kinematics.hal, inches.
@@ -275,3 +276,21 @@ def test_the_rate_bound_of_free_lengths_holds_against_finite_differences(layout)
         observed = float(np.max(np.abs(np.diff(margins)))) / (s[1] - s[0])
         worst = max(worst, observed / float(bound[INTERFERENCE, 0]))
     assert 0.0 < worst <= 1.0
+
+
+def test_the_scene_s_closest_legs_are_the_margin_s(linuxcnc):
+    """The picture and the markers name the pair and the margin the check gives (free lengths
+    for the shared pairs, not the zero distance at their joint)."""
+    rng = np.random.default_rng(3)
+    shared_named = 0
+    for _ in range(40):
+        angles = rng.uniform([-np.pi, 0.0, -0.6], [np.pi, 0.6, 0.6])
+        position = HOME + rng.uniform(-0.1, 0.1, 3)
+        margins = pose_margins(linuxcnc, tt_to_matrix(angles)[None], position)
+        view = scene_view(linuxcnc, tt_to_matrix(angles), position)
+        assert view.closest is not None and view.closest.constraint == "leg_interference"
+        assert view.closest.margin == pytest.approx(margins.margins[INTERFERENCE][0], abs=1e-12)
+        # (Legs 1–2, 3–4 and 5–6 end 2 in apart at the platform: their distance ties, and
+        # either picture of a tie is right; the margin is the check's.)
+        shared_named += view.closest.name in ("leg 1 vs leg 6", "leg 2 vs leg 3", "leg 4 vs leg 5")
+    assert shared_named > 0

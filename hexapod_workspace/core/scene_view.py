@@ -347,18 +347,42 @@ def closest_points(first: Body, second: Body) -> NDArray[np.float64]:
     return np.array([a, b])
 
 
-def _leg_pairs(bodies: list[Body], diameter: float) -> tuple[float, int, int] | None:
-    """Smallest leg-pair margin (segment distance − D) and the two leg indices."""
-    if diameter <= 0.0:
+def _leg_pairs(
+    bodies: list[Body], manipulator: Manipulator
+) -> tuple[float, int, int, NDArray[np.float64]] | None:
+    """Smallest leg-pair margin (segment distance − D), the two leg indices and the closest
+    points; legs that share a joint are compared along their free lengths, as the
+    ``leg_interference`` margin compares them (:func:`_free_lengths`)."""
+    if manipulator.leg_diameter <= 0.0:
         return None
-    best: tuple[float, int, int] | None = None
+    best: tuple[float, int, int, NDArray[np.float64]] | None = None
+    base, platform = manipulator.shared_base_pairs, manipulator.shared_platform_pairs
+    pair = 0
     for i in range(6):
         for j in range(i + 1, 6):
-            points = _segment_closest(bodies[i].points, bodies[j].points)
-            margin = float(np.linalg.norm(points[1] - points[0])) - diameter
+            ends = (base[pair], platform[pair], manipulator.paired_joint_length)
+            points = _segment_closest(
+                _free_lengths(bodies[i].points, *ends), _free_lengths(bodies[j].points, *ends)
+            )
+            margin = float(np.linalg.norm(points[1] - points[0])) - manipulator.leg_diameter
             if best is None or margin < best[0]:
-                best = (margin, i, j)
+                best = (margin, i, j, points)
+            pair += 1
     return best
+
+
+def _free_lengths(
+    leg: NDArray[np.float64], base: bool, platform: bool, length: float
+) -> NDArray[np.float64]:
+    """The segment A_iB_i (2, 3) without ``length`` (m) at a shared base or platform end (not
+    past the other end): what ``leg_interference`` measures for legs that share a joint."""
+    vector = leg[1] - leg[0]
+    size = float(np.linalg.norm(vector))
+    if not (base or platform) or size == 0.0:
+        return leg
+    start = min(length / size, 1.0) if base else 0.0
+    end = max(1.0 - length / size, start) if platform else 1.0
+    return np.array([leg[0] + start * vector, leg[0] + end * vector])
 
 
 def _segment_closest(p: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -402,10 +426,9 @@ def _closest_pair(
             points = closest_points(by_name[first], by_name[second])
             margin = float(result.margin[0])
             candidates.append(ClosestPair(name, first, second, "collision", margin, points))
-    legs = _leg_pairs(bodies, manipulator.leg_diameter)
+    legs = _leg_pairs(bodies, manipulator)
     if legs is not None:
-        margin, i, j = legs
-        points = _segment_closest(bodies[i].points, bodies[j].points)
+        margin, i, j, points = legs
         first, second = bodies[i].name, bodies[j].name
         candidates.append(
             ClosestPair(f"{first} vs {second}", first, second, "leg_interference", margin, points)
