@@ -38,6 +38,7 @@ def psi_zero_baseline(manipulator: Manipulator, path: PathCheck) -> PathCheck:
         angles=angles,
         interpolation=path.interpolation,
         tolerance=path.tolerance,
+        arcs=path.arcs,
     )
 
 

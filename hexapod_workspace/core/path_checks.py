@@ -33,6 +33,7 @@ from .path_certificate import (
 from .path_interpolation import (
     _Moves,
     _orientations,
+    _validate_arcs,
     _validate_interpolation,
     _validate_positions,
     _validate_tolerance,
@@ -109,6 +110,7 @@ def check_path(
     interpolation: str = "slerp",
     tolerance: float = DEFAULT_PATH_TOLERANCE,
     max_sample_angle: float = DEFAULT_MAX_SAMPLE_ANGLE,
+    arcs: ArrayLike | None = None,
 ) -> PathCheck:
     """Check a path of N waypoints and the N − 1 moves between them, certified.
 
@@ -131,6 +133,10 @@ def check_path(
         band may be missed; also the accuracy of the first violation. 1e-9 to 0.1.
     max_sample_angle : float
         Largest motion (rad-equivalent) between poses evaluated for the sampled minimum margin.
+    arcs : array_like, shape (N − 1, 7), optional
+        Moves that are arcs (CAM's ``CIRCLE``): per move, centre (m, base frame), axis and
+        angle φ (rad, right-handed about the axis); a row of NaN for a straight move
+        (:mod:`~hexapod_workspace.core.path_interpolation`). None: every move is straight.
 
     Returns
     -------
@@ -151,10 +157,17 @@ def check_path(
     if not (math.isfinite(max_sample_angle) and max_sample_angle >= tolerance):
         msg = f"max_sample_angle: expected a finite value >= tolerance, got {max_sample_angle!r}"
         raise ResolutionError(msg)
+    circles = _validate_arcs(arcs, positions)
     certifier = _Certifier(manipulator)
     waypoints, found = _waypoint_checks(certifier, positions, matrices)
     moves = _Moves(
-        positions[:-1], positions[1:], matrices[:-1], matrices[1:], interpolation, certifier.rho
+        positions[:-1],
+        positions[1:],
+        matrices[:-1],
+        matrices[1:],
+        interpolation,
+        certifier.rho,
+        arcs=circles,
     )
     raw = _check_moves(
         certifier,
@@ -173,6 +186,7 @@ def check_path(
         interpolation=interpolation,
         tolerance=tolerance,
         elapsed=time.perf_counter() - started,
+        arcs=None if circles is None else np.array(arcs, dtype=np.float64),
     )
 
 

@@ -57,8 +57,10 @@ from .path_certificate import (
 )
 from .path_checks import check_path
 from .path_interpolation import (
+    _Arcs,
     _Moves,
     _unit_rows,
+    _validate_arcs,
     _validate_interpolation,
     _validate_positions,
     _validate_tolerance,
@@ -83,6 +85,7 @@ def plan_torsion(
     interpolation: str = "slerp",
     tolerance: float = DEFAULT_PATH_TOLERANCE,
     margin_resolution: float = DEFAULT_MARGIN_RESOLUTION,
+    arcs: ArrayLike | None = None,
 ) -> TorsionPlan:
     """Choose the torsion at every waypoint of a toolpath for an axisymmetric tool.
 
@@ -107,6 +110,9 @@ def plan_torsion(
     margin_resolution : float
         The objective is maximised in levels of this many relative-margin units (1e-6 to
         0.1): the plan's smallest margin is within this of the best on the grid.
+    arcs : array_like, shape (N − 1, 7), optional
+        Moves that are arcs, as :func:`~hexapod_workspace.core.path_checks.check_path` takes
+        them.
 
     Returns
     -------
@@ -131,12 +137,14 @@ def plan_torsion(
             msg = f"max_dpsi: expected a finite value >= 0 rad or None, got {max_dpsi!r}"
             raise InputError(msg)
     directions = approach_to_tilt(axes)  # (N, 2)
+    circles = _validate_arcs(arcs, positions)
     baseline = check_path(
         manipulator,
         positions,
         angles=np.column_stack([directions, np.zeros(count)]),
         interpolation=interpolation,
         tolerance=tolerance,
+        arcs=arcs,
     )
     margin_resolution = float(margin_resolution)
     if not (math.isfinite(margin_resolution) and 1e-6 <= margin_resolution <= 0.1):
@@ -151,6 +159,7 @@ def plan_torsion(
         interpolation,
         tolerance,
         margin_resolution,
+        circles,
     )
     psi, objective, breakpoint = planner.solve()
     path = None
@@ -161,6 +170,7 @@ def plan_torsion(
             angles=np.column_stack([directions, psi]),
             interpolation=interpolation,
             tolerance=tolerance,
+            arcs=arcs,
         )
     return TorsionPlan(
         ok=psi is not None,
@@ -230,8 +240,10 @@ class _Planner:
         interpolation: str,
         tolerance: float,
         resolution: float,
+        arcs: _Arcs | None = None,
     ) -> None:
         self.certifier = _Certifier(manipulator)
+        self.arcs = arcs
         self.positions = positions
         self.interpolation = interpolation
         self.tolerance = tolerance
@@ -297,6 +309,7 @@ class _Planner:
             self.interpolation,
             self.certifier.rho,
             quaternions=(self.quaternions[k, g], self.quaternions[k + 1, h]),
+            arcs=None if self.arcs is None else self.arcs.take(k),
         )
 
     def _certify_by_ends(self) -> None:

@@ -159,6 +159,9 @@ class PathCheck:
         rad of platform rotation (see the module documentation).
     elapsed : float
         s.
+    arcs : ndarray, shape (N − 1, 7), or None
+        The moves that are arcs, as :func:`check_path` took them (NaN rows: straight moves);
+        None when every move is straight.
     """
 
     waypoints: WaypointChecks
@@ -166,6 +169,7 @@ class PathCheck:
     interpolation: str
     tolerance: float
     elapsed: float
+    arcs: NDArray[np.float64] | None = field(default=None, repr=False)
 
     @property
     def ok(self) -> bool:

@@ -11,6 +11,11 @@ p(s) + R(s)·b_i`` and moves at ``v_i = dB_i/ds = Δp + w × R(s)b_i``, whence
 
     |v_i| ≤ V_i := |Δp| + Ω·|b_i|,      |dv_i/ds| = |w × (w × R b_i)| ≤ A_i := Ω²·|b_i|.
 
+On an arc (:mod:`~hexapod_workspace.core.path_interpolation`: ``CIRCLE`` moves) Δp is replaced
+by p'(s), so ``V_i := P₁ + Ω·|b_i|`` and ``A_i := P₂ + Ω²·|b_i|`` with P₁ and P₂ the arc's
+bounds of |p'| and |p''|; everything below holds with these. The move's length D for a duration
+is the arc's lower bound of its length (a shorter D, a shorter T: speeds never under-stated).
+
 **6-UPS legs** (:data:`UPS`, q_i = ℓ_i): ``L_i = B_i − A_i`` with A_i fixed, so
 ``g_i = dℓ_i/ds = n_i·v_i``. Its own rate is, with ``dn_i/ds = (I − n_i n_iᵀ)·v_i / ℓ_i``,
 
@@ -90,6 +95,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import InputError
 from . import architectures
 from .manipulator import Manipulator
+from .path_interpolation import _Arcs, _validate_arcs
 from .rotations import (
     matrix_to_quaternion,
     quaternion_angle,
@@ -338,10 +344,12 @@ class _SlerpMoves:
         positions1: NDArray[np.float64],
         rotations0: NDArray[np.float64],
         rotations1: NDArray[np.float64],
+        arcs: _Arcs | None = None,
     ) -> None:
         self.joints = manipulator.platform_joints
         self.p0 = positions0
         self.dp = positions1 - positions0
+        self.arcs = arcs
         q0, q1 = matrix_to_quaternion(rotations0), matrix_to_quaternion(rotations1)
         self.omega = quaternion_angle(q0, q1)
         relative = quaternion_multiply(q1, quaternion_conjugate(q0))  # R₁R₀ᵀ, base frame
@@ -352,8 +360,17 @@ class _SlerpMoves:
         self.r0 = rotations0
         radius = np.linalg.norm(self.joints, axis=1)  # |b_i|
         self.translation = np.linalg.norm(self.dp, axis=1)
-        self.speed = self.translation[:, None] + self.omega[:, None] * radius  # V_i (M, 6)
-        self.accel = self.omega[:, None] ** 2 * radius  # A_i (M, 6)
+        travel = self.translation  # the bound of |dp/ds|
+        curvature = np.zeros_like(travel)  # the bound of |d²p/ds²|
+        if arcs is not None:
+            # Arcs (path_interpolation): |p'| ≤ arcs.speed, |p''| ≤ arcs.accel, so
+            # V_i = |p'| + Ω|b_i| and A_i = |p''| + Ω²|b_i| (|dv_i/ds| ≤ |p''| + |w × (w × Rb_i)|);
+            # the length for a duration is the arc's lower bound.
+            travel = np.where(arcs.mask, arcs.speed, travel)
+            curvature = np.where(arcs.mask, arcs.accel, 0.0)
+            self.translation = np.where(arcs.mask, arcs.length, self.translation)
+        self.speed = travel[:, None] + self.omega[:, None] * radius  # V_i (M, 6)
+        self.accel = curvature[:, None] + self.omega[:, None] ** 2 * radius  # A_i (M, 6)
 
     def motion(self, moves: NDArray[np.int64], s: NDArray[np.float64]) -> LegMotion:
         """Leg quantities of moves ``moves`` (n,) at parameters ``s`` (n,)."""
@@ -370,8 +387,15 @@ class _SlerpMoves:
         rotation = turn @ self.r0[moves]
         arms = np.einsum("nij,kj->nki", rotation, self.joints)  # R·b_i (n, 6, 3)
         position = self.p0[moves] + s[:, None] * self.dp[moves]
+        linear = self.dp[moves]
+        if self.arcs is not None:
+            on_arc = self.arcs.mask[moves]
+            if on_arc.any():
+                position[on_arc] = self.arcs.positions(moves[on_arc], s[on_arc])
+                linear = linear.copy()
+                linear[on_arc] = self.arcs.velocities(moves[on_arc], s[on_arc])
         w = (self.omega[moves])[:, None] * u
-        velocities = self.dp[moves][:, None, :] + np.cross(w[:, None, :], arms)
+        velocities = linear[:, None, :] + np.cross(w[:, None, :], arms)
         return LegMotion(position[:, None, :] + arms, velocities)
 
 
@@ -391,6 +415,7 @@ def actuator_rates(
     speed_limits: ArrayLike | None = None,
     architecture: str | None = None,
     relative: float = DEFAULT_RELATIVE,
+    arcs: ArrayLike | None = None,
 ) -> MoveRates:
     """Certified peak actuator rates (per unit s) of the N − 1 slerp moves of a path.
 
@@ -409,6 +434,9 @@ def actuator_rates(
         Key of :data:`ACTUATOR_MODELS`; default the manipulator's (``"ups"``).
     relative : float
         Tightness of the bound against the sampled peak, in (0, 1).
+    arcs : array_like, shape (N − 1, 7), optional
+        Moves that are arcs, as :func:`~hexapod_workspace.core.path_checks.check_path` takes
+        them; their ``translation`` is then a lower bound of the arc's length.
 
     Returns
     -------
@@ -441,7 +469,7 @@ def actuator_rates(
     model = ACTUATOR_MODELS[name]
     limits = np.zeros(6) if speed_limits is None else np.broadcast_to(speed_limits, (6,))
     weights = _weights(np.asarray(limits, dtype=np.float64))
-    moves = _SlerpMoves(manipulator, p[:-1], p[1:], r[:-1], r[1:])
+    moves = _SlerpMoves(manipulator, p[:-1], p[1:], r[:-1], r[1:], _validate_arcs(arcs, p))
     count = p.shape[0] - 1
     bound = np.zeros((count, 6))
     sampled = np.zeros((count, 6))
