@@ -117,7 +117,24 @@ def test_tool_change_splits_the_path():
         ("GOTO/0,0,0\nLOADTL/3\n", r"^line 2: LOADTL/3: tool 3 is not in the tool table"),
         ("GOTO/0,0,0,0,0,0\n", r"^line 1: .*expected a non-zero tool axis"),
         ("GOTO/0,0,x\n", r"^line 1: GOTO/0,0,x: expected a number, got 'x'"),
-        ("GOTO/0,0,0\nCIRCLE/0,0,0,0,0,1,5\n", r"^line 2: .*circular moves are not modelled"),
+        ("GOTO/5,0,0\nCIRCLE/0,0,0,0,0,1,5\n", r"^line 2: CIRCLE.*expected a GOTO after it"),
+        ("GOTO/5,0,0\nCIRCLE/0,0,0,0,0,1\n", r"^line 2: .*at least 7 numbers"),
+        ("GOTO/5,0,0\nCIRCLE/0,0,0,0,0,1,0\n", r"^line 2: .*expected a radius > 0"),
+        ("GOTO/5,0,0\nCIRCLE/0,0,0,0,0,1,5\nGOTO/0,4,0\n", r"^line 3: .*end is 4 mm from"),
+        ("GOTO/5.1,0,0\nCIRCLE/0,0,0,0,0,1,5\nGOTO/0,5,0\n", r"^line 3: .*start is 5.1 mm"),
+        (
+            "GOTO/5,0,0\nCIRCLE/0,0,0,0,0,1,5\nGOTO/0,5,0,0,1,0\n",
+            r"^line 3: .*the tool axis changes along the arc of line 2",
+        ),
+        (
+            "GOTO/5,0,0\nCIRCLE/0,0,0,0,0,1,5\nFEDRAT/100\nGOTO/0,5,0\n",
+            r"^line 3: FEDRAT/100: expected the GOTO that ends the arc of line 2",
+        ),
+        ("CIRCLE/0,0,0,0,0,1,5\nGOTO/0,5,0\n", r"^line 1: .*expected a point of this part"),
+        (
+            "GOTO/5,0,0\nSET/MODE,INCR\nCIRCLE/0,0,0,0,0,1,5\n",
+            r"^line 3: .*CIRCLE in incremental mode",
+        ),
         ("GOTO/0,0,0,$\n", r"^line 1: statement continued with '\$' past the end"),
         ("PARTNO/X\n", r"^CL file: expected at least one GOTO"),
         ("GOTO/0,0,0\n12,3\n", r"^line 2: expected an APT statement"),
@@ -410,3 +427,66 @@ def test_the_fusion_sample_models_from_and_gohome():
         "END": 1,
         "FINI": 1,
     }
+
+
+NX_CIRCLE = Path(__file__).resolve().parent / "data" / "cl" / "nx_circle_pocket.cls"
+
+
+def test_arcs_run_clockwise_about_their_axis_and_a_full_circle_closes():
+    # Clockwise about +z from (5, 0) to (0, 5) is three quarters of a turn; about −z, one.
+    for z, quarter_turns in ((1, 3), (-1, 1)):
+        axis = f"0,0,{z}"
+        program = parse_cldata(f"GOTO/5,0,0\nCIRCLE/0,0,0,{axis},5\nGOTO/0,5,0\n", units="mm")
+        phi = program.arcs[1, 6]
+        assert phi == pytest.approx(-quarter_turns * math.pi / 2)
+        np.testing.assert_allclose(program.arcs[1, :6], [0, 0, 0, 0, 0, z])
+        assert np.isnan(program.arcs[0]).all()
+    full = parse_cldata("GOTO/5,0,0\nCIRCLE/0,0,0,0,0,1,5\nGOTO/5,0,0\n", units="mm")
+    assert full.arcs[1, 6] == pytest.approx(-2 * math.pi)
+
+
+def test_the_nx_pocket_s_arcs_are_tangent_to_their_neighbours():
+    """The real NX CLSF (test/data/cl/SOURCES.md): under the clockwise-about-the-axis reading
+    every arc starts and ends tangent to the moves beside it (G1 continuity, as the CAM system
+    computes a pocket's contour); the other reading would reverse the tool at each arc."""
+    program = read_cldata(NX_CIRCLE)
+    arcs = np.flatnonzero(np.isfinite(program.arcs[:, 0]))
+    assert arcs.size == 15
+    assert program.units == "mm"
+    assert {name for name, _, _ in program.passed_over} >= {"PAINT", "TLDATA"}
+
+    def tangents(k, flip=1.0):
+        """Directions of move k (ending at waypoint k) at its start and its end (``flip`` −1:
+        the arcs read the other way round)."""
+        p0, p1 = program.positions[k - 1], program.positions[k]
+        if not np.isfinite(program.arcs[k, 0]):
+            direction = (p1 - p0) / np.linalg.norm(p1 - p0)
+            return direction, direction
+        centre, axis, phi = program.arcs[k, :3], program.arcs[k, 3:6], program.arcs[k, 6]
+        sense = flip * math.copysign(1.0, phi)  # right-handed about the axis: < 0 clockwise
+        ends = []
+        for point in (p0, p1):
+            radial = point - centre
+            radial -= (radial @ axis) * axis
+            tangent = sense * np.cross(axis, radial)
+            ends.append(tangent / np.linalg.norm(tangent))
+        return ends[0], ends[1]
+
+    def joints(flip):
+        """Cosines between each arc's end tangents and its neighbours' (links of 5 µm, which
+        have no direction to speak of, left out)."""
+        cosines = []
+        for k in arcs:
+            start, end = tangents(k, flip)
+            for neighbour, here, side in ((k - 1, start, 1), (k + 1, end, 0)):
+                step = program.positions[neighbour] - program.positions[neighbour - 1]
+                if np.linalg.norm(step) > 1e-4:
+                    cosines.append(float(tangents(neighbour, flip)[side] @ here))
+        return np.array(cosines)
+
+    ours, other = joints(1.0), joints(-1.0)
+    # Clockwise: no joint reverses the tool; most are tangent, the rest are the pocket's corners
+    # (the tool leaves an arc along its radius). Counter-clockwise: the tool would reverse.
+    assert np.all(ours > -0.1)
+    assert np.sum(ours > 0.999) >= 20
+    assert np.sum(other < -0.999) >= 10

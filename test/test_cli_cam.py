@@ -370,3 +370,63 @@ def test_nurbs_in_a_cl_file_exits_2_with_its_line():
     code, out, err = run_main("check-path", str(nurbs))
     assert code == 2 and out == ""
     assert "line 13: NURBS/: spline moves are not modelled" in one_error_line(err)
+
+
+def _arc_file(tmp_path, circle: bool, radius_mm: float = 350.0) -> Path:
+    """Half a circle in the x–z plane of the example's working volume about +y, run clockwise
+    seen from +y: from x = −r through z = −1150 − r (below) to x = +r (the CIRCLE left out:
+    its chord)."""
+    path = tmp_path / ("arc.cl" if circle else "chord.cl")
+    path.write_text(
+        "UNITS/MM\nFEDRAT/MMPM,600\n"
+        f"GOTO/{-radius_mm},0,-1150,0,0,1\n"
+        + (f"CIRCLE/0,0,-1150,0,1,0,{radius_mm}\n" if circle else "")
+        + f"GOTO/{radius_mm},0,-1150\n",
+        encoding="utf-8",
+    )
+    return path
+
+
+def test_a_circle_is_checked_and_timed_along_the_arc(tmp_path):
+    """Issue #35 item 2: a CIRCLE is a move of its own, checked along the arc (the chord of the
+    same file without it passes; the arc leaves the workspace at its bottom)."""
+    code, out, err = run_main("check-path", str(_arc_file(tmp_path, circle=False)), "--json")
+    assert code == 0, err
+    chord = json.loads(out)
+    assert "arc" not in chord["segments"][0]
+    code, out, err = run_main("check-path", str(_arc_file(tmp_path, circle=True)), "--json")
+    arc = json.loads(out)
+    assert code == 1 and not arc["ok"]
+    segment = arc["segments"][0]
+    assert segment["arc"]["angle_deg"] == pytest.approx(-180.0)
+    np.testing.assert_allclose(segment["arc"]["centre"], [0.0, 0.0, -1.15], atol=1e-12)
+    top = segment["position_at_violation"]
+    assert math.hypot(top[0], top[2] + 1.15) == pytest.approx(0.35, abs=1e-9)
+    assert top[2] < -1.15  # clockwise about +y (seen from +y) from −x goes under
+    # the duration is the arc's length at the feed (not the chord's 0.7 m)
+    assert segment["duration_s"] == pytest.approx(math.pi * 0.35 / (0.6 / 60.0), rel=1e-9)
+    assert chord["segments"][0]["duration_s"] == pytest.approx(0.7 / (0.6 / 60.0))
+
+
+def test_a_small_arc_passes_and_record_refuses_arcs(tmp_path):
+    small = _arc_file(tmp_path, circle=True, radius_mm=150.0)
+    code, out, err = run_main("check-path", str(small), "--json")
+    assert code == 0, err
+    assert json.loads(out)["segments"][0]["speed_ok"] is True
+    code, out, err = run_main("check-path", str(small), "--record", str(tmp_path / "arc.mcap"))
+    assert code == 2 and out == ""
+    assert "--record: the ~/check_path request carries waypoints, not arcs (line 5" in (
+        one_error_line(err)
+    )
+    assert not (tmp_path / "arc.mcap").exists()
+
+
+def test_the_real_nx_pocket_with_circles_is_read_and_checked():
+    """The NX pocket (test/data/cl/SOURCES.md): 15 CIRCLE moves read and checked as arcs."""
+    pocket = Path(__file__).resolve().parent / "data" / "cl" / "nx_circle_pocket.cls"
+    code, out, err = run_main("check-path", str(pocket), "--json")
+    assert code in (0, 1), err  # a verdict (the part is larger than the example machine)
+    document = json.loads(out)
+    arcs = [s["arc"] for s in document["segments"] if s.get("arc") is not None]
+    assert len(arcs) == 15
+    assert document["passed_over"]["PAINT"] >= 10

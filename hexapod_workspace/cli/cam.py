@@ -196,10 +196,13 @@ class _Part:
         lines: NDArray[np.int64] | None,
         first: int,
         written: bool = False,
+        arcs: NDArray[np.float64] | None = None,
     ) -> None:
         self.tool, self.positions, self.axes, self.degrees = tool, positions, axes, degrees
         self.feeds, self.rapid, self.lines, self.first = feeds, rapid, lines, first
         self.written = written  # degrees are the file's own (base frame): echoed as given
+        # the part's moves (N − 1, 7) in the base frame, None when none is an arc (CIRCLE)
+        self.arcs = arcs
 
 
 def _read_parts(
@@ -213,6 +216,10 @@ def _read_parts(
         positions = work.origin + program.positions @ work.rotation.T
         axes = vectors_to_base(program.axes, work)
         feeds = np.where(np.isnan(program.feeds), feed, program.feeds)
+        # arcs (CIRCLE) in the base frame: the centre moves as a point, the axis as a vector
+        arcs = program.arcs.copy()
+        arcs[:, :3] = work.origin + program.arcs[:, :3] @ work.rotation.T
+        arcs[:, 3:6] = program.arcs[:, 3:6] @ work.rotation.T
         parts = []
         for start, stop in program.parts:
             number = int(program.tools[start])
@@ -229,6 +236,7 @@ def _read_parts(
                     program.rapid[start:stop],
                     program.lines[start:stop],
                     start,
+                    arcs=_part_arcs(arcs[start + 1 : stop]),
                 )
             )
         for k, (start, stop) in enumerate(program.parts):
@@ -272,6 +280,11 @@ def _read_parts(
     return [part], None
 
 
+def _part_arcs(arcs: NDArray[np.float64]) -> NDArray[np.float64] | None:
+    """A part's arcs, or None when all its moves are straight."""
+    return arcs if bool(np.isfinite(arcs[:, 0]).any()) else None
+
+
 def _to_frame(document: dict[str, Any], work: WorkFrame) -> None:
     """Rewrite a path document's base-frame positions and angles in the work frame."""
     r_w = work.rotation
@@ -290,6 +303,10 @@ def _to_frame(document: dict[str, Any], work: WorkFrame) -> None:
         phi, theta, psi = angles([waypoint["phi_deg"], waypoint["theta_deg"], waypoint["psi_deg"]])
         waypoint.update(phi_deg=phi, theta_deg=theta, psi_deg=psi)
     for segment in document["segments"]:
+        arc = segment.get("arc")
+        if arc is not None:
+            arc["centre"] = position(arc["centre"])
+            arc["axis"] = (np.asarray(arc["axis"]) @ r_w).tolist()
         if segment["position_at_violation"] is not None:
             segment["position_at_violation"] = position(segment["position_at_violation"])
             segment["first_violation_pose_deg"] = angles(segment["first_violation_pose_deg"])
@@ -343,6 +360,7 @@ def _check_part(
             max_dpsi=max_dpsi,
             interpolation=options.interpolation,
             tolerance=tolerance,
+            arcs=part.arcs,
         )
         baseline = result.baseline
     else:
@@ -353,6 +371,7 @@ def _check_part(
             angles=degrees_to_radians(part.degrees),
             interpolation=options.interpolation,
             tolerance=tolerance,
+            arcs=part.arcs,
         )
         baseline = psi_zero_baseline(model, result)
     document = path_to_json(result, baseline, part.degrees if part.written else None)
@@ -365,7 +384,9 @@ def _check_part(
         msg = "feeds: the speed check needs --interpolation slerp (the controller's moves)"
         raise CliError(msg)
     rotations = tt_to_matrix(checked.waypoints.angles)
-    rates = actuator_rates(model, checked.waypoints.positions, rotations, speed_limits=limits)
+    rates = actuator_rates(
+        model, checked.waypoints.positions, rotations, speed_limits=limits, arcs=part.arcs
+    )
     speeds = feed_limits(rates, feed, np.full(moves, rotary_feed), limits)
     for k, segment in enumerate(document["segments"]):
         known = bool(np.isfinite(speeds.duration[k]))
@@ -516,6 +537,14 @@ def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str])
     rapid = _positive(options.rapid_feed_mm_min, "--rapid-feed-mm-min", "mm/min") * _MM_MIN
     rotary = _positive(options.rotary_feed_deg_min, "--rotary-feed-deg-min", "deg/min") * _DEG_MIN
     parts, program = _read_parts(options, cell, frame, feed)
+    if record is not None and any(part.arcs is not None for part in parts):
+        assert program is not None  # arcs come from CL files only
+        first = int(np.flatnonzero(np.isfinite(program.arcs[:, 0]))[0])
+        msg = (
+            f"--record: the ~/check_path request carries waypoints, not arcs (line "
+            f"{program.lines[first]} ends a CIRCLE); the node would check the chords"
+        )
+        raise CliError(msg)
     results, documents, calls = [], [], []
     for part in parts:
         result, document, call = _check_part(platform, part, cell, options, (rapid, rotary))

@@ -239,6 +239,18 @@ def path_to_json(
         ],
         "segments": [_segment_json(segments, k) for k in range(len(segments))],
     }
+    if path.arcs is not None:  # CIRCLE moves: where each one runs (base frame, m)
+        for k, segment in enumerate(document["segments"]):
+            row = path.arcs[k]
+            segment["arc"] = (
+                {
+                    "centre": row[:3].tolist(),
+                    "axis": row[3:6].tolist(),
+                    "angle_deg": math.degrees(float(row[6])),
+                }
+                if math.isfinite(float(row[0]))
+                else None
+            )
     document["psi_zero_baseline"] = {
         "waypoints_failed": baseline.failed_waypoints,
         "segments_failed": baseline.failed_segments,

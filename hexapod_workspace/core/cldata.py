@@ -22,6 +22,13 @@ statement                       meaning here
                                 move of the same part) and the point ``GOHOME`` returns to
 ``GOHOME``                      a move to the ``FROM`` point (its axis if it gave one)
 ``GODLTA/dx,dy,dz``, ``/d``     a move by (dx, dy, dz), or by d along the tool axis
+``CIRCLE/x,y,z,i,j,k,r[,...]``  the next ``GOTO`` (nothing but passed-over statements between)
+                                ends an arc about centre (x, y, z) and axis (i, j, k) of
+                                radius r, run clockwise about the axis (NX's extra values, a
+                                tolerance and the tool's size, cannot change it): a move of its
+                                own, checked along the arc (``CLProgram.arcs``); a helix when
+                                the end's height along the axis differs; refused when an end
+                                is off the circle, the tool axis changes, in incremental mode
 ``SET/MODE,INCR|ABSOL``         following ``GOTO`` positions are increments / absolute
 ``TLAXIS/i,j,k``                the tool axis of following 3-value ``GOTO`` statements
 ``FEDRAT/f[,MMPM|IPM|PERMIN]``  feed of the following cutting moves (also ``FEDRAT/MMPM,f``);
@@ -54,9 +61,9 @@ against ``--cl-units``) is refused naming both. A file that states no units at a
 itself has no default unit, and an inch file read as mm is a path 25.4 times smaller that may
 well pass.
 
-Refused, with the line and why: ``CIRCLE``, ``MOVARC`` and ``NURBS``/``KNOT``/``CNTRL`` (a
-curve's chord is not the curve: the move certificate covers straight moves, and a spline's
-deviation from its chords is not yet bounded here), canned cycles, cutter compensation,
+Refused, with the line and why: ``MOVARC`` and ``NURBS``/``KNOT``/``CNTRL`` (a curve's chord
+is not the curve, and a spline's knot vector is not stated in full by NX's CLSF: its order and
+end knots would be guessed), canned cycles, cutter compensation,
 ``TRACUT`` with a matrix, ``INSERT`` (text for the controller, whose effect is unknown),
 per-revolution feeds (``MMPR``, ``IPR``, ``PERREV``), ``ORIGIN`` together with a rotated
 ``MSYS`` (the order they compose in is not stated), ``LOAD`` of anything but a tool, ``SET`` but
@@ -146,8 +153,6 @@ PASSED_OVER: dict[str, str] = {
 }
 #: Statements that change the motion in ways this reader does not model: refused.
 _REFUSED = {
-    "CIRCLE": "circular moves are not modelled (a chord would be checked instead of the arc; "
-    "export arcs as linear GOTO moves)",
     "MOVARC": "circular moves are not modelled (a chord would be checked instead of the arc; "
     "export arcs as linear GOTO moves)",
     "NURBS": "spline moves are not modelled (a chord would be checked instead of the curve, "
@@ -207,6 +212,12 @@ class CLProgram:
     frames : tuple of (int, ndarray, ndarray)
         Each ``MSYS`` and ``ORIGIN`` applied: (line, origin in the work frame (m), rotation
         from the file's coordinates to the work frame (3, 3)).
+    arcs : ndarray, shape (N, 7)
+        The move that ends at waypoint k as an arc (``CIRCLE``): centre (work frame, m), unit
+        axis (work frame) and angle φ (rad, right-handed about the axis: negative, the file's
+        arcs run clockwise about their axis), as
+        :func:`~hexapod_workspace.core.path_checks.check_path` takes them; NaN for a straight
+        move and for the first waypoint of each part.
     """
 
     positions: NDArray[np.float64]
@@ -221,6 +232,7 @@ class CLProgram:
     units: str = "mm"
     units_source: str = ""
     frames: tuple[tuple[int, NDArray[np.float64], NDArray[np.float64]], ...] = field(default=())
+    arcs: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 7)))
 
     def __len__(self) -> int:
         return int(self.positions.shape[0])
@@ -401,6 +413,10 @@ class _Reader:
         self.part_starts = [0]
         self.passed: dict[str, list[int]] = {}
         self.frames: list[tuple[int, NDArray[np.float64], NDArray[np.float64]]] = []
+        # A CIRCLE waiting for the GOTO that ends it: (line, shown, centre and unit axis in file
+        # coordinates (m), radius (m)); the arcs of the moves, one row per waypoint.
+        self.circle: tuple[int, str, NDArray[np.float64], NDArray[np.float64], float] | None = None
+        self.arcs: list[NDArray[np.float64]] = []
 
     # -- units -----------------------------------------------------------------------------
     def scale(self, line: int, shown: str) -> float:
@@ -448,6 +464,7 @@ class _Reader:
             raise InputError(msg)
         self.positions.append(position)
         self.axes.append(axis)
+        self.arcs.append(np.full(7, np.nan))
         first = len(self.positions) - 1 == self.part_starts[-1]
         self.feeds.append(math.nan if first else self.feed)
         self.rapid.append(self.rapid_next and not first)
@@ -512,6 +529,10 @@ def parse_cldata(
         raise InputError(msg)
     if state.part_starts[-1] == len(state.positions):  # a boundary after the last move
         state.part_starts.pop()
+    if state.circle is not None:
+        line, shown = state.circle[:2]
+        msg = f"line {line}: {shown}: expected a GOTO after it (the arc's end), found none"
+        raise InputError(msg)
     stops = [*state.part_starts[1:], len(state.positions)]
     return CLProgram(
         positions=np.array(state.positions, dtype=np.float64).reshape(-1, 3),
@@ -526,12 +547,23 @@ def parse_cldata(
         units=state.first_unit or "mm",
         units_source=state.unit_source,
         frames=tuple(state.frames),
+        arcs=np.array(state.arcs, dtype=np.float64).reshape(-1, 7),
     )
 
 
 def _statement(state: _Reader, word: str, arguments: list[str], line: int, shown: str) -> None:
     """Apply one statement to the reader's state (or refuse it)."""
-    if word == "GOTO":
+    if state.circle is not None and word != "GOTO" and word not in PASSED_OVER:
+        msg = (
+            f"line {line}: {shown}: expected the GOTO that ends the arc of line "
+            f"{state.circle[0]} ({state.circle[1]}) first"
+        )
+        raise InputError(msg)
+    if word == "CIRCLE":
+        _circle(state, arguments, line, shown)
+    elif word == "GOTO" and state.circle is not None:
+        _end_arc(state, arguments, line, shown)
+    elif word == "GOTO":
         values = _numbers(arguments, (3, 6), line, shown, "3 (x,y,z) or 6 (x,y,z,i,j,k) numbers")
         if values.size == 6:
             if state.incremental:
@@ -663,6 +695,83 @@ def _statement(state: _Reader, word: str, arguments: list[str], line: int, shown
             "statements that cannot change the motion, frame, tool or units are passed over)"
         )
         raise InputError(msg)
+
+
+#: An arc's ends may be off its circle by the file's rounding: this much of the radius, plus
+#: 2 µm (four decimals of an inch file round a coordinate by 1.3 µm).
+_ARC_RELATIVE, _ARC_ABSOLUTE = 1e-5, 2e-6
+
+
+def _circle(state: _Reader, arguments: list[str], line: int, shown: str) -> None:
+    """``CIRCLE/xc,yc,zc,i,j,k,r[,...]``: the arc that the next GOTO ends (NX adds a
+    tolerance, the tool diameter and two more values, which cannot change the arc)."""
+    values = [_number(a, line, shown) for a in arguments]
+    if len(values) < 7:
+        msg = f"line {line}: {shown}: expected CIRCLE/x,y,z,i,j,k,r (at least 7 numbers)"
+        raise InputError(msg)
+    if state.incremental:
+        msg = f"line {line}: {shown}: a CIRCLE in incremental mode (SET/MODE,INCR) is not modelled"
+        raise InputError(msg)
+    if not state.in_part():
+        msg = f"line {line}: {shown}: expected a point of this part before the arc"
+        raise InputError(msg)
+    scale = state.scale(line, shown)
+    radius = values[6] * scale
+    if not radius > 0.0:
+        msg = f"line {line}: {shown}: expected a radius > 0, got {values[6]:g}"
+        raise InputError(msg)
+    axis = _unit_axis(np.array(values[3:6]), line, shown)
+    state.circle = (line, shown, np.array(values[:3]) * scale, axis, radius)
+
+
+def _end_arc(state: _Reader, arguments: list[str], line: int, shown: str) -> None:
+    """The GOTO that ends a CIRCLE: the waypoint, and the move to it as an arc.
+
+    The tool runs **clockwise about the circle's axis** (seen from the axis's tip): the
+    convention of the NX CLSF samples (test/data/cl/SOURCES.md), where it is the one under which
+    every arc is tangent to the moves before and after it. φ is the clockwise angle from the
+    start to the end (a full circle when they coincide), negative (right-handed about the axis).
+    The ends must lie on the circle (within the rounding of :data:`_ARC_RELATIVE` and
+    :data:`_ARC_ABSOLUTE`); a change of height along the axis makes a helix.
+    """
+    assert state.circle is not None
+    circle_line, _, centre, axis, radius = state.circle
+    values = _numbers(arguments, (3, 6), line, shown, "3 (x,y,z) or 6 (x,y,z,i,j,k) numbers")
+    if values.size == 6:
+        given = _unit_axis(values[3:], line, shown)
+        if float(np.linalg.norm(given - state.axis_file)) > 1e-9:
+            msg = (
+                f"line {line}: {shown}: the tool axis changes along the arc of line "
+                f"{circle_line}: not modelled (expected the tool axis of the arc's start)"
+            )
+            raise InputError(msg)
+    start = state.to_file(state.last(line, shown))
+    end = values[:3] * state.scale(line, shown)
+    planar = []
+    for name, point in (("start", start), ("end", end)):
+        offset = point - centre
+        inplane = offset - float(offset @ axis) * axis
+        distance = float(np.linalg.norm(inplane))
+        if abs(distance - radius) > _ARC_RELATIVE * radius + _ARC_ABSOLUTE:
+            msg = (
+                f"line {line}: {shown}: the arc's {name} is {distance * 1e3:.6g} mm from the "
+                f"axis of the CIRCLE of line {circle_line}, whose radius is "
+                f"{radius * 1e3:.6g} mm"
+            )
+            raise InputError(msg)
+        planar.append(inplane)
+    right_handed = math.atan2(
+        float(np.cross(planar[0], planar[1]) @ axis), float(planar[0] @ planar[1])
+    )
+    if abs(right_handed) < 1e-9:
+        phi = -2.0 * math.pi  # the end is the start: a full circle
+    elif right_handed > 0.0:
+        phi = right_handed - 2.0 * math.pi
+    else:
+        phi = right_handed
+    state.add(state.to_work(end), state.axis_work(), line, shown)
+    state.arcs[-1] = np.array([*state.to_work(centre), *(state.rotation @ axis), phi])
+    state.circle = None
 
 
 def _load_tool(state: _Reader, arguments: list[str], line: int, shown: str) -> None:
