@@ -1260,7 +1260,7 @@ def _pair_squared(
     return squared, (0.0 if denom > 1e-14 * a * e else 1.0)
 
 
-@_inline
+@_helper
 def _free_squared(
     model: NDArray[np.float64],
     pair: int,
