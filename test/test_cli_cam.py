@@ -413,6 +413,8 @@ def test_a_small_arc_passes_and_record_refuses_arcs(tmp_path):
     code, out, err = run_main("check-path", str(small), "--json")
     assert code == 0, err
     assert json.loads(out)["segments"][0]["speed_ok"] is True
+    code, out, err = run_main("check-path", str(small))
+    assert code == 0 and "1 moves (tool axes, torsion planned; 1 of them arcs" in out
     code, out, err = run_main("check-path", str(small), "--record", str(tmp_path / "arc.mcap"))
     assert code == 2 and out == ""
     assert "--record: the ~/check_path request carries waypoints, not arcs (line 5" in (

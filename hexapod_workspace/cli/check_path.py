@@ -313,6 +313,8 @@ def _text(result: PathCheck | TorsionPlan, document: dict[str, Any], out: IO[str
     plan = result if isinstance(result, TorsionPlan) else None
     waypoints, segments = document["waypoints"], document["segments"]
     mode = "tool axes, torsion planned" if plan is not None else "fixed orientations"
+    arcs = sum(1 for segment in segments if segment.get("arc") is not None)
+    mode += f"; {arcs} of them arcs, checked along the arc" if arcs else ""
     out.write(
         f"path: {len(waypoints)} waypoints, {len(segments)} moves ({mode}), "
         f"{document['interpolation']}, tolerance {document['tolerance_deg']:.3g} deg\n"
