@@ -727,9 +727,11 @@ def _circle(state: _Reader, arguments: list[str], line: int, shown: str) -> None
 def _end_arc(state: _Reader, arguments: list[str], line: int, shown: str) -> None:
     """The GOTO that ends a CIRCLE: the waypoint, and the move to it as an arc.
 
-    The tool runs **clockwise about the circle's axis** (seen from the axis's tip): the
-    convention of the NX CLSF samples (test/data/cl/SOURCES.md), where it is the one under which
-    every arc is tangent to the moves before and after it. φ is the clockwise angle from the
+    The tool runs **clockwise about the circle's axis** (seen from the axis's tip): the reading
+    of the NX CLSF sample (test/data/cl/SOURCES.md) under which no arc reverses the tool where it
+    meets the moves beside it and most meet them tangentially (read the other way, ten joints
+    reverse it); its arcs are all under 180°, so it does not tell this reading from "the short
+    way round", and no document stating the convention was found. φ is the clockwise angle from the
     start to the end (a full circle when they coincide), negative (right-handed about the axis).
     The ends must lie on the circle (within the rounding of :data:`_ARC_RELATIVE` and
     :data:`_ARC_ABSOLUTE`); a change of height along the axis makes a helix.
