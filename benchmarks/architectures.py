@@ -66,10 +66,7 @@ def main() -> None:
     os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})  # one core
     kernels.warm_up()
     config = example_config_path().parent
-    machines = {
-        name: hw.Manipulator.from_params_file(config / file, warn=False)
-        for name, file in EXAMPLES.items()
-    }
+    machines = {name: hw.load_manipulator(config / file) for name, file in EXAMPLES.items()}
     poses = random_poses(options.poses)
     rows: dict[str, dict[str, float]] = {}
     shares: dict[str, tuple[float, float]] = {}

@@ -44,6 +44,7 @@ from hexapod_workspace import (  # noqa: E402
     workspace_atlas,
 )
 from hexapod_workspace._resources import example_config_path  # noqa: E402
+from hexapod_workspace.core.loading import load_manipulator  # noqa: E402
 from hexapod_workspace.core.projected import (  # noqa: E402
     COARSE_TOLERANCE,
     EXACT_GOLDEN_STEPS,
@@ -185,7 +186,7 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=len(os.sched_getaffinity(0)))
     parser.add_argument("--line", type=int, default=13, help="positions of the warm-start line")
     options_cli = parser.parse_args()
-    manipulator = Manipulator.from_params_file(example_config_path())
+    manipulator = load_manipulator(example_config_path())
     options = AtlasOptions()
     grid = AtlasGrid.box([-0.2, 0.2, -0.2, 0.2, -1.3, -1.1], options_cli.step)
     print(

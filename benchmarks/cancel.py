@@ -20,7 +20,7 @@ import time
 
 import numpy as np
 
-from hexapod_workspace import Manipulator
+from hexapod_workspace.core.loading import example_manipulator
 from hexapod_workspace.core.resolution import WorkspaceKind
 from hexapod_workspace.ros.worker import CANCEL_GRACE, CanceledError, WorkspaceJob, WorkspaceWorker
 
@@ -64,7 +64,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=5, help="cancels per mode (default 5)")
     runs = parser.parse_args().runs
-    job = WorkspaceJob(manipulator=Manipulator.example(warn=False), **LONG_JOB)
+    job = WorkspaceJob(manipulator=example_manipulator(), **LONG_JOB)
     print(f"cancel of a running 3-D workspace job; load average {os.getloadavg()[0]:.2f}")
     for mode, grace in (("cooperative", 300.0), ("terminate", 0.0)):
         worker = WorkspaceWorker(cancel_grace=grace)

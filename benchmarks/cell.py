@@ -20,7 +20,8 @@ import time
 
 import numpy as np
 
-from hexapod_workspace import Manipulator, actuator_rates, axis_limits, check_path
+from hexapod_workspace import actuator_rates, axis_limits, check_path
+from hexapod_workspace.core.loading import example_manipulator
 from hexapod_workspace.core.rotations import tt_to_matrix
 
 
@@ -38,7 +39,7 @@ def main() -> None:
     parser.add_argument("--moves", type=int, default=2000)
     parser.add_argument("--repeat", type=int, default=3)
     options = parser.parse_args()
-    manipulator = Manipulator.example(warn=False)
+    manipulator = example_manipulator()
     rng = np.random.default_rng(18)
     count = options.moves + 1
     positions = np.array([0.0, 0.0, -1.2]) + np.cumsum(rng.uniform(-0.05, 0.05, (count, 3)), 0)

@@ -32,6 +32,7 @@ from hexapod_workspace import Manipulator
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core.collision import scene_distances
 from hexapod_workspace.core.constraints import check, check_pose
+from hexapod_workspace.core.loading import manipulator_from_mapping
 from hexapod_workspace.core.orientation import torsion_range
 from hexapod_workspace.core.params import flatten, load_params_file
 from hexapod_workspace.core.projected import projected_workspace
@@ -84,8 +85,8 @@ def main() -> None:
     parser.add_argument("--poses", type=int, default=20000)
     count = parser.parse_args().poses
     parameters = load_params_file(example_config_path())
-    plain = Manipulator.from_mapping(parameters)
-    cell = Manipulator.from_mapping({**parameters, **flatten(SCENE)})
+    plain = manipulator_from_mapping(parameters)
+    cell = manipulator_from_mapping({**parameters, **flatten(SCENE)})
     scene = cell.collision
     assert scene is not None
     angles = random_angles(count)

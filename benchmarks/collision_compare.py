@@ -27,6 +27,7 @@ import hexapod_workspace
 from hexapod_workspace import Manipulator
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core.constraints import check, check_pose
+from hexapod_workspace.core.loading import manipulator_from_mapping
 from hexapod_workspace.core.orientation import torsion_range
 from hexapod_workspace.core.params import flatten, load_params_file
 from hexapod_workspace.core.projected import projected_workspace
@@ -44,8 +45,8 @@ def main() -> None:
     arguments = parser.parse_args()
     count = arguments.poses
     parameters = load_params_file(example_config_path())
-    plain = Manipulator.from_mapping(parameters)
-    cell = Manipulator.from_mapping({**parameters, **flatten(SCENE)})
+    plain = manipulator_from_mapping(parameters)
+    cell = manipulator_from_mapping({**parameters, **flatten(SCENE)})
     angles = random_angles(count)
     position = np.array([0.0, 0.0, -1.3])
     directions = [

@@ -95,9 +95,9 @@ def cold_figures(scratch: Path, every: bool = True) -> list[tuple[str, float, fl
         "first check-path on a small CSV": [*CLI, "check-path", str(csv)],
         "warm_up of the packaged 6-UPS example": python(
             """
-            from hexapod_workspace import Manipulator
+            from hexapod_workspace import example_manipulator
             from hexapod_workspace.core import kernels
-            kernels.warm_up(kernels.model_vector(Manipulator.example()))
+            kernels.warm_up(kernels.model_vector(example_manipulator()))
             """
         ),
         "warm_up of every kernel, every variant": python(

@@ -36,7 +36,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from speed import best_of, load_baseline, per_call, random_poses
+from speed import best_of, load_baseline, machine_from, per_call, random_poses
 
 import hexapod_workspace as new
 from hexapod_workspace._resources import example_config_path
@@ -57,11 +57,11 @@ def figures(
     """Seconds of each figure for one version of the package, by ``clock``."""
     # The packaged example, given as parameters the baseline knows (it predates
     # limits.singularity_min, 0 here).
-    parameters = new.Manipulator.from_params_file(example_config_path()).to_parameters()
+    parameters = new.load_manipulator(example_config_path()).to_parameters()
     parameters.pop("limits.singularity_min")
     known = package.core.manipulator.PARAMETER_DEFAULTS  # the leg-architecture keys are newer
     parameters = {name: value for name, value in parameters.items() if name in known}
-    machine = package.Manipulator.from_mapping(parameters)
+    machine = machine_from(package, parameters)
     rng = np.random.default_rng(3)
     waypoints = POSITION + rng.normal(scale=0.05, size=(200, 3))
     angles = random_poses(200, seed=4) * np.array([1.0, 0.5, 0.5])
@@ -88,8 +88,8 @@ def singularity_figures(
     poses: np.ndarray, clock: Callable[[], float] = time.perf_counter
 ) -> list[tuple[str, float, float]]:
     """(figure, seconds without, seconds with the singularity margin enforced), new code."""
-    free = new.Manipulator.from_params_file(example_config_path())
-    enforced = new.Manipulator.from_mapping(
+    free = new.load_manipulator(example_config_path())
+    enforced = new.manipulator_from_mapping(
         {**free.to_parameters(), "limits.singularity_min": 0.3}, warn=False
     )
     rows = []
@@ -119,7 +119,7 @@ def architecture_figures(
     (the same random orientations; a different share of them is reachable on each machine)."""
     config = example_config_path().parent
     machines = [
-        new.Manipulator.from_params_file(config / name)
+        new.load_manipulator(config / name)
         for name in ("example_gpm.yaml", "example_pus.yaml", "example_rus.yaml")
     ]
     rows = []

@@ -32,9 +32,10 @@ for variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import numpy as np  # noqa: E402
 
-from hexapod_workspace import Manipulator, check_path, plan_torsion  # noqa: E402
+from hexapod_workspace import check_path, plan_torsion  # noqa: E402
 from hexapod_workspace._resources import example_config_path  # noqa: E402
 from hexapod_workspace.core.constraints import pose_margins  # noqa: E402
+from hexapod_workspace.core.loading import load_manipulator  # noqa: E402
 from hexapod_workspace.core.path_interpolation import _Moves  # noqa: E402
 from hexapod_workspace.core.paths import DEFAULT_PATH_TOLERANCE  # noqa: E402
 from hexapod_workspace.core.rotations import approach_vector, tt_to_matrix  # noqa: E402
@@ -128,7 +129,7 @@ def main() -> None:
         pinned = True
     except (AttributeError, OSError):
         pinned = False
-    manipulator = Manipulator.from_params_file(example_config_path())
+    manipulator = load_manipulator(example_config_path())
     tolerance = DEFAULT_PATH_TOLERANCE
     print(
         f"certified moves vs dense sampling, packaged example, tolerance "

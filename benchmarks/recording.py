@@ -147,9 +147,9 @@ def service_impact(repeat: int, workdir: Path) -> None:
     """
     from hexapod_workspace._resources import example_config_path
     from hexapod_workspace.core import constraints
-    from hexapod_workspace.core.manipulator import Manipulator
+    from hexapod_workspace.core.loading import load_manipulator
 
-    manipulator = Manipulator.from_params_file(example_config_path())
+    manipulator = load_manipulator(example_config_path())
     store = logs.get_typestore()
     stamp = time.time_ns()
     try:

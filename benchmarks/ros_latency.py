@@ -213,7 +213,7 @@ def run(args: argparse.Namespace, domain: int) -> int:
     from rclpy.action import ActionClient
     from rclpy.executors import SingleThreadedExecutor
 
-    from hexapod_workspace import Manipulator, check
+    from hexapod_workspace import check, load_manipulator
     from hexapod_workspace._resources import example_config_path
 
     rclpy.init(domain_id=domain)
@@ -260,7 +260,7 @@ def run(args: argparse.Namespace, domain: int) -> int:
         for _ in range(args.batch_samples):  # interleaved with its floor
             flat_batched.append(timed(flat, flat_checks))
             flat_floor.append(timed(flat, flat_floor_checks))
-        manipulator = Manipulator.from_params_file(example_config_path())
+        manipulator = load_manipulator(example_config_path())
         core = []
         for _ in range(args.batch_samples):
             start = time.perf_counter()

@@ -346,7 +346,7 @@ def idle_phase(samples: int) -> dict:
     from hexapod_workspace_msgs.srv import CheckPoses
     from rclpy.executors import SingleThreadedExecutor
 
-    from hexapod_workspace import Manipulator, check
+    from hexapod_workspace import check, load_manipulator
     from hexapod_workspace._resources import example_config_path
 
     node = rclpy.create_node(f"load_idle_{os.getpid()}")
@@ -373,7 +373,7 @@ def idle_phase(samples: int) -> dict:
             node_one.append(timed(checks, one))
             floor_one.append(timed(floor, one))
         batched = [timed(checks, batch) for _ in range(max(10, samples // 10))]
-        manipulator = Manipulator.from_params_file(example_config_path())
+        manipulator = load_manipulator(example_config_path())
         core = []
         for _ in range(len(batched)):
             start = time.perf_counter()

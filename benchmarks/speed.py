@@ -68,6 +68,19 @@ def load_baseline(directory: Path, commit: str = BASELINE_COMMIT):
     return importlib.import_module("hexapod_workspace_baseline")
 
 
+def machine_from(package, parameters: dict | None = None, path: Path | None = None):
+    """A manipulator built by ``package``, this one or a baseline that predates
+    ``core.loading`` (where the loaders were ``Manipulator.from_mapping`` and
+    ``Manipulator.from_params_file``): from ``parameters``, or else from the file ``path``."""
+    if hasattr(package, "manipulator_from_mapping"):
+        if parameters is not None:
+            return package.manipulator_from_mapping(parameters)
+        return package.load_manipulator(path)
+    if parameters is not None:
+        return package.Manipulator.from_mapping(parameters)
+    return package.Manipulator.from_params_file(path)
+
+
 def best_of(
     repeats: int,
     function: Callable[[], object],
@@ -156,11 +169,11 @@ def main() -> None:
     options = parser.parse_args()
     cpus = sorted(os.sched_getaffinity(0))
     kernels.warm_up()
-    manipulator = new.Manipulator.from_params_file(example_config_path())
+    manipulator = new.load_manipulator(example_config_path())
     table = Table()
     with tempfile.TemporaryDirectory() as scratch:
         baseline = load_baseline(Path(scratch))
-        old = baseline.Manipulator.from_params_file(example_config_path()) if baseline else None
+        old = machine_from(baseline, path=example_config_path()) if baseline else None
         print(
             f"speed, packaged example at ({', '.join(f'{v:g}' for v in POSITION)}) m, all four "
             f"constraints; baseline: {'commit ' + BASELINE_COMMIT if baseline else 'unavailable'}"

@@ -12,11 +12,11 @@ from pathlib import Path
 
 import numpy as np
 
-from hexapod_workspace import Manipulator
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.cli.scene import view_at
 from hexapod_workspace.cli.scene_plot import plot_scene
-from hexapod_workspace.core.collision import collision_scene
+from hexapod_workspace.core.collision import collision_scene, require_free_home
+from hexapod_workspace.core.loading import load_manipulator
 
 #: The scene of the page's YAML example (collision.* as the parameters file gives them), with
 #: the vise's top at z = -1.49 m instead of -1.70 m.
@@ -39,8 +39,8 @@ SCENE = {
 
 
 def main(out_dir: Path) -> None:
-    manipulator = Manipulator.from_params_file(example_config_path())
-    scene = collision_scene(SCENE, manipulator=manipulator)
+    manipulator = load_manipulator(example_config_path())
+    scene = require_free_home(manipulator, collision_scene(SCENE))
     view = view_at(manipulator, np.radians([0.0, 15.0, 0.0]), [0.05, 0.0, -1.45], scene)
     path = plot_scene(view, out_dir / "scene.png")
     pair = view.closest

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hexapod_workspace import Manipulator, orientation_workspace, projected_workspace
+from hexapod_workspace import example_manipulator, orientation_workspace, projected_workspace
 from hexapod_workspace.cli.plotting import plot_orientation, plot_projected
 
 out_dir = Path(sys.argv[1]) if len(sys.argv) > 1 else Path("tutorial_out")
@@ -22,7 +22,7 @@ out_dir.mkdir(parents=True, exist_ok=True)
 
 # The packaged example (config/example_gpm.yaml): axisymmetric, the platform
 # hanging below the base, at the scale of the paper's Fig. 1.
-machine = Manipulator.example()
+machine = example_manipulator()
 
 # The paper analyses its machine on the axis of symmetry and off it.
 positions = {"on_axis": (0.0, 0.0, -1.3), "off_axis": (0.2, 0.2, -0.95)}

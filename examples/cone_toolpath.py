@@ -23,9 +23,10 @@ from pathlib import Path
 
 import numpy as np
 
-from hexapod_workspace import Manipulator, plan_torsion
+from hexapod_workspace import plan_torsion
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.cli.check_path import plot_path
+from hexapod_workspace.core.loading import load_manipulator
 from hexapod_workspace.core.rotations import approach_vector
 
 CENTER = np.array([0.2, 0.2, -0.95])  # m, the demo's off-axis position
@@ -57,7 +58,7 @@ def main() -> None:
     options = parser.parse_args()
     out = Path(options.out)
     out.mkdir(parents=True, exist_ok=True)
-    manipulator = Manipulator.from_params_file(example_config_path())
+    manipulator = load_manipulator(example_config_path())
     positions, axes = toolpath(options.waypoints)
     csv = out / "cone_toolpath.csv"
     np.savetxt(

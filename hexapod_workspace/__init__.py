@@ -14,7 +14,13 @@ from .core.atlas import AtlasGrid, AtlasOptions
 from .core.cldata import CLProgram, parse_cldata, read_cldata
 from .core.constraints import CONSTRAINT_NAMES, CheckResult, check
 from .core.frames import CellFrames, Tool, WorkFrame, cell_from_mapping, tool_model
-from .core.manipulator import HomePoseWarning, Manipulator
+from .core.loading import (
+    HomePoseWarning,
+    example_manipulator,
+    load_manipulator,
+    manipulator_from_mapping,
+)
+from .core.manipulator import Manipulator
 from .core.orientation import (
     OrientationSlice,
     OrientationWorkspace,
@@ -73,7 +79,10 @@ __all__ = [
     "check",
     "check_path",
     "check_waypoints",
+    "example_manipulator",
     "feed_limits",
+    "load_manipulator",
+    "manipulator_from_mapping",
     "orientation_workspace",
     "parse_cldata",
     "plan_torsion",

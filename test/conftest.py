@@ -8,6 +8,7 @@ import pytest
 from hexapod_workspace import Manipulator
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import kernels
+from hexapod_workspace.core.loading import load_manipulator, manipulator_from_mapping
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -18,9 +19,7 @@ def compiled_kernels() -> float:
     variant compiles it where it first uses it."""
     config = example_config_path().parent
     models = [
-        kernels.model_vector(
-            Manipulator.from_params_file(config / f"{name}.yaml"), report_singularity=report
-        )
+        kernels.model_vector(load_manipulator(config / f"{name}.yaml"), report_singularity=report)
         for name in ("example_gpm", "example_collision", "example_pus", "example_rus")
         for report in (False, True)
     ]
@@ -30,13 +29,13 @@ def compiled_kernels() -> float:
 @pytest.fixture(scope="session")
 def example() -> Manipulator:
     """The packaged example GPM (axisymmetric, platform below the base)."""
-    return Manipulator.from_params_file(example_config_path())
+    return load_manipulator(example_config_path())
 
 
 @pytest.fixture(scope="session")
 def example_parameters() -> dict:
     """The example's parameters as dotted names (a fresh copy per use is the caller's job)."""
-    return Manipulator.from_params_file(example_config_path()).to_parameters()
+    return load_manipulator(example_config_path()).to_parameters()
 
 
 @pytest.fixture
@@ -58,4 +57,4 @@ def symmetric(example) -> Manipulator:
     parameters = example.to_parameters()
     parameters["geometry.base_joints"] = polar_joints(0.55, [-12, 12, 108, 132, 228, 252], 0.0)
     parameters["geometry.platform_joints"] = polar_joints(0.30, [-48, 48, 72, 168, 192, 288], 0.10)
-    return Manipulator.from_mapping(parameters)
+    return manipulator_from_mapping(parameters)

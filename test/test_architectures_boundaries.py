@@ -23,7 +23,8 @@ import numpy as np
 import pytest
 import reference_arch as ra
 
-from hexapod_workspace import Manipulator, check_path, projected_workspace, torsion_range
+from hexapod_workspace import check_path, projected_workspace, torsion_range
+from hexapod_workspace.core.loading import load_manipulator
 
 CONFIG = Path(__file__).resolve().parents[1] / "config"
 EXAMPLES = {"ups": "example_gpm.yaml", "pus": "example_pus.yaml", "rus": "example_rus.yaml"}
@@ -43,7 +44,7 @@ def machines(architecture: str):
     path = CONFIG / EXAMPLES[architecture]
     model = ra.load(path)
     positions = (model.home_position, model.home_position + np.array(OFFSETS[architecture]))
-    return Manipulator.from_params_file(path), model, positions
+    return load_manipulator(path), model, positions
 
 
 def reachable(model: ra.ReferenceModel, angles, position) -> np.ndarray:

@@ -20,9 +20,10 @@ import reference_arch as ra
 import yaml
 from cli_support import one_error_line, run_main
 
-from hexapod_workspace import Manipulator, check
+from hexapod_workspace import check
 from hexapod_workspace.core.constraint_table import constraint_names
 from hexapod_workspace.core.legs import leg_endpoints
+from hexapod_workspace.core.loading import load_manipulator, manipulator_from_mapping
 from hexapod_workspace.core.rotations import tt_to_matrix
 from hexapod_workspace.errors import ConfigError, GeometryError
 
@@ -49,7 +50,7 @@ def refusal(architecture: str, section: str, name: str, value: Any) -> str:
     tree = parameters(architecture)
     tree[section][name] = value
     with pytest.raises((GeometryError, ConfigError)) as error:
-        Manipulator.from_mapping(tree, warn=False)
+        manipulator_from_mapping(tree, warn=False)
     text = str(error.value)
     assert "\n" not in text
     return text
@@ -57,7 +58,7 @@ def refusal(architecture: str, section: str, name: str, value: Any) -> str:
 
 @pytest.mark.parametrize("architecture", ["pus", "rus"])
 def test_examples_load_with_the_figures_of_their_comments(architecture):
-    manipulator = Manipulator.from_params_file(EXAMPLES[architecture])
+    manipulator = load_manipulator(EXAMPLES[architecture])
     assert manipulator.architecture == architecture
     assert constraint_names(manipulator) == MOVING_NAMES
     home = check(manipulator, np.zeros((1, 3)), manipulator.home_position, singularity=True)
@@ -73,7 +74,7 @@ def test_examples_load_with_the_figures_of_their_comments(architecture):
 @pytest.mark.parametrize("architecture", ["pus", "rus"])
 def test_leg_endpoints_close_the_legs(architecture, rng):
     """pose → q → leg ends: every solved leg has its fixed length; unsolved legs are NaN."""
-    manipulator = Manipulator.from_params_file(EXAMPLES[architecture])
+    manipulator = load_manipulator(EXAMPLES[architecture])
     reference = ra.load(EXAMPLES[architecture])
     angles = np.column_stack(
         [rng.uniform(-math.pi, math.pi, 3000), rng.uniform(0, 0.8, 3000), rng.uniform(-1, 1, 3000)]
@@ -135,15 +136,15 @@ def test_bad_architecture_parameters_are_refused_in_one_line(
 def test_ups_refuses_the_parameters_of_the_other_architectures(example):
     values = {**example.to_parameters(), "geometry.rail_directions": [1.0, 0.0, 0.0] * 6}
     with pytest.raises(ConfigError, match="geometry.rail_directions: a parameter of"):
-        Manipulator.from_mapping(values, warn=False)
+        manipulator_from_mapping(values, warn=False)
     # Left empty (how the node holds an unused array parameter) they are not given.
-    assert Manipulator.from_mapping(example.to_parameters(), warn=False) == example
+    assert manipulator_from_mapping(example.to_parameters(), warn=False) == example
 
 
 @pytest.mark.parametrize("architecture", ["pus", "rus"])
 def test_parameters_round_trip(architecture):
-    manipulator = Manipulator.from_params_file(EXAMPLES[architecture])
-    again = Manipulator.from_mapping(manipulator.to_parameters(), warn=False)
+    manipulator = load_manipulator(EXAMPLES[architecture])
+    again = manipulator_from_mapping(manipulator.to_parameters(), warn=False)
     assert again == manipulator
     assert manipulator.to_parameters()["limits.leg_length_min"] == []
 
@@ -152,7 +153,7 @@ def test_missing_architecture_parameter_is_named():
     tree = parameters("rus")
     del tree["geometry"]["crank_axes"]
     with pytest.raises(ConfigError, match="geometry.crank_axes: required parameter is missing"):
-        Manipulator.from_mapping(tree, warn=False)
+        manipulator_from_mapping(tree, warn=False)
 
 
 @pytest.mark.parametrize("architecture", ["pus", "rus"])
@@ -196,8 +197,8 @@ def test_rate_bounds_hold_along_moves(architecture, rng):
     τ_f the smallest |τ| met along the move: Q = V/τ_f (pus) or V/(r_min·τ_f) (rus),
     K = V/(r_min·τ_f) (rus), N = V(1 + 1/τ_f)/L_min, E = V/τ_f."""
     path = EXAMPLES[architecture]
-    model = Manipulator.from_mapping(
-        {**Manipulator.from_params_file(path).to_parameters(), "limits.singularity_min": 0.01},
+    model = manipulator_from_mapping(
+        {**load_manipulator(path).to_parameters(), "limits.singularity_min": 0.01},
         warn=False,
     )
     rho = float(np.max(np.linalg.norm(model.platform_joints, axis=1)))
@@ -252,8 +253,8 @@ def test_batch_check_equals_the_one_pose_kernel(architecture, singularity_min, r
     from hexapod_workspace.core.constraint_table import INDEX
     from hexapod_workspace.core.constraints import check_pose
 
-    base = Manipulator.from_params_file(EXAMPLES[architecture]).to_parameters()
-    model = Manipulator.from_mapping({**base, "limits.singularity_min": singularity_min})
+    base = load_manipulator(EXAMPLES[architecture]).to_parameters()
+    model = manipulator_from_mapping({**base, "limits.singularity_min": singularity_min})
     angles = np.column_stack(
         [rng.uniform(-math.pi, math.pi, 800), rng.uniform(0, 0.9, 800), rng.uniform(-1, 1, 800)]
     )

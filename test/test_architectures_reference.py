@@ -3,7 +3,7 @@ architecture, over at least 10⁵ random poses each: the packaged example of eac
 (10⁵ poses over six positions) and one variant with per-leg limits, explicit joint axes, an
 enforced singularity margin and architecture-specific changes (4·10⁴ more poses).
 
-Written against the planned public contract only: ``Manipulator.from_params_file`` reads
+Written against the planned public contract only: ``load_manipulator`` reads
 the architecture keys; ``check(manipulator, angles, position, singularity=True)`` (σ_min
 reported even where not enforced) returns ``margins`` by name
 (``leg_length`` for ups, ``actuator`` for pus/rus, ``ik``, ``transmission``, ``base_joint``,
@@ -35,6 +35,7 @@ import yaml
 
 from hexapod_workspace import Manipulator
 from hexapod_workspace.core.constraints import check
+from hexapod_workspace.core.loading import load_manipulator
 
 CONFIG = Path(__file__).resolve().parents[1] / "config"
 EXAMPLES = {"ups": "example_gpm.yaml", "pus": "example_pus.yaml", "rus": "example_rus.yaml"}
@@ -197,7 +198,7 @@ def disagreements(
 
 
 def run(label: str, path: Path, rng: np.random.Generator, poses: int) -> dict[str, int]:
-    manipulator = Manipulator.from_params_file(path)
+    manipulator = load_manipulator(path)
     reference_model = ra.load(path)
     counts: dict[str, int] = {
         key: 0 for key in ("poses", "reachable", "no ik", "ties", "ill_conditioned")

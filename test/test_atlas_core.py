@@ -157,7 +157,7 @@ def test_package_imports_without_the_atlas_extra_and_says_how_to_get_it():
     code = _BLOCK + (
         "import hexapod_workspace as hw\n"
         "from hexapod_workspace._resources import example_config_path\n"
-        "m = hw.Manipulator.from_params_file(example_config_path())\n"
+        "m = hw.load_manipulator(example_config_path())\n"
         "try:\n"
         "    hw.workspace_atlas(m, hw.AtlasGrid.box([0, 0, 0, 0, -1.3, -1.3], 0.1), store='x')\n"
         "except hw.MissingExtraError as error:\n"

@@ -26,12 +26,12 @@ from hexapod_workspace import (
     AtlasError,
     AtlasGrid,
     AtlasOptions,
-    Manipulator,
     __version__,
     workspace_atlas,
 )
 from hexapod_workspace.atlas.store import MARKER, open_atlas
 from hexapod_workspace.core.atlas import ATLAS_VARIABLES, position_capability
+from hexapod_workspace.core.loading import manipulator_from_mapping
 
 OPTIONS = AtlasOptions(n_phi=24, tolerance=1e-3)
 #: 3 × 2 × 3 = 18 positions around the home position, in 6 chunks of 3 (one z column each).
@@ -88,7 +88,7 @@ def test_store_layout_and_values_equal_per_position_calls(reference, example):
     assert "orientation_volume" not in reference
     assert reference.attrs["software_version"] == __version__
     assert reference.attrs["complete"] is True
-    stored = Manipulator.from_mapping(json.loads(reference.attrs["manipulator_parameters"]))
+    stored = manipulator_from_mapping(json.loads(reference.attrs["manipulator_parameters"]))
     assert stored == example
     assert np.all(reference[MARKER].values == 1)
     rng = np.random.default_rng(20261123)

@@ -14,8 +14,8 @@ import pytest
 from cli_support import run_main
 from test_paired_joints import LINUXCNC_BASE, LINUXCNC_PLATFORM
 
-from hexapod_workspace import Manipulator
 from hexapod_workspace.core.constraints import inverse_kinematics
+from hexapod_workspace.core.loading import load_manipulator
 from hexapod_workspace.core.rotations import xyz_fixed_to_matrix
 
 SIM = Path(__file__).parent / "data" / "linuxcnc" / "hexapod-sim"
@@ -56,7 +56,7 @@ def test_the_simulation_converts_and_its_struts_are_linuxcnc_s(tmp_path):
     assert code == 0, err
     assert "legs sharing a joint: 3 pair(s) (1 and 6, 2 and 3, 4 and 5)" in out
     assert "passed over (cannot change a strut length): genhexkins.max-error (1)" in out
-    model = Manipulator.from_params_file(output)
+    model = load_manipulator(output)
     np.testing.assert_allclose(model.base_joints, LINUXCNC_BASE * INCH, atol=1e-15)
     np.testing.assert_allclose(model.home_position, [0.0, 0.0, 20 * INCH], atol=1e-15)
     assert model.paired_joint_length == pytest.approx(4 * INCH)
@@ -99,7 +99,7 @@ def test_spindle_and_tool_offsets_move_both_joint_sets(tmp_path):
     summary = json.loads(out)
     assert summary["joint_z_offset"] == 5.0 and summary["linear_unit"] == "inch"
     assert summary["legs_sharing_a_joint"] == [[1, 6], [2, 3], [4, 5]]
-    model = Manipulator.from_params_file(output)
+    model = load_manipulator(output)
     pose = np.array([1.0, -2.0, 21.0, 8.0, -6.0, 20.0])
     legs = inverse_kinematics(
         model, xyz_fixed_to_matrix(np.radians(pose[3:]))[None], pose[:3] * INCH

@@ -22,9 +22,11 @@ from hexapod_workspace.core.collision import (
     pair_table,
     rate_bound,
     record,
+    require_free_home,
     scene_distances,
 )
 from hexapod_workspace.core.collision.distance import BOX, CYLINDER, GJK_GAP_BOUND, POINT, SEGMENT
+from hexapod_workspace.core.loading import manipulator_from_mapping
 from hexapod_workspace.core.params import load_params_file
 from hexapod_workspace.core.rotations import tt_to_matrix
 from hexapod_workspace.errors import ConfigError, InputError
@@ -34,7 +36,7 @@ SHAPES = ("sphere", "capsule", "box", "cylinder")
 
 @pytest.fixture(scope="module")
 def manipulator() -> Manipulator:
-    return Manipulator.from_mapping(load_params_file(example_config_path()))
+    return manipulator_from_mapping(load_params_file(example_config_path()))
 
 
 def random_rotation(rng: np.random.Generator) -> np.ndarray:
@@ -503,7 +505,7 @@ def test_obstacle_at_the_home_pose_is_refused(manipulator: Manipulator) -> None:
     params = {"collision": {"obstacles": {"names": ["clamp"], "clamp": group}}}
     collision_scene(params)  # valid on its own
     with pytest.raises(ConfigError, match=r"^collision: leg \d vs clamp collide at the home pose"):
-        collision_scene(params, manipulator=manipulator)
+        require_free_home(manipulator, collision_scene(params))
 
 
 def test_bad_poses_are_refused(manipulator: Manipulator) -> None:

@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from hexapod_workspace import Manipulator
 from hexapod_workspace.core.collision import scene_distances
 from hexapod_workspace.core.constraints import check
 from hexapod_workspace.core.legs import leg_endpoints
+from hexapod_workspace.core.loading import manipulator_from_mapping
 from hexapod_workspace.core.params import flatten, load_params_file
 from hexapod_workspace.core.rotations import tt_to_matrix
 from hexapod_workspace.errors import ConfigError
@@ -32,7 +32,7 @@ def test_rus_home_check_uses_the_crank_end() -> None:
     in collision and the model is refused naming leg 1 (with A0_1 as the leg's end it was
     accepted)."""
     parameters = load_params_file(CONFIG / "example_rus.yaml")
-    machine = Manipulator.from_mapping(parameters, warn=False)
+    machine = manipulator_from_mapping(parameters, warn=False)
     home = np.asarray(machine.home_position, dtype=float)
     base_ends, platform_ends = leg_endpoints(machine, np.eye(3), home)
     crank_end, joint = base_ends[0, 0], platform_ends[0, 0]
@@ -50,7 +50,7 @@ def test_rus_home_check_uses_the_crank_end() -> None:
         }
     }
     with pytest.raises(ConfigError, match=r"collision: leg 1 vs ball collide at the home pose"):
-        Manipulator.from_mapping({**parameters, **flatten(scene)}, warn=False)
+        manipulator_from_mapping({**parameters, **flatten(scene)}, warn=False)
 
 
 @pytest.mark.parametrize("architecture", ["pus", "rus"])
@@ -59,7 +59,7 @@ def test_scene_distances_equal_the_kernels_for_moving_base_joints(architecture: 
     (which build leg bodies from the leg vectors), and NaN where a leg has no solution."""
     path = CONFIG / f"example_{architecture}.yaml"
     parameters = load_params_file(path)
-    machine = Manipulator.from_mapping(parameters, warn=False)
+    machine = manipulator_from_mapping(parameters, warn=False)
     home = np.asarray(machine.home_position, dtype=float)
     base_ends, platform_ends = leg_endpoints(machine, np.eye(3), home)
     # Balls beside legs 2 and 5, a third of the way up from their base-side ends.
@@ -74,7 +74,7 @@ def test_scene_distances_equal_the_kernels_for_moving_base_joints(architecture: 
         centre = point + (0.5 * machine.leg_diameter + 0.02 + 0.005) * outward
         obstacles[name] = {"shape": "sphere", "position": centre.tolist(), "radius": 0.02}
     scene = {"collision": {"clearance": 0.002, "obstacles": obstacles}}
-    cell = Manipulator.from_mapping({**parameters, **flatten(scene)}, warn=False)
+    cell = manipulator_from_mapping({**parameters, **flatten(scene)}, warn=False)
     assert cell.collision is not None
     rng = np.random.default_rng(11)
     count = 2000

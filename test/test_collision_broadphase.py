@@ -20,6 +20,7 @@ from hexapod_workspace.core.collision_kernels import (
     collision_margins,
 )
 from hexapod_workspace.core.legs import leg_endpoints
+from hexapod_workspace.core.loading import example_manipulator, manipulator_from_mapping
 from hexapod_workspace.core.model_layout import MODEL_SIZE, B, model_vector
 from hexapod_workspace.core.params import flatten
 from hexapod_workspace.errors import ConfigError
@@ -27,7 +28,7 @@ from hexapod_workspace.errors import ConfigError
 
 @pytest.fixture(scope="module")
 def plain() -> Manipulator:
-    return Manipulator.example()
+    return example_manipulator()
 
 
 def _both(model: Manipulator, rotations: np.ndarray, positions: np.ndarray):
@@ -60,7 +61,7 @@ def _scenes(plain: Manipulator, rng: np.random.Generator, count: int, obstacles:
         obstacle_groups = {name: templates[k] for k, name in enumerate(names)}
         parameters["collision"]["obstacles"] = {"names": names, **obstacle_groups}
         try:
-            model = Manipulator.from_mapping({**plain.to_parameters(), **flatten(parameters)})
+            model = manipulator_from_mapping({**plain.to_parameters(), **flatten(parameters)})
         except ConfigError:  # an obstacle in collision at the home pose: drawn again
             continue
         made += 1
@@ -110,7 +111,7 @@ def test_ties_name_the_lowest_pair(plain: Manipulator) -> None:
                 if key.startswith(f"collision.obstacles.{name}."):
                     doubled[key.replace(f".{name}.", f".{name}_copy.")] = value
         doubled["collision.obstacles.names"] = names + [f"{name}_copy" for name in names]
-        twin = Manipulator.from_mapping(doubled)
+        twin = manipulator_from_mapping(doubled)
         rotations, positions = random_poses(rng, 100)
         found, every = _both(twin, rotations, positions)
         np.testing.assert_array_equal(found, every)

@@ -23,7 +23,8 @@ import pytest
 import reference_arch as ra
 from test_architectures_boundaries import interpolate
 
-from hexapod_workspace import Manipulator, check_path, projected_workspace
+from hexapod_workspace import check_path, projected_workspace
+from hexapod_workspace.core.loading import manipulator_from_mapping
 from hexapod_workspace.core.orientation import orientation_workspace
 from hexapod_workspace.core.params import flatten, load_params_file
 
@@ -73,7 +74,7 @@ def machines(architecture: str, tool_length: float, legs: tuple[int, ...], gap: 
     model = ra.load(path)
     collision = scene(model, tool_length, legs, gap)
     parameters = {**load_params_file(path), **flatten(collision)}
-    return Manipulator.from_mapping(parameters, warn=False), model, collision["collision"]
+    return manipulator_from_mapping(parameters, warn=False), model, collision["collision"]
 
 
 def reference_collision(model: ra.ReferenceModel, collision: dict, angles, position) -> np.ndarray:

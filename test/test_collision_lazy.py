@@ -21,6 +21,7 @@ from hexapod_workspace import Manipulator
 from hexapod_workspace.core.collision.scene import _tool_ends
 from hexapod_workspace.core.constraint_table import COLLISION
 from hexapod_workspace.core.constraints import check
+from hexapod_workspace.core.loading import load_manipulator, manipulator_from_mapping
 from hexapod_workspace.core.orientation import torsion_range
 from hexapod_workspace.core.params import flatten, load_params_file
 from hexapod_workspace.core.rotations import tt_to_matrix
@@ -131,11 +132,11 @@ def grazing_machine() -> tuple[Manipulator, np.ndarray, float]:
     from hexapod_workspace._resources import example_config_path
 
     parameters = load_params_file(example_config_path())
-    base = Manipulator.from_mapping(parameters)
+    base = manipulator_from_mapping(parameters)
     position = np.asarray(base.home_position, dtype=float)
     tool_radius, radius, clearance, depth = 0.04, 0.004, 0.002, 0.0005
     tool = {"radius": tool_radius, "length": 0.25}
-    probe = Manipulator.from_mapping(
+    probe = manipulator_from_mapping(
         {**parameters, **flatten({"collision": {"clearance": clearance, "tool": tool}})}
     )
     assert probe.collision is not None
@@ -154,7 +155,7 @@ def grazing_machine() -> tuple[Manipulator, np.ndarray, float]:
         "ball": {"shape": "sphere", "position": centre.tolist(), "radius": radius},
     }
     scene = {"collision": {"clearance": clearance, "tool": tool, "obstacles": obstacles}}
-    return Manipulator.from_mapping({**parameters, **flatten(scene)}), position, s_star
+    return manipulator_from_mapping({**parameters, **flatten(scene)}), position, s_star
 
 
 def test_a_ray_grazing_a_ball_between_probes_is_caught() -> None:
@@ -185,7 +186,7 @@ def test_torsion_scan_lazy_against_eager_and_dense_sampling() -> None:
     (the spindle meets leg 3 near φ 90°, θ 30°) over 36 tool directions, the lazy scan's
     torsion intervals equal dense sampling's away from their ends, and equal the eager scan's
     (every sample evaluated) to the tolerance."""
-    cell = Manipulator.from_params_file(EXAMPLE)
+    cell = load_manipulator(EXAMPLE)
     home = np.array([0.0, 0.0, -1.3])
     tolerance = 1e-4
     psi = np.linspace(-math.pi, math.pi, 20_001)

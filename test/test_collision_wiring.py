@@ -19,6 +19,11 @@ from hexapod_workspace import Manipulator
 from hexapod_workspace.core import constraints
 from hexapod_workspace.core.collision import scene_distances
 from hexapod_workspace.core.constraint_table import COLLISION, CONSTRAINTS, applicable
+from hexapod_workspace.core.loading import (
+    example_manipulator,
+    load_manipulator,
+    manipulator_from_mapping,
+)
 from hexapod_workspace.core.orientation import torsion_range
 from hexapod_workspace.core.params import flatten
 from hexapod_workspace.core.path_checks import check_path
@@ -32,16 +37,16 @@ HOME = np.array([0.0, 0.0, -1.3])
 
 @pytest.fixture(scope="module")
 def plain() -> Manipulator:
-    return Manipulator.example()
+    return example_manipulator()
 
 
 @pytest.fixture(scope="module")
 def cell() -> Manipulator:
-    return Manipulator.from_params_file(EXAMPLE)
+    return load_manipulator(EXAMPLE)
 
 
 def with_scene(plain: Manipulator, collision: dict) -> Manipulator:
-    return Manipulator.from_mapping({**plain.to_parameters(), **flatten(collision)})
+    return manipulator_from_mapping({**plain.to_parameters(), **flatten(collision)})
 
 
 def test_no_scene_no_constraint(plain: Manipulator) -> None:
@@ -295,7 +300,7 @@ def test_collision_row_adds_the_moving_base_joints_speed() -> None:
 
     parameters = load_params_file(EXAMPLE.parent / "example_pus.yaml")
     spindle = {"collision.tool.radius": 0.02, "collision.tool.length": 0.05}
-    pus = Manipulator.from_mapping({**parameters, **spindle}, warn=False)
+    pus = manipulator_from_mapping({**parameters, **spindle}, warn=False)
     assert COLLISION in applicable(pus)
     speed, turn, spin, actuate, crank, ends = CONSTRAINTS[COLLISION].coefficients(pus)
     assert (speed, turn, actuate, crank, ends) == (1.0, 0.0, 0.0, 0.0, 1.0)

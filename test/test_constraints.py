@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 from reference import pose_margins_literal, segment_distance_literal
 
-from hexapod_workspace import InputError, Manipulator, check
+from hexapod_workspace import InputError, check
 from hexapod_workspace.core.constraints import inverse_kinematics, pose_margins, segment_distance
+from hexapod_workspace.core.loading import manipulator_from_mapping
 from hexapod_workspace.core.rotations import tt_to_matrix
 
 #: The 6-UPS model's constraints (the rows of the table that apply to it), as before the leg
@@ -118,7 +119,7 @@ def test_margins_with_per_leg_limits_match_literal(example, rng):
     parameters["limits.base_joint_max_angle"] = [0.5, 0.6, 0.7, 0.8, 0.9, 1.0]
     parameters["limits.platform_joint_max_angle"] = [1.0, 0.9, 0.8, 0.7, 0.6, 0.5]
     parameters["limits.leg_length_min"] = [0.80, 0.81, 0.82, 0.83, 0.84, 0.85]
-    model = Manipulator.from_mapping(parameters, warn=False)
+    model = manipulator_from_mapping(parameters, warn=False)
     angles = random_angles(rng, 200)
     result = check(model, angles)
     for index in range(len(angles)):
@@ -212,7 +213,7 @@ def test_limiting_leg_is_the_leg_of_the_smallest_margin(example, rng):
 def test_disabled_interference_is_infinite(example):
     parameters = example.to_parameters()
     parameters["limits.leg_diameter"] = 0.0
-    model = Manipulator.from_mapping(parameters)
+    model = manipulator_from_mapping(parameters)
     result = check(model, [0.0, 0.1, 0.0])
     assert result.margins["leg_interference"][0] == math.inf
     assert result.limiting_legs["leg_interference"][0] == 0
@@ -226,7 +227,7 @@ def test_interference_detects_touching_legs(example):
     distance = home.margins["leg_interference"][0] + example.leg_diameter
     parameters = example.to_parameters()
     parameters["limits.leg_diameter"] = distance + 1e-6
-    model = Manipulator.from_mapping(parameters, warn=False)
+    model = manipulator_from_mapping(parameters, warn=False)
     result = check(model, [0.0, 0.0, 0.0], example.home_position)
     assert result.violated == [["leg_interference"]]
     assert result.margins["leg_interference"][0] == pytest.approx(-1e-6, abs=1e-12)

@@ -24,6 +24,7 @@ from hexapod_workspace.core.frames import (
     tool_pose,
     work_to_base,
 )
+from hexapod_workspace.core.loading import example_manipulator, load_manipulator
 from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.core.rotations import matrix_to_tt
 from hexapod_workspace.errors import ConfigError, InputError
@@ -34,7 +35,7 @@ TOOL_ANGLES = [0.4, 0.12, -0.3]
 
 @pytest.fixture(scope="module")
 def example() -> Manipulator:
-    return Manipulator.example(warn=False)
+    return example_manipulator()
 
 
 def _tool_poses(rng: np.random.Generator, count: int):
@@ -170,8 +171,8 @@ def test_parameters_file_with_cell_sections_is_accepted(tmp_path):
     text = text.replace("    limits:\n", "    limits:\n      actuator_speed_max: [0.1]\n", 1)
     path = tmp_path / "cell.yaml"
     path.write_text(text, encoding="utf-8")
-    assert Manipulator.from_params_file(path, warn=False) == Manipulator.example(warn=False)
+    assert load_manipulator(path) == example_manipulator()
     misspelt = tmp_path / "bad.yaml"
     misspelt.write_text(text.replace("    tools:\n", "    toolz:\n"), encoding="utf-8")
     with pytest.raises(ConfigError, match="toolz: unknown section"):
-        Manipulator.from_params_file(misspelt, warn=False)
+        load_manipulator(misspelt)

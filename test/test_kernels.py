@@ -30,6 +30,10 @@ from hexapod_workspace.core.constraints import (
     pose_margins,
     segment_distance,
 )
+from hexapod_workspace.core.loading import (
+    load_manipulator,
+    manipulator_from_mapping,
+)
 from hexapod_workspace.core.rotations import tt_to_matrix
 from hexapod_workspace.core.search import RaySearch
 
@@ -67,7 +71,7 @@ def _design(example: Manipulator, name: str) -> Manipulator:
         parameters["geometry.platform_joints"] = platform[[1, 0, 3, 2, 5, 4]].ravel().tolist()
     elif name != "axisymmetric":
         raise ValueError(name)
-    return Manipulator.from_mapping(parameters, warn=False)
+    return manipulator_from_mapping(parameters, warn=False)
 
 
 def _random_poses(rng: np.random.Generator, count: int) -> np.ndarray:
@@ -184,7 +188,7 @@ def test_huge_angles_and_degenerate_legs_take_the_exact_path(example):
     parameters["geometry.home_position"] = [0.0, 0.0, 0.0]
     parameters["pose.position"] = [0.0, 0.0, 0.0]
     parameters["limits.leg_diameter"] = 0.02
-    vertical = Manipulator.from_mapping(parameters, warn=False)
+    vertical = manipulator_from_mapping(parameters, warn=False)
     angles = np.array([[0.0, 0.0, 0.0], [0.2, 0.05, 0.1]])
     result = check(vertical, angles)
     reference, _, _ = batched_margins(vertical, angles, vertical.position)
@@ -303,11 +307,11 @@ def test_block_decisions_equal_the_per_probe_functions(name):
     from hexapod_workspace.core import search_kernels
 
     config = CONFIG.parent / f"{name if name.startswith('example') else 'example_gpm'}.yaml"
-    machine = Manipulator.from_params_file(config, warn=False)
+    machine = load_manipulator(config)
     if name == "singularity":
         parameters = machine.to_parameters()
         parameters["limits.singularity_min"] = 0.02
-        machine = Manipulator.from_mapping(parameters, warn=False)
+        machine = manipulator_from_mapping(parameters, warn=False)
     model = kernels.model_vector(machine)
     used = int(model[kernels.ROWS_USED])
     fixed = machine.architecture == "ups"
@@ -469,11 +473,11 @@ def test_one_signature_per_kernel_after_a_mixed_workload():
     are normalised at the boundary: each kernel of the variant has one compiled signature."""
     code = """
 import numpy as np
-from hexapod_workspace import Manipulator, check, projected_workspace
+from hexapod_workspace import check, example_manipulator, projected_workspace
 from hexapod_workspace.core import kernels
 from hexapod_workspace.core.constraints import check_pose, pose_margins
 from hexapod_workspace.core.orientation import torsion_range
-m = Manipulator.example()
+m = example_manipulator()
 T = np.eye(4)
 T[:3, 3] = m.position
 angles = np.radians([[0, 10, 0], [30, 20, 5]])
@@ -509,9 +513,9 @@ def test_a_6ups_check_compiles_no_stage_it_does_not_use(tmp_path):
     (each stage costs tens of seconds of compilation)."""
     code = """
 import numpy as np
-from hexapod_workspace import Manipulator, check
+from hexapod_workspace import check, example_manipulator
 from hexapod_workspace.core import collision_kernels, margin_kernels
-check(Manipulator.example(), np.radians([[0, 30, 0]]))
+check(example_manipulator(), np.radians([[0, 30, 0]]))
 for name in ("_pose_moving", "_pose_collision", "_block_collision", "_block_singularity",
              "_pose_singularity", "_leg_planes_pus", "_leg_planes_rus"):
     print(name, len(getattr(margin_kernels, name).signatures))

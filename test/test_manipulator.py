@@ -11,13 +11,18 @@ import numpy as np
 import pytest
 
 from hexapod_workspace import ConfigError, GeometryError, HomePoseWarning, Manipulator
+from hexapod_workspace.core.loading import (
+    example_manipulator,
+    load_manipulator,
+    manipulator_from_mapping,
+)
 from hexapod_workspace.core.params import load_params_file
 
 
 def build(parameters: dict, **changes) -> Manipulator:
     values = dict(parameters)
     values.update(changes)
-    return Manipulator.from_mapping(values, warn=False)
+    return manipulator_from_mapping(values, warn=False)
 
 
 def test_example_loads_with_defaults_from_the_home_pose(example):
@@ -41,18 +46,18 @@ def test_nested_and_dotted_mappings_are_the_same(example_parameters):
         for group in groups:
             node = node.setdefault(group, {})
         node[leaf] = value
-    assert Manipulator.from_mapping(nested) == Manipulator.from_mapping(example_parameters)
+    assert manipulator_from_mapping(nested) == manipulator_from_mapping(example_parameters)
 
 
 def test_to_parameters_round_trip(example):
-    assert Manipulator.from_mapping(example.to_parameters()) == example
+    assert manipulator_from_mapping(example.to_parameters()) == example
 
 
 def test_explicit_axes_round_trip_and_are_normalised(example_parameters):
     axes = [0.0, 0.0, -2.0] * 6
     model = build(example_parameters, **{"geometry.base_joint_axes": axes})
     np.testing.assert_allclose(model.base_joint_axes, np.tile([0.0, 0.0, -1.0], (6, 1)))
-    assert Manipulator.from_mapping(model.to_parameters(), warn=False) == model
+    assert manipulator_from_mapping(model.to_parameters(), warn=False) == model
 
 
 def test_params_file_root_keys(tmp_path, example_parameters):
@@ -65,7 +70,7 @@ def test_params_file_root_keys(tmp_path, example_parameters):
             load_params_file(path)["limits.leg_diameter"]
             == example_parameters["limits.leg_diameter"]
         )
-        Manipulator.from_params_file(path)
+        load_manipulator(path)
 
 
 def test_params_file_without_node_section(tmp_path):
@@ -189,7 +194,7 @@ def test_missing_parameter(example_parameters):
     values = dict(example_parameters)
     del values["limits.leg_length_max"]
     with pytest.raises(ConfigError, match="limits.leg_length_max: required parameter is missing"):
-        Manipulator.from_mapping(values)
+        manipulator_from_mapping(values)
 
 
 def test_unknown_model_parameter(example_parameters):
@@ -205,20 +210,20 @@ def test_node_parameters_outside_the_model_are_ignored(example_parameters, examp
 def test_position_defaults_to_home(example_parameters):
     values = dict(example_parameters)
     del values["pose.position"]
-    model = Manipulator.from_mapping(values)
+    model = manipulator_from_mapping(values)
     np.testing.assert_array_equal(model.position, model.home_position)
 
 
 def test_unreachable_home_pose_warns_but_builds(example_parameters):
     with pytest.warns(HomePoseWarning, match="home pose .* unreachable: leg_length violated"):
-        model = Manipulator.from_mapping({**example_parameters, "limits.leg_length_max": [1.2]})
+        model = manipulator_from_mapping({**example_parameters, "limits.leg_length_max": [1.2]})
     assert model.leg_length_max[0] == 1.2
 
 
 def test_reachable_home_pose_does_not_warn(example_parameters):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        Manipulator.from_mapping(example_parameters)
+        manipulator_from_mapping(example_parameters)
 
 
 def test_arrays_are_read_only(example):
@@ -274,7 +279,7 @@ def test_unknown_names_in_a_file_are_named_at_their_level(tmp_path, example, nam
     """Every level of the file is checked; a misspelt section is named."""
     parameters = {**example.to_parameters(), name: 1.0}
     with pytest.raises(ConfigError, match=re.escape(reason)):
-        Manipulator.from_params_file(_write(tmp_path, parameters))
+        load_manipulator(_write(tmp_path, parameters))
 
 
 def test_node_and_ros_parameters_are_known_in_a_file(tmp_path, example):
@@ -285,13 +290,13 @@ def test_node_and_ros_parameters_are_known_in_a_file(tmp_path, example):
         "use_sim_time": False,
         "qos_overrides./hexapod_workspace/reachability.publisher.depth": 5,
     }
-    assert Manipulator.from_params_file(_write(tmp_path, parameters)) == example
+    assert load_manipulator(_write(tmp_path, parameters)) == example
 
 
 def test_unknown_key_next_to_ros__parameters(tmp_path, example):
     path = _write(tmp_path, example.to_parameters(), "  ros_parameters:\n    frame_id: x\n")
     with pytest.raises(ConfigError, match="unknown key 'ros_parameters' in section"):
-        Manipulator.from_params_file(path)
+        load_manipulator(path)
 
 
 @pytest.mark.parametrize("name", ["geometry.base_joints", "limits.leg_length_max", "pose.position"])
@@ -301,13 +306,13 @@ def test_lengths_beyond_a_million_metres_are_refused(example_parameters, name):
     value = np.array(parameters.get(name, [1.0]), dtype=float)
     parameters[name] = (value * 1e300).tolist()
     with pytest.raises(GeometryError, match=re.escape(f"{name}: expected values within")):
-        Manipulator.from_mapping(parameters)
+        manipulator_from_mapping(parameters)
 
 
 def test_example_from_any_working_directory(tmp_path, monkeypatch, example):
     """The API snippets (README, Getting started) use the packaged example, not a relative path."""
     monkeypatch.chdir(tmp_path)
-    assert Manipulator.example() == example
+    assert example_manipulator() == example
 
 
 def test_a_clone_named_like_the_package_does_not_shadow_it(tmp_path):
@@ -343,7 +348,7 @@ def test_leg_endpoints_follow_the_pose_written_out_per_leg() -> None:
     from hexapod_workspace.core.legs import leg_endpoints
     from hexapod_workspace.core.rotations import tt_to_matrix
 
-    m = Manipulator.example(warn=False)
+    m = example_manipulator()
     angles = np.radians([[30.0, 20.0, 10.0], [0.0, 0.0, 0.0]])
     position = np.array([0.05, -0.02, -1.2])
     base, platform = leg_endpoints(m, tt_to_matrix(angles), position)

@@ -11,9 +11,9 @@ import dataclasses
 
 import numpy as np
 
-from hexapod_workspace import Manipulator
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core.collision import collision_scene
+from hexapod_workspace.core.loading import load_manipulator
 from hexapod_workspace.core.projected import projected_workspace
 from hexapod_workspace.core.rotations import quaternion_to_matrix
 from hexapod_workspace.core.scene_view import cone_of, scene_view
@@ -81,7 +81,7 @@ def centre_of(marker):
 
 
 def test_the_pair_in_violation_and_every_obstacle_are_drawn():
-    model = Manipulator.from_params_file(example_config_path())
+    model = load_manipulator(example_config_path())
     scene = collision_scene(SCENE)  # no home-pose refusal: the ball is meant to hit leg 1
     cone = cone_of(projected_workspace(model, HOME, n_phi=36), model, scene)
     view = scene_view(model, np.eye(3), HOME, scene, cone=cone)
@@ -129,9 +129,7 @@ def test_the_pair_in_violation_and_every_obstacle_are_drawn():
 
 
 def test_legs_of_no_diameter_are_lines():
-    model = dataclasses.replace(
-        Manipulator.from_params_file(example_config_path()), leg_diameter=0.0
-    )
+    model = dataclasses.replace(load_manipulator(example_config_path()), leg_diameter=0.0)
     view = scene_view(model, np.eye(3), HOME)
     assert view.closest is None
     by_ns = spaces(markers_of(view))

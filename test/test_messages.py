@@ -12,6 +12,7 @@ from hexapod_workspace import logs
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import constraints
 from hexapod_workspace.core.constraint_table import CONSTRAINT_NAMES
+from hexapod_workspace.core.loading import load_manipulator
 from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.core.orientation import OrientationSlice, OrientationWorkspace
 from hexapod_workspace.core.projected import ProjectedWorkspace
@@ -21,7 +22,7 @@ from hexapod_workspace.logs import messages
 
 @pytest.fixture(scope="module")
 def manipulator() -> Manipulator:
-    return Manipulator.from_params_file(example_config_path())
+    return load_manipulator(example_config_path())
 
 
 @pytest.fixture(scope="module")

@@ -23,6 +23,7 @@ from hexapod_workspace import GeometryError, Manipulator, check, check_path
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core.constraint_table import INDEX, rate_bounds
 from hexapod_workspace.core.constraints import pose_margins
+from hexapod_workspace.core.loading import load_manipulator, manipulator_from_mapping
 from hexapod_workspace.core.rotations import tt_to_matrix
 from hexapod_workspace.core.scene_view import scene_view
 
@@ -82,7 +83,7 @@ def three_three() -> np.ndarray:
 
 @pytest.fixture(scope="module")
 def linuxcnc() -> Manipulator:
-    return Manipulator.from_mapping(parameters())
+    return manipulator_from_mapping(parameters())
 
 
 def test_linuxcnc_hexapod_is_accepted_with_its_three_base_pairs(linuxcnc):
@@ -133,18 +134,18 @@ def test_linuxcnc_hexapod_is_accepted_with_its_three_base_pairs(linuxcnc):
 )
 def test_paired_joint_refusals_name_the_parameter(changes, message):
     with pytest.raises(GeometryError) as raised:
-        Manipulator.from_mapping(parameters(**changes))
+        manipulator_from_mapping(parameters(**changes))
     assert str(raised.value).startswith(message), str(raised.value)
     assert "\n" not in str(raised.value)
 
 
 def test_a_paired_joint_length_without_shared_joints_is_refused(example_parameters):
     with pytest.raises(GeometryError, match=r"^geometry.paired_joint_length: given \(0.05 m\), "):
-        Manipulator.from_mapping({**example_parameters, "geometry.paired_joint_length": 0.05})
+        manipulator_from_mapping({**example_parameters, "geometry.paired_joint_length": 0.05})
 
 
 def test_shared_joints_need_no_length_when_interference_is_off():
-    model = Manipulator.from_mapping(
+    model = manipulator_from_mapping(
         parameters(**{"geometry.paired_joint_length": 0.0, "limits.leg_diameter": 0.0})
     )
     assert model.paired_joint_length == 0.0
@@ -152,19 +153,17 @@ def test_shared_joints_need_no_length_when_interference_is_off():
 
 
 def test_paired_joints_of_moving_base_joints_are_refused():
-    pus = Manipulator.from_params_file(
-        example_config_path().parent / "example_pus.yaml"
-    ).to_parameters()
+    pus = load_manipulator(example_config_path().parent / "example_pus.yaml").to_parameters()
     base = np.reshape(pus["geometry.base_joints"], (6, 3))
     base[1] = base[0]
     with pytest.raises(GeometryError, match="paired joints are modelled for geometry.architecture"):
-        Manipulator.from_mapping({**pus, "geometry.base_joints": base.ravel().tolist()})
+        manipulator_from_mapping({**pus, "geometry.base_joints": base.ravel().tolist()})
 
 
 @pytest.mark.parametrize("layout", ["6-3", "3-3"])
 def test_free_length_interference_agrees_with_the_literal_reference(layout):
     platform = LINUXCNC_PLATFORM if layout == "6-3" else three_three()
-    model = Manipulator.from_mapping(parameters(platform=platform), warn=False)
+    model = manipulator_from_mapping(parameters(platform=platform), warn=False)
     rng = np.random.default_rng(20261203)
     count = 300
     angles = np.column_stack(
@@ -218,7 +217,7 @@ def _moves(count: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
 def test_moves_of_a_paired_machine_are_certified_against_dense_sampling(layout):
     platform = LINUXCNC_PLATFORM if layout == "6-3" else three_three()
     # Legs of 3 in: the shared pairs' free lengths limit many moves.
-    model = Manipulator.from_mapping(
+    model = manipulator_from_mapping(
         parameters(platform=platform, **{"limits.leg_diameter": 3.0 * INCH}), warn=False
     )
     positions, angles = _moves(120, seed=7)
@@ -249,7 +248,7 @@ def test_moves_of_a_paired_machine_are_certified_against_dense_sampling(layout):
 @pytest.mark.parametrize("layout", ["6-3", "3-3"])
 def test_the_rate_bound_of_free_lengths_holds_against_finite_differences(layout):
     platform = LINUXCNC_PLATFORM if layout == "6-3" else three_three()
-    model = Manipulator.from_mapping(
+    model = manipulator_from_mapping(
         parameters(platform=platform, **{"geometry.paired_joint_length": 8.0 * INCH}), warn=False
     )
     rho = float(np.max(np.linalg.norm(model.platform_joints, axis=1)))

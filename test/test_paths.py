@@ -14,9 +14,10 @@ import numpy as np
 import pytest
 from path_support import random_large_moves
 
-from hexapod_workspace import InputError, Manipulator, check, check_path, plan_torsion
+from hexapod_workspace import InputError, check, check_path, plan_torsion
 from hexapod_workspace.core.constraint_table import COLLISION, INDEX
 from hexapod_workspace.core.constraints import inverse_kinematics, pose_margins
+from hexapod_workspace.core.loading import manipulator_from_mapping
 from hexapod_workspace.core.path_certificate import _Certifier
 from hexapod_workspace.core.path_interpolation import _Moves
 from hexapod_workspace.core.rotations import (
@@ -172,7 +173,7 @@ def test_angular_rate_and_lipschitz_bounds_hold(example, rng, interpolation):
         )
     # Margins: |Δm| ≤ L·Δs with the floor taken as the smallest leg along the move (the
     # singularity margin evaluated: a limit > 0).
-    model = Manipulator.from_mapping(
+    model = manipulator_from_mapping(
         {**example.to_parameters(), "limits.singularity_min": 0.01}, warn=False
     )
     every_row = pose_margins(model, rotations.reshape(-1, 3, 3), positions).margins

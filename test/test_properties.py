@@ -28,6 +28,7 @@ from hypothesis import strategies as st
 from reference import segment_distance_literal, segment_distance_squared_batch
 
 from hexapod_workspace import Manipulator, check, projected_workspace
+from hexapod_workspace.core.loading import example_manipulator, manipulator_from_mapping
 from hexapod_workspace.core.rotations import (
     matrix_to_quaternion,
     matrix_to_tt,
@@ -70,7 +71,7 @@ def test_quaternion_round_trip_is_the_identity_on_orientations(p, t, s):
 
 @pytest.fixture(scope="module")
 def example() -> Manipulator:
-    return Manipulator.example(warn=False)
+    return example_manipulator()
 
 
 def _rz(angle: float) -> np.ndarray:
@@ -87,7 +88,7 @@ def symmetric(example) -> Manipulator:
         first = np.reshape(parameters[key], (6, 3))[:2]
         joints = [first @ _rz(k * 2.0 * math.pi / 3.0).T for k in range(3)]
         parameters[key] = np.concatenate(joints).ravel().tolist()
-    return Manipulator.from_mapping(parameters, warn=False)
+    return manipulator_from_mapping(parameters, warn=False)
 
 
 @PROPERTY
@@ -126,7 +127,7 @@ def test_the_example_is_symmetric_as_the_symmetry_test_assumes(example, symmetri
 def _with_platform_limit(example: Manipulator, limit: float) -> Manipulator:
     parameters = example.to_parameters()
     parameters["limits.platform_joint_max_angle"] = [limit]
-    return Manipulator.from_mapping(parameters, warn=False)
+    return manipulator_from_mapping(parameters, warn=False)
 
 
 @settings(PROPERTY, max_examples=12)

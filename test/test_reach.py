@@ -11,6 +11,7 @@ import pytest
 
 from hexapod_workspace import check
 from hexapod_workspace.core.frames import Tool, WorkFrame, tool_model
+from hexapod_workspace.core.loading import example_manipulator
 from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.core.orientation import torsion_range
 from hexapod_workspace.core.reach import AXES, axis_limits, reach
@@ -42,7 +43,7 @@ def reachable_along(model, rotation, position, d, r, t):
 
 @pytest.fixture(scope="module")
 def model() -> Manipulator:
-    return tool_model(Manipulator.example(warn=False), Tool(np.array([0.0, 0.0, -0.1])))
+    return tool_model(example_manipulator(), Tool(np.array([0.0, 0.0, -0.1])))
 
 
 @pytest.mark.parametrize(
@@ -118,7 +119,7 @@ def _first_violation(flags: list[bool], grid: np.ndarray) -> float:
 def far_pivot() -> Manipulator:
     """The pivot (tool centre point) 3 m from the platform joints: an angle tolerance of the
     platform would make the translation limits 3 m × angle short."""
-    model = tool_model(Manipulator.example(warn=False), Tool(np.array([0.0, 0.0, -3.0])))
+    model = tool_model(example_manipulator(), Tool(np.array([0.0, 0.0, -3.0])))
     rho = float(np.max(np.linalg.norm(model.platform_joints, axis=1)))
     assert rho >= 3.0
     return model
@@ -166,7 +167,7 @@ def test_cli_tolerances_are_per_unit(far_pivot, tmp_path):
     from cli_support import run_main
 
     config = tmp_path / "far.yaml"
-    parameters = {**Manipulator.example(warn=False).to_parameters(), "tool.offset": [0, 0, -3.0]}
+    parameters = {**example_manipulator().to_parameters(), "tool.offset": [0, 0, -3.0]}
     config.write_text(
         "hexapod_workspace:\n  ros__parameters:\n"
         + "".join(f"    {name}: {value!r}\n" for name, value in parameters.items()),

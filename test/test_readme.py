@@ -28,8 +28,8 @@ import numpy as np
 import pytest
 from cli_support import run_main
 
-from hexapod_workspace import Manipulator
 from hexapod_workspace.core import resolution
+from hexapod_workspace.core.loading import example_manipulator
 from hexapod_workspace.core.resolution import WorkspaceKind
 from hexapod_workspace.ros.worker import WorkspaceJob, compute_fields
 
@@ -140,7 +140,7 @@ def test_the_demo_table_is_what_the_demo_prints(tmp_path):
 # ------------------------------------------------------------------------- the node's examples
 def _node_job(kind: int, position, n_rays: int, tolerance: float = resolution.DEFAULT_TOLERANCE):
     job = WorkspaceJob(
-        manipulator=Manipulator.example(),
+        manipulator=example_manipulator(),
         kind=int(kind),
         position=np.asarray(position, dtype=float),
         n_rays=n_rays,
@@ -161,7 +161,7 @@ def _shown_number(text: str, name: str) -> float:
 
 def test_the_trigger_examples_are_what_the_node_answers():
     ros = ROS_PAGE
-    example = Manipulator.example()
+    example = example_manipulator()
     jobs = {
         "compute_projected_workspace": (
             WorkspaceKind.PROJECTED_TORSION_ZERO,

@@ -36,7 +36,7 @@ from hexapod_workspace import logs
 from hexapod_workspace._resources import data_dir, example_config_path
 from hexapod_workspace.cli.replay import run_replay
 from hexapod_workspace.core import constraints
-from hexapod_workspace.core.manipulator import Manipulator
+from hexapod_workspace.core.loading import load_manipulator
 from hexapod_workspace.errors import LogReadError, RecordingError
 from hexapod_workspace.logs import messages
 
@@ -47,7 +47,7 @@ CLOUD = "sensor_msgs/msg/PointCloud2"
 def sample_messages() -> list[tuple[str, str, str, dict]]:
     """(topic, type, qos, fields) of every topic and every service the node records, in the
     recorded form (service parts as their message twins), from real check results."""
-    manipulator = Manipulator.from_params_file(example_config_path())
+    manipulator = load_manipulator(example_config_path())
     angles = np.radians([[0.0, 0.0, 0.0], [30.0, 20.0, 5.0], [45.0, 80.0, 10.0]])
     result = constraints.check(manipulator, angles)
     rng = np.random.default_rng(7)

@@ -22,6 +22,7 @@ from test_messages import orientation_stub, projected_stub
 from hexapod_workspace import logs
 from hexapod_workspace.cli.replay import run_replay
 from hexapod_workspace.core import constraints
+from hexapod_workspace.core.loading import example_manipulator
 from hexapod_workspace.core.orientation import OrientationSlice
 from hexapod_workspace.logs import messages
 from hexapod_workspace.logs.record import record_results
@@ -442,10 +443,10 @@ def test_projected_plot_radial_axis_clears_the_largest_tilt(tmp_path: Path) -> N
     """The curves never lie on the frame; every ring is labelled, and no label covers a curve
     (checked on the drawn figure, in display coordinates), also where the curves hug a ring (on
     the axis: 38-39.5° against the 40° ring)."""
-    from hexapod_workspace import Manipulator, projected_workspace
+    from hexapod_workspace import projected_workspace
     from hexapod_workspace.cli import plotting
 
-    example = Manipulator.example()
+    example = example_manipulator()
     cases = {
         "stubs": [projected_stub(), projected_stub("exact")],
         "on the axis": [
@@ -470,10 +471,10 @@ def test_orientation_plot_labels_of_the_two_panels_stay_apart() -> None:
     (measured on the drawn figure, on and off the axis)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-    from hexapod_workspace import Manipulator, orientation_workspace
+    from hexapod_workspace import orientation_workspace
     from hexapod_workspace.cli import plotting
 
-    example = Manipulator.example()
+    example = example_manipulator()
     for position in ([0, 0, -1.3], [0.2, 0.2, -0.95]):
         workspace = orientation_workspace(example, position, n_rays=36, psi_step=np.radians(5))
         figure = plotting.orientation_figure(workspace)

@@ -14,9 +14,10 @@ import sys
 import numpy as np
 from cli_support import run_cli
 
-from hexapod_workspace import Manipulator, check
+from hexapod_workspace import check
 from hexapod_workspace._resources import example_config_path
-from hexapod_workspace.core.collision import collision_scene, scene_distances
+from hexapod_workspace.core.collision import collision_scene, require_free_home, scene_distances
+from hexapod_workspace.core.loading import load_manipulator
 from hexapod_workspace.core.rotations import tt_to_matrix
 from hexapod_workspace.core.scene_view import scene_view
 
@@ -38,8 +39,8 @@ SCENE = {
 
 
 def test_closest_pair_matches_the_kernels_and_the_collision_distances():
-    model = Manipulator.from_params_file(example_config_path())
-    scene = collision_scene(SCENE, manipulator=model)
+    model = load_manipulator(example_config_path())
+    scene = require_free_home(model, collision_scene(SCENE))
     rng = np.random.default_rng(3)
     for _ in range(60):
         angles = np.array([rng.uniform(-np.pi, np.pi), rng.uniform(0, 0.5), rng.uniform(-1, 1)])
@@ -97,11 +98,11 @@ def test_check_path_plot_draws_the_first_violation(tmp_path):
 def test_scene_plot_uses_no_pyplot(tmp_path):
     code = (
         "import sys, numpy as np\n"
-        "from hexapod_workspace import Manipulator\n"
+        "from hexapod_workspace import load_manipulator\n"
         "from hexapod_workspace._resources import example_config_path\n"
         "from hexapod_workspace.cli.scene import view_at\n"
         "from hexapod_workspace.cli.scene_plot import plot_scene\n"
-        "m = Manipulator.from_params_file(example_config_path())\n"
+        "m = load_manipulator(example_config_path())\n"
         f"plot_scene(view_at(m, [0, 0.2, 0], [0, 0, -1.3], None), {str(tmp_path / 'a.png')!r})\n"
         "print('matplotlib.pyplot' in sys.modules)\n"
     )

@@ -16,7 +16,6 @@ from reference import _rotation, singularity_literal
 
 from hexapod_workspace import (
     ConfigError,
-    Manipulator,
     check,
     check_path,
     projected_workspace,
@@ -24,6 +23,7 @@ from hexapod_workspace import (
 )
 from hexapod_workspace.core.constraint_table import INDEX, SINGULARITY
 from hexapod_workspace.core.constraints import check_pose, inverse_kinematics, pose_margins
+from hexapod_workspace.core.loading import manipulator_from_mapping
 from hexapod_workspace.core.rotations import tt_to_matrix
 
 LIMIT = 0.4  # limits the example near (0, 0, -1.3) m: σ_min 0.46 at the centre, 0.36 at the edge
@@ -31,7 +31,7 @@ LIMIT = 0.4  # limits the example near (0, 0, -1.3) m: σ_min 0.46 at the centre
 
 @pytest.fixture(scope="module")
 def limited(example):
-    return Manipulator.from_mapping(
+    return manipulator_from_mapping(
         {**example.to_parameters(), "limits.singularity_min": LIMIT}, warn=False
     )
 
@@ -169,7 +169,7 @@ def test_boundaries_against_dense_sampling(limited):
     workspace = projected_workspace(limited, position, n_phi=24, tolerance=1e-6)
     assert "singularity" in workspace.limiting
     free = projected_workspace(
-        Manipulator.from_mapping({**limited.to_parameters(), "limits.singularity_min": 0.0}),
+        manipulator_from_mapping({**limited.to_parameters(), "limits.singularity_min": 0.0}),
         position,
         n_phi=24,
     )
@@ -214,7 +214,7 @@ def test_moves_against_dense_sampling(limited, rng):
 @pytest.mark.parametrize("value", [-0.1, 1.5, math.nan, [0.1, 0.2]])
 def test_bad_limit_is_refused_naming_it(example, value):
     with pytest.raises(ConfigError, match="limits.singularity_min"):
-        Manipulator.from_mapping({**example.to_parameters(), "limits.singularity_min": value})
+        manipulator_from_mapping({**example.to_parameters(), "limits.singularity_min": value})
 
 
 def test_cli_reports_singularity_on_request(tmp_path, example):

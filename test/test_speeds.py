@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 from hexapod_workspace.core.frames import Tool, tool_model
+from hexapod_workspace.core.loading import example_manipulator, load_manipulator
 from hexapod_workspace.core.manipulator import Manipulator
 from hexapod_workspace.core.rotations import tt_to_matrix
 from hexapod_workspace.core.speeds import actuator_rates, feed_limits
@@ -127,11 +128,7 @@ CASES = {
 @pytest.fixture(scope="module", params=sorted(CASES))
 def model(request) -> Manipulator:
     name, _, _ = CASES[request.param]
-    base = (
-        Manipulator.example(warn=False)
-        if name is None
-        else Manipulator.from_params_file(CONFIG / name, warn=False)
-    )
+    base = example_manipulator() if name is None else load_manipulator(CONFIG / name)
     offset, tilt = (0.15, 0.2) if name is None else (0.05, 0.05)
     tool = Tool(np.array([0.01, 0.0, -offset]), np.array([0.0, tilt, 0.0]))
     return tool_model(base, tool)
@@ -188,7 +185,7 @@ def test_feed_max_is_safe_and_tight_and_speeds_follow_the_feed(model, path):
 
 
 def test_no_move_no_feed_and_no_limits():
-    model = Manipulator.example(warn=False)
+    model = example_manipulator()
     positions = np.array([[0.0, 0.0, -1.2]] * 2 + [[0.01, 0.0, -1.2]])
     rotations = np.stack([np.eye(3)] * 3)
     rates = actuator_rates(model, positions, rotations)

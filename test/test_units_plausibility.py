@@ -14,8 +14,9 @@ import pytest
 from cli_support import one_error_line, run_main
 
 from hexapod_workspace import Manipulator
-from hexapod_workspace.core.frames import cell_from_mapping
-from hexapod_workspace.core.validation import cell_unit_reason, machine_size, millimetre_reason
+from hexapod_workspace.core.frames import cell_from_mapping, cell_unit_reason
+from hexapod_workspace.core.loading import manipulator_from_mapping
+from hexapod_workspace.core.validation import machine_size, millimetre_reason
 from hexapod_workspace.errors import ConfigError, GeometryError
 
 
@@ -74,10 +75,10 @@ def test_positions_in_millimetres_get_the_hint_not_unreachable(tmp_path):
 
 
 def test_the_rule_is_one_function_for_the_model_and_the_cell(example):
-    # Manipulator.from_mapping (the node builds its model through it) refuses the limit ...
+    # manipulator_from_mapping (the node builds its model through it) refuses the limit ...
     parameters = {**example.to_parameters(), "limits.leg_length_max": [1500.0]}
     with pytest.raises(GeometryError, match=r"limits\.leg_length_max: expected m .* divided"):
-        Manipulator.from_mapping(parameters)
+        manipulator_from_mapping(parameters)
     # ... and the cell's values go through the same rule against the same size.
     cell = cell_from_mapping({"limits.actuator_speed_max": [50.0]})
     reason = cell_unit_reason(example, cell)

@@ -21,6 +21,7 @@ from hexapod_workspace import (
     projected_workspace,
     torsion_range,
 )
+from hexapod_workspace.core.loading import load_manipulator
 
 ON_AXIS = np.array([0.0, 0.0, -1.3])
 OFF_AXIS = np.array([0.2, 0.2, -0.95])
@@ -408,14 +409,13 @@ def test_leg_length_boundary_closed_form(example, tz_off):
 
 
 def _machine(example, symmetric, name):
-    from hexapod_workspace import Manipulator
     from hexapod_workspace._resources import data_path
 
     if name == "ups-off-axis":
         return example, OFF_AXIS
     if name == "ups-symmetric":  # its torsion extremes lie on theta = 0 (120 deg symmetry)
         return symmetric, ON_AXIS
-    model = Manipulator.from_params_file(data_path("config", f"example_{name}.yaml"))
+    model = load_manipulator(data_path("config", f"example_{name}.yaml"))
     return model, model.position
 
 

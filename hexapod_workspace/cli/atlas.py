@@ -26,7 +26,7 @@ import numpy as np
 from ..core.atlas import AtlasGrid, AtlasOptions, dexterous_mask, positions_capability
 from ..core.manipulator import Manipulator
 from ..errors import InputError
-from .inputs import CliError, finite, load_manipulator, tolerance_flag
+from .inputs import CliError, configured_manipulator, finite, tolerance_flag
 from .progress import ProgressBar
 
 __all__ = [
@@ -251,7 +251,7 @@ def cmd_atlas(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
         )
     except InputError as error:
         raise CliError(str(error)) from error
-    manipulator = load_manipulator(options.config, None, err)
+    manipulator = configured_manipulator(options.config, None, err)
     _check_cap(grid, manipulator, atlas_options, options.force)
     from ..atlas import workspace_atlas
 

@@ -77,7 +77,7 @@ from .check_path import (
     record_path_calls,
 )
 from .commands import PROG
-from .inputs import PLOT_FORMATS, CliError, finite, load_manipulator, output_file
+from .inputs import PLOT_FORMATS, CliError, configured_manipulator, finite, output_file
 
 __all__ = [
     "FRAMES",
@@ -530,7 +530,7 @@ def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str])
         else output_file(options.plot, "--plot", force=options.force, suffixes=PLOT_FORMATS)
     )
     # the platform frame's model: each part's tool model is built from it
-    platform = load_manipulator(options.config, None, err, with_tool=False)
+    platform = configured_manipulator(options.config, None, err, with_tool=False)
     cell = cell_from_params_file(options.config or example_config_path())
     frame = options.frame or ("work" if is_cl_file(options.file) else "base")
     feed = _positive(options.feed_mm_min, "--feed-mm-min", "mm/min") * _MM_MIN

@@ -44,9 +44,9 @@ from .inputs import (
     PLOT_FORMATS,
     GivenPoses,
     add_angles_option,
+    configured_manipulator,
     finite,
     given_poses,
-    load_manipulator,
     output_file,
     plausible_positions,
 )
@@ -592,7 +592,7 @@ def cmd_check_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> i
         if options.plot is None
         else output_file(options.plot, "--plot", force=options.force, suffixes=PLOT_FORMATS)
     )
-    manipulator = load_manipulator(options.config, None, err)
+    manipulator = configured_manipulator(options.config, None, err)
     waypoints = read_path_file(options.file, options.angles)
     plausible_positions(manipulator, waypoints.positions, f"path file {options.file}: x,y,z")
     tolerance = (

@@ -20,7 +20,8 @@ from numpy.typing import NDArray
 
 from .._resources import example_config_path
 from ..core import resolution
-from ..core.frames import cell_from_params_file, tool_model
+from ..core.frames import cell_from_params_file, require_plausible_cell, tool_model
+from ..core.loading import load_manipulator
 from ..core.manipulator import Manipulator
 from ..core.rotations import (
     ANGLE_CONVENTIONS,
@@ -28,7 +29,7 @@ from ..core.rotations import (
     degrees_to_radians,
     tt_to_matrix,
 )
-from ..core.validation import machine_size, millimetre_reason, require_plausible_cell
+from ..core.validation import machine_size, millimetre_reason
 from ..errors import HexapodWorkspaceError, InputError
 from .tables import (
     ORIENTATION_QUANTITIES,
@@ -45,9 +46,9 @@ __all__ = [
     "CliError",
     "GivenPoses",
     "add_angles_option",
+    "configured_manipulator",
     "finite",
     "given_poses",
-    "load_manipulator",
     "output_file",
     "plausible_positions",
     "pose_flag",
@@ -241,7 +242,7 @@ def pose_flag(
     return given_poses(array.reshape(-1, size), name, flag)
 
 
-def load_manipulator(
+def configured_manipulator(
     config: str | Path | None,
     position: NDArray[np.float64] | None,
     err: IO[str],
@@ -258,7 +259,7 @@ def load_manipulator(
     path = Path(config) if config else example_config_path()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        manipulator = Manipulator.from_params_file(path)
+        manipulator = load_manipulator(path)
     cell = require_plausible_cell(manipulator, cell_from_params_file(path))
     if with_tool:
         manipulator = tool_model(manipulator, cell.tool)
@@ -269,7 +270,7 @@ def load_manipulator(
     position = finite(position, "--position", "m")
     plausible_positions(manipulator, position, "--position")
     try:
-        resolution.validate_position(manipulator, position)
+        resolution.validate_position(position, manipulator.position)
     except InputError as error:
         msg = "--position" + str(error).removeprefix("position")
         raise CliError(msg) from error

@@ -16,8 +16,7 @@ from typing import IO, Any
 import numpy as np
 
 from ..core.genhexkins import read_genhexkins
-from ..core.manipulator import Manipulator
-from ..core.validation import require_usable
+from ..core.loading import manipulator_from_mapping, require_usable
 from .inputs import CliError
 
 __all__ = ["IMPORT_DESCRIPTION", "IMPORT_HELP", "cmd_import_genhexkins", "import_arguments"]
@@ -126,7 +125,7 @@ def cmd_import_genhexkins(options: argparse.Namespace, out: IO[str], err: IO[str
         leg_diameter=options.leg_diameter,
         paired_joint_length=options.paired_joint_length,
     )
-    model = require_usable(Manipulator.from_mapping(machine.parameters, warn=False))
+    model = require_usable(manipulator_from_mapping(machine.parameters, warn=False))
     # Twelve decimals (picometres, nanoradians): the file reads as written, not as binary noise
     # (0.33654999999999996 m for 13.25 in).
     parameters = {

@@ -33,8 +33,8 @@ from .inputs import (
     CliError,
     GivenPoses,
     add_angles_option,
+    configured_manipulator,
     finite,
-    load_manipulator,
     output_file,
     pose_flag,
     psi_step_flag,
@@ -150,7 +150,7 @@ def _record_path(options: argparse.Namespace) -> Path | None:
 
 
 def _manipulator(options: argparse.Namespace, err: IO[str]):
-    return load_manipulator(options.config, options.position, err)
+    return configured_manipulator(options.config, options.position, err)
 
 
 # ---------------------------------------------------------------------------- check

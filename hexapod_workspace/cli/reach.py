@@ -30,7 +30,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._resources import example_config_path
-from ..core.frames import CellFrames, Tool, cell_from_params_file, tool_model, work_to_base
+from ..core.frames import (
+    CellFrames,
+    Tool,
+    cell_from_params_file,
+    require_plausible_cell,
+    tool_model,
+    work_to_base,
+)
 from ..core.manipulator import Manipulator
 from ..core.reach import (
     AXES,
@@ -42,15 +49,14 @@ from ..core.reach import (
     axis_limits,
     reach,
 )
-from ..core.validation import require_plausible_cell
 from .cam import tool_json, work_json
 from .commands import PROG
 from .inputs import (
     CliError,
     GivenPoses,
     add_angles_option,
+    configured_manipulator,
     finite,
-    load_manipulator,
     plausible_positions,
     pose_flag,
 )
@@ -173,7 +179,7 @@ def _pose(
 ]:
     """Model (tool frame), cell, tool, rotation and position in the base frame, frame rotation,
     accuracies (m, rad)."""
-    platform = load_manipulator(options.config, None, err, with_tool=False)
+    platform = configured_manipulator(options.config, None, err, with_tool=False)
     cell = require_plausible_cell(
         platform, cell_from_params_file(options.config or example_config_path())
     )

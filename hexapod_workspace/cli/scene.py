@@ -19,7 +19,7 @@ from typing import IO, Any
 
 import numpy as np
 
-from ..core.collision import CollisionScene, collision_scene
+from ..core.collision import CollisionScene, collision_scene, require_free_home
 from ..core.frames import cell_from_params_file
 from ..core.manipulator import Manipulator
 from ..core.params import load_params_file
@@ -28,7 +28,7 @@ from ..core.resolution import Method
 from ..core.rotations import tt_to_matrix
 from ..core.scene_view import SceneView, cone_of, scene_view
 from ..errors import UnreachableReferenceError
-from .inputs import PLOT_FORMATS, CliError, finite, load_manipulator, output_file
+from .inputs import PLOT_FORMATS, CliError, configured_manipulator, finite, output_file
 from .reports import write_json
 
 __all__ = ["CONE_AZIMUTHS", "cmd_scene", "config_scene", "scene_arguments", "view_at"]
@@ -58,7 +58,7 @@ def config_scene(config: str | Path | None, manipulator: Manipulator) -> Collisi
     work = cell_from_params_file(config).work
     transform = np.eye(4)
     transform[:3, :3], transform[:3, 3] = work.rotation, work.origin
-    return collision_scene(parameters, work_transform=transform, manipulator=manipulator)
+    return require_free_home(manipulator, collision_scene(parameters, work_transform=transform))
 
 
 def view_at(
@@ -121,7 +121,7 @@ def cmd_scene(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
     from .scene_plot import plot_scene
 
     plot = output_file(options.plot, "--plot", force=options.force, suffixes=PLOT_FORMATS)
-    manipulator = load_manipulator(options.config, options.position, err)
+    manipulator = configured_manipulator(options.config, options.position, err)
     angles = np.radians(finite(options.pose, "--pose", "degrees"))
     scene = config_scene(options.config, manipulator)
     try:

@@ -486,7 +486,7 @@ def check(
         candidate = np.asarray(position, dtype=np.float64)
         if candidate.shape != (3,) or not np.all(np.isfinite(candidate)):
             _require_finite_angles(angles)  # bad angles are reported before a bad position
-    position = validate_position(manipulator, position)  # 3 finite values, |p| bounded
+    position = validate_position(position, manipulator.position)  # 3 finite values, |p| bounded
     # One compiled signature per kernel: C-contiguous, writable float64 (a strided view such as
     # T[:3, 3], or a frozen Manipulator's read-only position, is copied).
     position = kernels.vector(position)
@@ -636,13 +636,15 @@ def check_pose(
     else:
         values = np.asarray(position, dtype=np.float64)
         if values.shape != (3,):
-            validate_position(manipulator, values)  # raises, with the same reason as check()
+            # raises, with the same reason as check()
+            validate_position(values, manipulator.position)
         x, y, z = values.tolist()
         if (
             not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z))
             or math.sqrt(x * x + y * y + z * z) > MAX_POSITION_NORM
         ):
-            validate_position(manipulator, values)  # raises, with the same reason as check()
+            # raises, with the same reason as check()
+            validate_position(values, manipulator.position)
     model = kernels.model_vector(manipulator)
     variant = kernels.for_model(model)
     fields = variant.check_one(model, *angles, x, y, z, variant.collide)

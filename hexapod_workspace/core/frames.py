@@ -47,18 +47,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ConfigError, InputError
-from .manipulator import (
-    Manipulator,
-    _angles3,
-    _describe,
-    _frozen,
-    _numbers,
-    _tool_number,
-    _unknown_tool,
-    _vector3,
-)
+from .manipulator import Manipulator
 from .params import flatten, load_params_file
 from .rotations import tt_to_matrix
+from .validation import machine_size, millimetre_reason
+from .values import angles3, describe, frozen, numbers, tool_number, unknown_tool, vector3
 
 __all__ = [
     "CELL_DEFAULTS",
@@ -67,7 +60,9 @@ __all__ = [
     "WorkFrame",
     "cell_from_mapping",
     "cell_from_params_file",
+    "cell_unit_reason",
     "platform_pose",
+    "require_plausible_cell",
     "tool_model",
     "tool_pose",
     "vectors_to_base",
@@ -106,8 +101,8 @@ class Tool:
         Tool-table number (0: the ``tool.*`` parameters, not the table).
     """
 
-    offset: NDArray[np.float64] = field(default_factory=lambda: _frozen(np.zeros(3)))
-    orientation: NDArray[np.float64] = field(default_factory=lambda: _frozen(np.zeros(3)))
+    offset: NDArray[np.float64] = field(default_factory=lambda: frozen(np.zeros(3)))
+    orientation: NDArray[np.float64] = field(default_factory=lambda: frozen(np.zeros(3)))
     number: int = 0
 
     @property
@@ -146,8 +141,8 @@ class WorkFrame:
         Its name in messages (``header.frame_id``).
     """
 
-    origin: NDArray[np.float64] = field(default_factory=lambda: _frozen(np.zeros(3)))
-    orientation: NDArray[np.float64] = field(default_factory=lambda: _frozen(np.zeros(3)))
+    origin: NDArray[np.float64] = field(default_factory=lambda: frozen(np.zeros(3)))
+    orientation: NDArray[np.float64] = field(default_factory=lambda: frozen(np.zeros(3)))
     frame_id: str = "work"
 
     @property
@@ -207,7 +202,8 @@ def cell_from_mapping(parameters: Mapping[str, Any]) -> CellFrames:
     """Read and validate ``tool.*``, ``work.*``, ``tools.T<n>.*`` and
     ``limits.actuator_speed_max`` from a parameter mapping (nested or dotted names).
 
-    Other names are left to :meth:`Manipulator.from_mapping` and the node.
+    Other names are left to
+    :func:`~hexapod_workspace.core.loading.manipulator_from_mapping` and the node.
 
     Returns
     -------
@@ -234,16 +230,16 @@ def cell_from_mapping(parameters: Mapping[str, Any]) -> CellFrames:
             raise ConfigError(msg)
     values = {**CELL_DEFAULTS, **{k: v for k, v in flat.items() if k in CELL_DEFAULTS}}
     tool = Tool(
-        _frozen(_vector3("tool.offset", values["tool.offset"])),
-        _frozen(_angles3("tool.orientation", values["tool.orientation"])),
+        frozen(vector3("tool.offset", values["tool.offset"])),
+        frozen(angles3("tool.orientation", values["tool.orientation"])),
     )
     frame_id = values["work.frame_id"]
     if not isinstance(frame_id, str) or not frame_id.strip():
-        msg = f"work.frame_id: expected a non-empty string, got {_describe(frame_id)}"
+        msg = f"work.frame_id: expected a non-empty string, got {describe(frame_id)}"
         raise ConfigError(msg)
     work = WorkFrame(
-        _frozen(_vector3("work.origin", values["work.origin"])),
-        _frozen(_angles3("work.orientation", values["work.orientation"])),
+        frozen(vector3("work.origin", values["work.origin"])),
+        frozen(angles3("work.orientation", values["work.orientation"])),
         frame_id,
     )
     entries: dict[int, dict[str, Any]] = {}
@@ -258,30 +254,30 @@ def cell_from_mapping(parameters: Mapping[str, Any]) -> CellFrames:
             msg = f"tools.T{number}.offset: required parameter is missing (tool T{number})"
             raise ConfigError(msg)
         tools[number] = Tool(
-            _frozen(_vector3(f"tools.T{number}.offset", entry["offset"])),
-            _frozen(_angles3(f"tools.T{number}.orientation", entry.get("orientation", [0.0] * 3))),
+            frozen(vector3(f"tools.T{number}.offset", entry["offset"])),
+            frozen(angles3(f"tools.T{number}.orientation", entry.get("orientation", [0.0] * 3))),
             number,
         )
     tool = _selected(tool, tools, values["tool.number"])
     name = "limits.actuator_speed_max"
-    speeds = _numbers(name, values[name])
+    speeds = numbers(name, values[name])
     if speeds.size not in (1, 6):
         msg = f"{name}: expected 1 or 6 numbers, got {speeds.size}"
         raise ConfigError(msg)
     if np.any(speeds < 0.0):
-        msg = f"{name}: expected values >= 0 (0 = unlimited), got {_describe(speeds.tolist())}"
+        msg = f"{name}: expected values >= 0 (0 = unlimited), got {describe(speeds.tolist())}"
         raise ConfigError(msg)
-    return CellFrames(tool, work, tools, _frozen(np.broadcast_to(speeds, (6,)).copy()))
+    return CellFrames(tool, work, tools, frozen(np.broadcast_to(speeds, (6,)).copy()))
 
 
 def _selected(tool: Tool, tools: dict[int, Tool], number: Any) -> Tool:
     """The active tool: ``tool`` for ``tool.number`` 0, else the table's entry (ConfigError
     naming ``tool.number`` and the defined tools when there is none)."""
-    number = _tool_number(number)
+    number = tool_number(number)
     if number == 0:
         return tool
     if number not in tools:
-        raise _unknown_tool(number, tools)
+        raise unknown_tool(number, tools)
     return tools[number]
 
 
@@ -334,9 +330,9 @@ def tool_model(manipulator: Manipulator, tool: Tool) -> Manipulator:
     axes = manipulator.platform_joint_axes @ rotation_t.T
     return replace(
         manipulator,
-        platform_joints=_frozen(joints),
-        platform_joint_axes=_frozen(axes),
-        home_position=_frozen(manipulator.home_position + tool.offset),
+        platform_joints=frozen(joints),
+        platform_joint_axes=frozen(axes),
+        home_position=frozen(manipulator.home_position + tool.offset),
         axes_from_home=(manipulator.axes_from_home[0], False),
         collision=scene,
     )
@@ -415,3 +411,32 @@ def vectors_to_base(vectors: ArrayLike, work: WorkFrame) -> NDArray[np.float64]:
     array = np.asarray(vectors, dtype=np.float64)
     rotated: NDArray[np.float64] = array @ work.rotation.T
     return rotated
+
+
+def cell_unit_reason(manipulator: Manipulator, cell: CellFrames) -> str | None:
+    """:func:`~hexapod_workspace.core.validation.millimetre_reason` of the cell's lengths and
+    speeds against the machine's size: ``tool.offset``, ``tools.T<n>.offset``, ``work.origin``
+    (m) and, for actuators that slide (``ups``, ``pus``: m/s), ``limits.actuator_speed_max``."""
+    size = machine_size(
+        manipulator.base_joints, manipulator.platform_joints, manipulator.home_position
+    )
+    checks: list[tuple[str, ArrayLike, str, str]] = [
+        ("tool.offset", cell.tool.offset if cell.tool.number == 0 else np.zeros(3), "m", ""),
+        *((f"tools.T{n}.offset", t.offset, "m", "") for n, t in sorted(cell.tools.items())),
+        ("work.origin", cell.work.origin, "m", ""),
+    ]
+    if manipulator.architecture in ("ups", "pus"):
+        checks.append(("limits.actuator_speed_max", cell.actuator_speed_max, "m/s", "/s"))
+    for name, values, unit, per in checks:
+        reason = millimetre_reason(name, values, size, unit, per)
+        if reason is not None:
+            return reason
+    return None
+
+
+def require_plausible_cell(manipulator: Manipulator, cell: CellFrames) -> CellFrames:
+    """Return ``cell``, or raise :class:`ConfigError` with :func:`cell_unit_reason`."""
+    reason = cell_unit_reason(manipulator, cell)
+    if reason is not None:
+        raise ConfigError(reason)
+    return cell

@@ -60,7 +60,7 @@ class GenhexMachine:
     ----------
     parameters : dict
         Dotted model parameters in SI units (m, rad), ready for
-        :meth:`~hexapod_workspace.Manipulator.from_mapping`.
+        :func:`~hexapod_workspace.core.loading.manipulator_from_mapping`.
     unit : str
         The machine's linear unit as the INI spells it; ``scale`` metres per unit.
     scale : float

@@ -370,7 +370,7 @@ def orientation_workspace(
             f"{MAX_POINTS} boundary points; use fewer rays or a larger psi_step"
         )
         raise ResolutionError(msg)
-    position = validate_position(manipulator, position)
+    position = validate_position(position, manipulator.position)
     search = RaySearch(manipulator, position)
     require_reachable_reference(search)
     slicer = _Slicer(search, n_rays, tolerance)
@@ -476,7 +476,7 @@ def torsion_range(
     TorsionRange
     """
     tolerance = validate_tolerance(tolerance)
-    position = validate_position(manipulator, position)
+    position = validate_position(position, manipulator.position)
     values = np.array([phi, theta], dtype=np.float64)
     if not np.all(np.isfinite(values)):
         msg = f"direction: expected finite (phi, theta), got {values.tolist()}"

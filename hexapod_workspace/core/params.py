@@ -3,7 +3,7 @@
 A parameters file maps a node name (``hexapod_workspace``, ``/hexapod_workspace`` or the
 wildcard ``/**``) to ``{"ros__parameters": {...}}``. This module returns that mapping flattened
 to the node's dotted parameter names (``geometry.base_joints``, ...);
-:meth:`hexapod_workspace.Manipulator.from_mapping` interprets it.
+:func:`hexapod_workspace.core.loading.manipulator_from_mapping` interprets it.
 """
 
 from __future__ import annotations

@@ -222,7 +222,7 @@ def projected_workspace(
         raise InputError(msg) from None
     n_phi = validate_rays(n_phi, "n_phi")
     tolerance = validate_tolerance(tolerance)
-    position = validate_position(manipulator, position)
+    position = validate_position(position, manipulator.position)
     search = RaySearch(manipulator, position)
     require_reachable_reference(search)
     phi = 2.0 * math.pi * np.arange(n_phi) / n_phi

@@ -12,15 +12,11 @@ from __future__ import annotations
 import enum
 import math
 from collections.abc import Callable
-from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError, ResolutionError
-
-if TYPE_CHECKING:
-    from .manipulator import Manipulator
 
 __all__ = [
     "DEFAULT_N_PHI",
@@ -206,8 +202,9 @@ def validate_positions(positions: ArrayLike, minimum: int, maximum: int) -> NDAr
     return array
 
 
-def validate_position(manipulator: Manipulator, position: ArrayLike | None) -> NDArray[np.float64]:
-    """The position to use (default ``manipulator.position``), checked: shape (3,), finite, m.
+def validate_position(position: ArrayLike | None, default: ArrayLike) -> NDArray[np.float64]:
+    """The position to use, checked: shape (3,), finite, m; ``default`` (a model's
+    ``pose.position``) when ``position`` is None.
 
     Raises
     ------
@@ -216,7 +213,7 @@ def validate_position(manipulator: Manipulator, position: ArrayLike | None) -> N
         the base origin (where margins would stop being finite numbers).
     """
     if position is None:
-        return np.array(manipulator.position)
+        return np.array(default, dtype=np.float64)
     try:
         array = np.asarray(position, dtype=np.float64)
     except (TypeError, ValueError) as error:

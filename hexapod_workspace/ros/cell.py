@@ -14,7 +14,7 @@ Frames
 Run-time changes
     ``tool.*``, ``tools.T<n>.*``, ``work.*`` and ``limits.actuator_speed_max`` are parameters like
     the model's: validated as a whole set (the model by
-    :func:`~hexapod_workspace.core.validation.require_usable`, the cell by
+    :func:`~hexapod_workspace.core.loading.require_usable`, the cell by
     :func:`~hexapod_workspace.core.frames.cell_from_mapping`), swapped in as one state between two
     requests, and every change, accepted or refused, is recorded in the log
     (``/hexapod_workspace/parameter_changes``, ``ParameterChange``) and shown on

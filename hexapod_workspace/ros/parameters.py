@@ -8,7 +8,7 @@ example GPM; the resolution bounds and defaults come from :mod:`hexapod_workspac
 :func:`refusal` checks one parameter as a client sent it (unknown name, wrong type, read-only,
 out of range) and :func:`state_from` the would-be full set (it builds the
 :class:`~hexapod_workspace.Manipulator` and refuses an unusable one with
-:func:`~hexapod_workspace.core.validation.require_usable`): the node's start-up and run-time
+:func:`~hexapod_workspace.core.loading.require_usable`): the node's start-up and run-time
 validation are this one function, and every refusal names the parameter and the value given.
 
 The packaged example stands in for the model only when the node is given no model parameter at
@@ -34,14 +34,24 @@ from rclpy.parameter import Parameter
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import resolution
 from hexapod_workspace.core.architectures import ARCHITECTURES
-from hexapod_workspace.core.frames import CELL_DEFAULTS, CellFrames, cell_from_mapping, tool_model
+from hexapod_workspace.core.frames import (
+    CELL_DEFAULTS,
+    CellFrames,
+    cell_from_mapping,
+    require_plausible_cell,
+    tool_model,
+)
+from hexapod_workspace.core.loading import (
+    load_manipulator,
+    manipulator_from_mapping,
+    require_usable,
+)
 from hexapod_workspace.core.manipulator import (
     ARCHITECTURE_PARAMETERS,
     PARAMETER_DEFAULTS,
     Manipulator,
     required_parameters,
 )
-from hexapod_workspace.core.validation import require_plausible_cell, require_usable
 from hexapod_workspace.errors import ConfigError
 
 from .recorder import Rotation
@@ -202,7 +212,7 @@ class Spec:
 
 def parameter_specs() -> dict[str, Spec]:
     """Every parameter of the node by name, model defaults from the packaged example."""
-    example = Manipulator.from_params_file(example_config_path(), warn=False).to_parameters()
+    example = load_manipulator(example_config_path()).to_parameters()
     specs = [
         Spec(
             name,
@@ -558,7 +568,7 @@ def state_from(values: dict[str, Any]) -> State:
         model.update(
             {name: _plain(values[name]) for name in _SCENE_FRAMES if values.get(name) is not None}
         )
-    platform = require_usable(Manipulator.from_mapping(model, warn=False))
+    platform = require_usable(manipulator_from_mapping(model, warn=False))
     cell = cell_from_mapping(
         {
             name: _plain(value)

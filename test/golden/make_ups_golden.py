@@ -19,13 +19,13 @@ import sys
 import numpy as np
 
 from hexapod_workspace import (
-    Manipulator,
     check,
     check_path,
     orientation_workspace,
     projected_workspace,
     torsion_range,
 )
+from hexapod_workspace.core.loading import example_manipulator, manipulator_from_mapping
 
 CONSTRAINTS = ("leg_length", "base_joint", "platform_joint", "leg_interference")
 
@@ -49,8 +49,8 @@ def positions(count: int = 4000) -> np.ndarray:
 
 def answers() -> dict[str, np.ndarray]:
     """Every golden array, by name, computed by the code that is imported."""
-    m = Manipulator.example()
-    diameter = Manipulator.from_mapping({**m.to_parameters(), "limits.leg_diameter": 0.05})
+    m = example_manipulator()
+    diameter = manipulator_from_mapping({**m.to_parameters(), "limits.leg_diameter": 0.05})
     arrays: dict[str, np.ndarray] = {"angles": poses()}
     for label, machine in (("example", m), ("diameter", diameter)):
         result = check(machine, arrays["angles"])

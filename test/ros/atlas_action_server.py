@@ -14,8 +14,8 @@ import rclpy
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.serialization import serialize_message
 
-from hexapod_workspace import Manipulator
 from hexapod_workspace._resources import example_config_path
+from hexapod_workspace.core.loading import load_manipulator
 from hexapod_workspace.logs import LogWriter
 from hexapod_workspace.ros.atlas_action import attach_atlas_action
 
@@ -35,7 +35,7 @@ class Recorder:
 
 def main() -> None:
     rclpy.init()
-    manipulator = Manipulator.from_params_file(example_config_path())
+    manipulator = load_manipulator(example_config_path())
     writer = LogWriter(sys.argv[1]).open()
     node = rclpy.create_node("hexapod_workspace")
     executor = MultiThreadedExecutor(num_threads=3)

@@ -17,6 +17,7 @@ import pytest
 from ros_support import RosClient, domain_selector, running_node
 
 from hexapod_workspace import Manipulator
+from hexapod_workspace.core.loading import load_manipulator
 
 
 @pytest.fixture(scope="module")
@@ -94,7 +95,7 @@ def workspace_node(ros_domain: int, tmp_path_factory: pytest.TempPathFactory, re
 @pytest.fixture(scope="module")
 def model(workspace_node) -> Manipulator:
     """The manipulator the node was started with, built by the core from the same file."""
-    return Manipulator.from_params_file(workspace_node.params_path)
+    return load_manipulator(workspace_node.params_path)
 
 
 @pytest.fixture(scope="module")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from hexapod_workspace.core.loading import load_manipulator
 from hexapod_workspace.logs import messages
 from hexapod_workspace.ros.clouds import decimated_cloud_fields
 
@@ -44,7 +45,6 @@ def test_the_worker_hands_the_log_a_cloud_bounded_to_record_points(
     from rclpy.serialization import deserialize_message
     from sensor_msgs.msg import PointCloud2
 
-    from hexapod_workspace import Manipulator
     from hexapod_workspace._resources import example_config_path
     from hexapod_workspace.core.resolution import WorkspaceKind
     from hexapod_workspace.ros.clouds import CloudTopics
@@ -54,7 +54,7 @@ def test_the_worker_hands_the_log_a_cloud_bounded_to_record_points(
     topics = {int(kind): topic for kind in WorkspaceKind}
     worker = WorkspaceWorker(cloud_topics=CloudTopics("clouds_test", "/", topics, ros_domain))
     job = WorkspaceJob(
-        manipulator=Manipulator.from_params_file(example_config_path()),
+        manipulator=load_manipulator(example_config_path()),
         kind=WorkspaceKind.PROJECTED_TORSION_ZERO,
         position=np.array([0.0, 0.0, -1.3]),
         n_rays=36,

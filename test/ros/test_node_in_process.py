@@ -22,8 +22,9 @@ from hexapod_workspace_msgs.msg import CommandedPose, TiltTorsion, WorkspaceRequ
 from hexapod_workspace_msgs.srv import CheckPoses  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
 
-from hexapod_workspace import Manipulator, check  # noqa: E402
+from hexapod_workspace import check  # noqa: E402
 from hexapod_workspace._resources import example_config_path  # noqa: E402
+from hexapod_workspace.core.loading import example_manipulator, load_manipulator  # noqa: E402
 from hexapod_workspace.errors import ConfigError  # noqa: E402
 from hexapod_workspace.ros.node import WorkspaceNode  # noqa: E402
 from hexapod_workspace.ros.parameters import command_line_override_names  # noqa: E402
@@ -101,7 +102,7 @@ def test_rclpy_parameters_stay_settable(node):
 
 def example_model(**changes) -> dict:
     """The packaged example's whole model as overrides (empty axes left out), changed."""
-    model = {k: v for k, v in Manipulator.example().to_parameters().items() if v != []}
+    model = {k: v for k, v in example_manipulator().to_parameters().items() if v != []}
     model.pop("frame_id")
     return {**model, **changes}
 
@@ -178,7 +179,7 @@ def test_optional_model_parameters_take_the_model_defaults_not_the_example(ros_c
 def test_no_model_parameter_uses_the_example_and_says_so(ros_context, capfd):
     node = make_node(ros_context)
     try:
-        assert node.state.manipulator == Manipulator.example()
+        assert node.state.manipulator == example_manipulator()
     finally:
         node.destroy_node()
     logged = capfd.readouterr().err
@@ -207,7 +208,7 @@ DEGENERATE = [
 def singular_layout() -> dict:
     """Vertical legs (each platform joint under its base joint): six parallel lines, the
     Plücker matrix has rank 3 at home. The lengths fit the example's limits there."""
-    base = np.reshape(Manipulator.example().to_parameters()["geometry.base_joints"], (6, 3))
+    base = np.reshape(example_manipulator().to_parameters()["geometry.base_joints"], (6, 3))
     platform = base.copy()
     platform[:, 2] = 0.1
     return {"geometry.platform_joints": platform.ravel().tolist()}
@@ -337,7 +338,7 @@ def test_commands_in_a_batch_are_answered_one_each_in_order(node):
     assert [r.success for r in published] == [True, False, True, True, False]
     assert "theta" in published[1].message or "finite" in published[1].message
     assert published[4].message.startswith("overloaded")
-    model = Manipulator.from_params_file(example_config_path())
+    model = load_manipulator(example_config_path())
     expected = check(model, [[0.0, 0.2, 0.0]], (0.0, 0.0, -1.3))
     assert published[2].check.reachable == bool(expected.reachable[0])
 
@@ -364,7 +365,7 @@ def test_each_command_of_a_batch_is_checked_at_its_own_position(node, rng, size)
             commands.append(command)
         stream.answer(commands)
     assert [r.request_id for r in published] == [f"p{k}" for k in range(size)]
-    model = Manipulator.from_params_file(example_config_path())
+    model = load_manipulator(example_config_path())
     for k, result in enumerate(published):
         expected = check(model, angles[k : k + 1], (0.0, 0.0, heights[k]))
         assert result.position.z == heights[k]

@@ -22,7 +22,8 @@ from geometry_msgs.msg import Pose  # noqa: E402
 from hexapod_workspace_msgs.msg import TiltTorsion, WorkspaceRequest  # noqa: E402
 from hexapod_workspace_msgs.srv import CheckPath, CheckPoses  # noqa: E402
 
-from hexapod_workspace import Manipulator, check, projected_workspace  # noqa: E402
+from hexapod_workspace import check, projected_workspace  # noqa: E402
+from hexapod_workspace.core.loading import load_manipulator  # noqa: E402
 from hexapod_workspace.core.rotations import matrix_to_quaternion, tt_to_matrix  # noqa: E402
 from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402
 
@@ -80,7 +81,7 @@ def check_request(angles: np.ndarray, position) -> CheckPoses.Request:
 def test_node_serves_an_architecture_file(architecture, ros_domain, ros_client, tmp_path):
     text = params_text(architecture, tmp_path, **{"check.report_singularity": True})
     with running_node(tmp_path, params_text=text) as node:
-        model = Manipulator.from_params_file(node.params_path)
+        model = load_manipulator(node.params_path)
         assert model.architecture == architecture
         ros_client.client(CheckPoses, f"{NODE}/check_poses")
         rng = np.random.default_rng(17)

@@ -36,6 +36,7 @@ from rcl_interfaces.srv import GetParameters, SetParameters  # noqa: E402
 
 from hexapod_workspace import check, check_path  # noqa: E402
 from hexapod_workspace.core.frames import cell_from_params_file, tool_model  # noqa: E402
+from hexapod_workspace.core.loading import load_manipulator  # noqa: E402
 from hexapod_workspace.core.manipulator import Manipulator  # noqa: E402
 from hexapod_workspace.core.reach import AXES, axis_limits  # noqa: E402
 from hexapod_workspace.core.rotations import (  # noqa: E402
@@ -137,7 +138,7 @@ def set_parameters(client, *parameters: ParameterMsg):
 
 @pytest.fixture(scope="module")
 def platform(workspace_node) -> Manipulator:
-    return Manipulator.from_params_file(workspace_node.params_path)
+    return load_manipulator(workspace_node.params_path)
 
 
 @pytest.fixture

@@ -4,7 +4,7 @@ at run time (applied, or refused with the old model kept, and recorded), and the
 ``~/markers``.
 
 The expected margins and pairs come from the CLI (``check --config ... --json``) and from the
-ROS-free core on a model built from the same parameters (``Manipulator.from_mapping``), in
+ROS-free core on a model built from the same parameters (``manipulator_from_mapping``), in
 this process; the node runs from the install space in another.
 """
 
@@ -34,6 +34,7 @@ from rcl_interfaces.srv import SetParameters  # noqa: E402
 from visualization_msgs.msg import Marker, MarkerArray  # noqa: E402
 
 from hexapod_workspace import Manipulator, check, check_path  # noqa: E402
+from hexapod_workspace.core.loading import manipulator_from_mapping  # noqa: E402
 from hexapod_workspace.core.params import flatten  # noqa: E402
 from hexapod_workspace.core.rotations import matrix_to_quaternion, tt_to_matrix  # noqa: E402
 from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402
@@ -71,7 +72,7 @@ def model_with(changes: dict | None = None) -> Manipulator:
             flat.pop(name, None)
         else:
             flat[name] = value
-    return Manipulator.from_mapping(flat, warn=False)
+    return manipulator_from_mapping(flat, warn=False)
 
 
 def pose_request(*angles_deg: tuple[float, float, float]) -> CheckPoses.Request:

@@ -18,6 +18,7 @@ from hexapod_workspace_msgs.srv import CheckPoses, CheckPosesFlat  # noqa: E402
 from test_ros_node import check_request, sample_angles  # noqa: E402
 
 from hexapod_workspace import check, logs  # noqa: E402
+from hexapod_workspace.core.loading import load_manipulator  # noqa: E402
 from hexapod_workspace.errors import InputError  # noqa: E402
 from hexapod_workspace.logs.summary import summarize_log  # noqa: E402
 from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402
@@ -102,10 +103,9 @@ def test_flat_margins_columns_follow_the_constraint_names(model_from_file):
 
 @pytest.fixture(scope="module")
 def model_from_file():
-    from hexapod_workspace import Manipulator
     from hexapod_workspace._resources import example_config_path
 
-    return Manipulator.from_params_file(example_config_path())
+    return load_manipulator(example_config_path())
 
 
 # ---------------------------------------------------------------------------- over DDS

@@ -28,7 +28,8 @@ from rcl_interfaces.msg import Parameter as ParameterMsg  # noqa: E402
 from rcl_interfaces.msg import ParameterType, ParameterValue  # noqa: E402
 from rcl_interfaces.srv import SetParameters  # noqa: E402
 
-from hexapod_workspace import Manipulator, check, logs  # noqa: E402
+from hexapod_workspace import check, logs  # noqa: E402
+from hexapod_workspace.core.loading import load_manipulator  # noqa: E402
 
 NODE = "/hexapod_workspace"
 MANUAL = ["--autostart=false"]
@@ -125,7 +126,7 @@ def diagnostics_value(client, key: str, expected: str, timeout: float = 15.0) ->
 
 
 def test_every_transition_over_dds(ros_client, tmp_path):
-    model = Manipulator.from_params_file(logs_example_path())
+    model = load_manipulator(logs_example_path())
     expected = check(model, np.array([POSE]), (0.0, 0.0, -1.3))
     with running_node(tmp_path, node_options=MANUAL) as node:
         ros_client.client(GetState, f"{NODE}/get_state")

@@ -26,10 +26,10 @@ from rcl_interfaces.srv import (  # noqa: E402
 )
 
 from hexapod_workspace import (  # noqa: E402
-    Manipulator,
     check,
     logs,
 )
+from hexapod_workspace.core.loading import manipulator_from_mapping  # noqa: E402
 from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402
 
 #: The constraints of a 6-UPS model: the names the node gives for the example (the rows of the
@@ -269,7 +269,7 @@ def test_invalid_parameter_update_is_refused_and_verdicts_kept(client, model):
 
 def test_valid_parameter_update_changes_verdicts_and_back(client, model):
     angles = sample_angles(200, seed=6)
-    shorter = Manipulator.from_mapping(
+    shorter = manipulator_from_mapping(
         {**model.to_parameters(), "limits.leg_length_max": [1.40]}, warn=False
     )
     expected = check(shorter, angles, model.position)

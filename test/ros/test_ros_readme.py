@@ -26,7 +26,8 @@ require_ros()
 
 from rclpy.parameter import Parameter  # noqa: E402
 
-from hexapod_workspace import Manipulator, logs  # noqa: E402
+from hexapod_workspace import logs  # noqa: E402
+from hexapod_workspace.core.loading import example_manipulator  # noqa: E402
 from hexapod_workspace.ros.node import EXTENSIONS, NODE_NAME, WorkspaceNode  # noqa: E402
 from hexapod_workspace.ros.parameters import MODEL_DESCRIPTIONS, parameter_specs  # noqa: E402
 
@@ -89,7 +90,7 @@ def test_the_documented_node_parameters_are_what_the_node_declares(node):
         name: spec for name, spec in parameter_specs().items() if name not in MODEL_DESCRIPTIONS
     }
     declared = node.get_parameters_by_prefix("")
-    model = set(Manipulator.example().to_parameters())
+    model = set(example_manipulator().to_parameters())
     rclpy_own = {"use_sim_time", "start_type_description_service"}
     own = set(declared) - model - rclpy_own
     assert set(specs) <= own

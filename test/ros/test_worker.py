@@ -9,8 +9,8 @@ import time
 import numpy as np
 import pytest
 
-from hexapod_workspace import Manipulator
 from hexapod_workspace._resources import example_config_path
+from hexapod_workspace.core.loading import load_manipulator
 from hexapod_workspace.core.orientation import orientation_workspace
 from hexapod_workspace.core.resolution import WorkspaceKind
 from hexapod_workspace.ros.worker import (
@@ -32,7 +32,7 @@ def worker():
 
 def job(**changes) -> WorkspaceJob:
     fields = {
-        "manipulator": Manipulator.from_params_file(example_config_path()),
+        "manipulator": load_manipulator(example_config_path()),
         "kind": WorkspaceKind.ORIENTATION,
         "position": np.array([0.0, 0.0, -1.3]),
         "n_rays": 24,

@@ -15,7 +15,15 @@ The ``collision`` row of the constraint table is evaluated inside the compiled k
 
 from .distance import GJK_TOLERANCE, pair_distance, pair_distances, record
 from .params import CollisionScene, Obstacle, PlatformBody, ToolBody, collision_scene
-from .scene import MOVING_BODIES, RateBound, SceneDistances, pair_table, rate_bound, scene_distances
+from .scene import (
+    MOVING_BODIES,
+    RateBound,
+    SceneDistances,
+    pair_table,
+    rate_bound,
+    require_free_home,
+    scene_distances,
+)
 
 __all__ = [
     "GJK_TOLERANCE",
@@ -32,5 +40,6 @@ __all__ = [
     "pair_table",
     "rate_bound",
     "record",
+    "require_free_home",
     "scene_distances",
 ]

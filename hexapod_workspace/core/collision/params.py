@@ -34,7 +34,7 @@ import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -43,9 +43,6 @@ from ...errors import ConfigError
 from ..params import flatten, unknown_parameter
 from ..resolution import MAX_POSITION_NORM
 from .distance import BOX, CYLINDER, POINT, SEGMENT, record
-
-if TYPE_CHECKING:
-    from ..manipulator import Manipulator
 
 __all__ = [
     "OBSTACLE_FRAMES",
@@ -355,7 +352,6 @@ def collision_scene(
     *,
     work_transform: Any = None,
     tool_transform: Any = None,
-    manipulator: Manipulator | None = None,
 ) -> CollisionScene:
     """Build and validate the collision scene from parameters.
 
@@ -369,9 +365,6 @@ def collision_scene(
         ``frame: work``; default the identity (work frame = base frame).
     tool_transform : array_like, shape (4, 4), optional
         Platform (mobile) frame <- tool frame; default the identity.
-    manipulator : Manipulator, optional
-        When given, an obstacle or body that collides at the home pose (home position,
-        identity orientation) is refused, naming the pair.
 
     Returns
     -------
@@ -381,7 +374,8 @@ def collision_scene(
     ------
     ConfigError
         One line naming the parameter, what was expected and what was given: unknown shape or
-        frame, missing or non-positive size, NaN, a misspelt name, the home pose in collision.
+        frame, missing or non-positive size, NaN, a misspelt name (the home pose is checked
+        against the model by :func:`~hexapod_workspace.core.collision.scene.require_free_home`).
     """
     flat = {k: v for k, v in flatten(parameters).items() if k.startswith("collision.")}
     work = np.eye(4) if work_transform is None else _transform("work_transform", work_transform)
@@ -472,15 +466,4 @@ def collision_scene(
     scene = CollisionScene(
         clearance, platform, tool, tuple(obstacles), tool_frame, parameters=dict(flat)
     )
-    if manipulator is not None:
-        from .scene import scene_distances
-
-        home = scene_distances(manipulator, scene, np.eye(3), manipulator.home_position)
-        if home.margin[0] < 0.0:
-            distance = float(home.margin[0]) + clearance
-            msg = (
-                f"collision: {home.pair_name(0)} collide at the home pose (distance "
-                f"{distance:.4g} m, clearance {clearance:g} m)"
-            )
-            raise ConfigError(msg)
     return scene

@@ -55,7 +55,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ...errors import InputError
+from ...errors import ConfigError, InputError
+from ..legs import leg_endpoints
 from .distance import (
     _C,
     _INFLATION,
@@ -82,6 +83,7 @@ __all__ = [
     "pair_table",
     "platform_record",
     "rate_bound",
+    "require_free_home",
     "scene_distances",
 ]
 
@@ -390,8 +392,6 @@ def scene_distances(
             raise InputError(msg)
     # The legs' base-side ends where the architecture puts them (a slide's joint, a crank's end;
     # NaN for a leg without an inverse-kinematics solution, whose margin is then NaN).
-    from ..legs import leg_endpoints
-
     base_ends, _ = leg_endpoints(manipulator, rotations, positions)
     pairs, names = pair_table(scene)
     bodies = np.zeros((_FIRST_OBSTACLE + len(scene.obstacles), RECORD_SIZE))
@@ -433,3 +433,36 @@ def scene_distances(
         pair_names=names,
         distances=distances if all_pairs else None,
     )
+
+
+def require_free_home(manipulator: Manipulator, scene: CollisionScene) -> CollisionScene:
+    """Return ``scene``, or refuse a scene in which a pair collides at the home pose.
+
+    Parameters
+    ----------
+    manipulator : Manipulator
+        The model the scene belongs to; its home pose is the home position with the identity
+        orientation.
+    scene : CollisionScene
+        Bodies in the platform frame, obstacles in the base frame.
+
+    Returns
+    -------
+    CollisionScene
+        ``scene`` itself.
+
+    Raises
+    ------
+    ConfigError
+        ``collision: <pair> collide at the home pose (distance …, clearance …)``, naming the
+        closest pair.
+    """
+    home = scene_distances(manipulator, scene, np.eye(3), manipulator.home_position)
+    if home.margin[0] < 0.0:
+        distance = float(home.margin[0]) + scene.clearance
+        msg = (
+            f"collision: {home.pair_name(0)} collide at the home pose (distance "
+            f"{distance:.4g} m, clearance {scene.clearance:g} m)"
+        )
+        raise ConfigError(msg)
+    return scene
