@@ -37,8 +37,8 @@ from speed import best_of, per_call, random_poses
 import hexapod_workspace as hw
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import kernels
-from hexapod_workspace.core.constraints import check_pose
-from hexapod_workspace.core.rotations import tt_to_matrix
+from hexapod_workspace.core.base.rotations import tt_to_matrix
+from hexapod_workspace.core.evaluation.check import check_pose
 
 EXAMPLES = {"ups": "example_gpm.yaml", "pus": "example_pus.yaml", "rus": "example_rus.yaml"}
 

@@ -44,14 +44,14 @@ from hexapod_workspace import (  # noqa: E402
     workspace_atlas,
 )
 from hexapod_workspace._resources import example_config_path  # noqa: E402
-from hexapod_workspace.core.loading import load_manipulator  # noqa: E402
-from hexapod_workspace.core.projected import (  # noqa: E402
+from hexapod_workspace.core.evaluation.loading import load_manipulator  # noqa: E402
+from hexapod_workspace.core.workspaces.projected import (  # noqa: E402
     COARSE_TOLERANCE,
     EXACT_GOLDEN_STEPS,
     EXACT_PSI_SAMPLES,
     reference_torsion_interval,
 )
-from hexapod_workspace.core.search import RaySearch  # noqa: E402
+from hexapod_workspace.core.workspaces.search import RaySearch  # noqa: E402
 
 GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 

@@ -20,8 +20,8 @@ import time
 
 import numpy as np
 
-from hexapod_workspace.core.loading import example_manipulator
-from hexapod_workspace.core.resolution import WorkspaceKind
+from hexapod_workspace.core.base.resolution import WorkspaceKind
+from hexapod_workspace.core.evaluation.loading import example_manipulator
 from hexapod_workspace.ros.worker import CANCEL_GRACE, CanceledError, WorkspaceJob, WorkspaceWorker
 
 #: A 3-D workspace job that runs far longer than any cancel takes (it reports progress often).

@@ -21,8 +21,8 @@ import time
 import numpy as np
 
 from hexapod_workspace import actuator_rates, axis_limits, check_path
-from hexapod_workspace.core.loading import example_manipulator
-from hexapod_workspace.core.rotations import tt_to_matrix
+from hexapod_workspace.core.base.rotations import tt_to_matrix
+from hexapod_workspace.core.evaluation.loading import example_manipulator
 
 
 def _best(function, repeat: int) -> float:

@@ -30,14 +30,14 @@ import numpy as np
 
 from hexapod_workspace import Manipulator
 from hexapod_workspace._resources import example_config_path
-from hexapod_workspace.core.collision import scene_distances
-from hexapod_workspace.core.constraints import check, check_pose
-from hexapod_workspace.core.loading import manipulator_from_mapping
-from hexapod_workspace.core.orientation import torsion_range
-from hexapod_workspace.core.params import flatten, load_params_file
-from hexapod_workspace.core.projected import projected_workspace
-from hexapod_workspace.core.rotations import tt_to_matrix
-from hexapod_workspace.core.search import RaySearch
+from hexapod_workspace.core.base.params import flatten, load_params_file
+from hexapod_workspace.core.base.rotations import tt_to_matrix
+from hexapod_workspace.core.evaluation.check import check, check_pose
+from hexapod_workspace.core.evaluation.loading import manipulator_from_mapping
+from hexapod_workspace.core.model.collision import scene_distances
+from hexapod_workspace.core.workspaces.orientation import torsion_range
+from hexapod_workspace.core.workspaces.projected import projected_workspace
+from hexapod_workspace.core.workspaces.search import RaySearch
 
 SCENE = {
     "collision": {
@@ -124,9 +124,9 @@ def main() -> None:
     RaySearch.lazy_collision = True
     # The kernel alone on the batch: with its broad phase, and evaluating every pair. (Imported
     # here: collision_compare.py imports this module to ask trees that predate these.)
-    from hexapod_workspace.core.collision_kernels import collision_margins
-    from hexapod_workspace.core.legs import leg_endpoints
-    from hexapod_workspace.core.model_layout import MODEL_SIZE, B, model_vector
+    from hexapod_workspace.core.kernels.collision import collision_margins
+    from hexapod_workspace.core.kernels.layout import MODEL_SIZE, B, model_vector
+    from hexapod_workspace.core.model.legs import leg_endpoints
 
     base_ends, platform_ends = leg_endpoints(cell, rotations, position)
     legs = np.ascontiguousarray(np.transpose(platform_ends - base_ends, (0, 2, 1)))

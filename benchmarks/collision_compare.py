@@ -26,11 +26,11 @@ from collision import SCENE, best_of, random_angles
 import hexapod_workspace
 from hexapod_workspace import Manipulator
 from hexapod_workspace._resources import example_config_path
-from hexapod_workspace.core.constraints import check, check_pose
-from hexapod_workspace.core.loading import manipulator_from_mapping
-from hexapod_workspace.core.orientation import torsion_range
-from hexapod_workspace.core.params import flatten, load_params_file
-from hexapod_workspace.core.projected import projected_workspace
+from hexapod_workspace.core.base.params import flatten, load_params_file
+from hexapod_workspace.core.evaluation.check import check, check_pose
+from hexapod_workspace.core.evaluation.loading import manipulator_from_mapping
+from hexapod_workspace.core.workspaces.orientation import torsion_range
+from hexapod_workspace.core.workspaces.projected import projected_workspace
 
 
 def cpu(repeats: int, function: Callable[[], object]) -> float:

@@ -102,7 +102,8 @@ def cold_figures(scratch: Path, every: bool = True) -> list[tuple[str, float, fl
         ),
         "warm_up of every kernel, every variant": python(
             """
-            from hexapod_workspace.core import kernels, planner_kernels
+            from hexapod_workspace.core import kernels
+            from hexapod_workspace.core.kernels import planner as planner_kernels
             kernels.warm_up()
             planner_kernels.warm_up()
             """

@@ -41,7 +41,7 @@ from speed import best_of, load_baseline, machine_from, per_call, random_poses
 import hexapod_workspace as new
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import kernels
-from hexapod_workspace.core.constraints import check_pose
+from hexapod_workspace.core.evaluation.check import check_pose
 
 MODEL_BASELINE = "3c6da1e"
 POSITION = np.array([0.0, 0.0, -1.3])
@@ -59,7 +59,9 @@ def figures(
     # limits.singularity_min, 0 here).
     parameters = new.load_manipulator(example_config_path()).to_parameters()
     parameters.pop("limits.singularity_min")
-    known = package.core.manipulator.PARAMETER_DEFAULTS  # the leg-architecture keys are newer
+    # The leg-architecture keys are newer; the model moved to core.model with the layers.
+    layout = getattr(package.core, "model", None)
+    known = (layout.manipulator if layout else package.core.manipulator).PARAMETER_DEFAULTS
     parameters = {name: value for name, value in parameters.items() if name in known}
     machine = machine_from(package, parameters)
     rng = np.random.default_rng(3)

@@ -4,7 +4,7 @@
 Dense sampling gives the certified check's guarantee (no violated band wider than the tolerance
 is missed) only with a sample at least every ``h = tol / (Ω + |Δp|/ρ)`` along each move (the
 tolerance measured as platform rotation or joint travel, as in
-:mod:`hexapod_workspace.core.paths`). Both are timed in this run on the same moves:
+:mod:`hexapod_workspace.core.motions`). Both are timed in this run on the same moves:
 
 * short moves: a fine 5-axis toolpath on the packaged example (a helix of tool-tip positions,
   tool axes on a 15° cone, ψ = 0; moves of about 0.6 mm and 0.2°);
@@ -34,11 +34,11 @@ import numpy as np  # noqa: E402
 
 from hexapod_workspace import check_path, plan_torsion  # noqa: E402
 from hexapod_workspace._resources import example_config_path  # noqa: E402
-from hexapod_workspace.core.constraints import pose_margins  # noqa: E402
-from hexapod_workspace.core.loading import load_manipulator  # noqa: E402
-from hexapod_workspace.core.path_interpolation import _Moves  # noqa: E402
-from hexapod_workspace.core.paths import DEFAULT_PATH_TOLERANCE  # noqa: E402
-from hexapod_workspace.core.rotations import approach_vector, tt_to_matrix  # noqa: E402
+from hexapod_workspace.core.base.rotations import approach_vector, tt_to_matrix  # noqa: E402
+from hexapod_workspace.core.evaluation.check import pose_margins  # noqa: E402
+from hexapod_workspace.core.evaluation.loading import load_manipulator  # noqa: E402
+from hexapod_workspace.core.motions import DEFAULT_PATH_TOLERANCE  # noqa: E402
+from hexapod_workspace.core.motions.interpolation import _Moves  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "test"))
 from planner_reference import numpy_planner  # noqa: E402

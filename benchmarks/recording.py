@@ -146,14 +146,14 @@ def service_impact(repeat: int, workdir: Path) -> None:
     of 10^4 poses.
     """
     from hexapod_workspace._resources import example_config_path
-    from hexapod_workspace.core import constraints
-    from hexapod_workspace.core.loading import load_manipulator
+    from hexapod_workspace.core.evaluation import check as constraints
+    from hexapod_workspace.core.evaluation.loading import load_manipulator
 
     manipulator = load_manipulator(example_config_path())
     store = logs.get_typestore()
     stamp = time.time_ns()
     try:
-        from hexapod_workspace.core.projected import projected_workspace
+        from hexapod_workspace.core.workspaces.projected import projected_workspace
     except ImportError:
         projected_workspace = None
     rng = np.random.default_rng(5)

@@ -97,7 +97,7 @@ def flat_floor_server_source(service: str, node_name: str, poses: int = 1000) ->
         node_name,
         f"""
 import array
-from hexapod_workspace.core.constraints import CONSTRAINT_NAMES
+from hexapod_workspace.core.evaluation.check import CONSTRAINT_NAMES
 from hexapod_workspace_msgs.srv import CheckPosesFlat
 count, names = {poses}, list(CONSTRAINT_NAMES)
 answer = CheckPosesFlat.Response(success=True, message=f"{{count}}/{{count}} reachable")

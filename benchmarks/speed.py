@@ -41,7 +41,7 @@ from reference import paper_projected_workspace  # noqa: E402
 import hexapod_workspace as new  # noqa: E402
 from hexapod_workspace._resources import example_config_path  # noqa: E402
 from hexapod_workspace.core import kernels  # noqa: E402
-from hexapod_workspace.core.constraints import check_pose  # noqa: E402
+from hexapod_workspace.core.evaluation.check import check_pose  # noqa: E402
 
 POSITION = np.array([0.0, 0.0, -1.3])
 

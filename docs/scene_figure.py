@@ -15,8 +15,8 @@ import numpy as np
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.cli.scene import view_at
 from hexapod_workspace.cli.scene_plot import plot_scene
-from hexapod_workspace.core.collision import collision_scene, require_free_home
-from hexapod_workspace.core.loading import load_manipulator
+from hexapod_workspace.core.evaluation.loading import load_manipulator
+from hexapod_workspace.core.model.collision import collision_scene, require_free_home
 
 #: The scene of the page's YAML example (collision.* as the parameters file gives them), with
 #: the vise's top at z = -1.49 m instead of -1.70 m.

@@ -26,8 +26,8 @@ import numpy as np
 from hexapod_workspace import plan_torsion
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.cli.check_path import plot_path
-from hexapod_workspace.core.loading import load_manipulator
-from hexapod_workspace.core.rotations import approach_vector
+from hexapod_workspace.core.base.rotations import approach_vector
+from hexapod_workspace.core.evaluation.loading import load_manipulator
 
 CENTER = np.array([0.2, 0.2, -0.95])  # m, the demo's off-axis position
 RADIUS = 0.02  # m

@@ -5,33 +5,39 @@ compiled kernels) and the standard library, with PyYAML only to read a parameter
 lives in :mod:`hexapod_workspace.ros`.
 
 Units are SI (m, rad). Orientations are Tilt-and-Torsion angles (φ, θ, ψ) with
-``R = Rz(φ) Ry(θ) Rz(−φ) Rz(ψ)``; see :mod:`hexapod_workspace.core.rotations`.
+``R = Rz(φ) Ry(θ) Rz(−φ) Rz(ψ)``; see :mod:`hexapod_workspace.core.base.rotations`.
 """
 
 from ._version import __version__ as __version__
 from .atlas import workspace_atlas
-from .core.atlas import AtlasGrid, AtlasOptions
-from .core.cldata import CLProgram, parse_cldata, read_cldata
-from .core.constraints import CONSTRAINT_NAMES, CheckResult, check
-from .core.frames import CellFrames, Tool, WorkFrame, cell_from_mapping, tool_model
-from .core.loading import (
+from .core.cell.cldata import CLProgram, parse_cldata, read_cldata
+from .core.cell.frames import CellFrames, Tool, WorkFrame, cell_from_mapping, tool_model
+from .core.cell.reach import Reach, axis_limits, reach
+from .core.evaluation.check import CONSTRAINT_NAMES, CheckResult, check
+from .core.evaluation.loading import (
     HomePoseWarning,
     example_manipulator,
     load_manipulator,
     manipulator_from_mapping,
 )
-from .core.manipulator import Manipulator
-from .core.orientation import (
+from .core.model.manipulator import Manipulator
+from .core.motions import (
+    PathCheck,
+    TorsionPlan,
+    check_path,
+    check_waypoints,
+    plan_torsion,
+)
+from .core.motions.speeds import actuator_rates, feed_limits
+from .core.workspaces.atlas import AtlasGrid, AtlasOptions
+from .core.workspaces.orientation import (
     OrientationSlice,
     OrientationWorkspace,
     TorsionRange,
     orientation_workspace,
     torsion_range,
 )
-from .core.paths import PathCheck, TorsionPlan, check_path, check_waypoints, plan_torsion
-from .core.projected import ProjectedWorkspace, projected_workspace
-from .core.reach import Reach, axis_limits, reach
-from .core.speeds import actuator_rates, feed_limits
+from .core.workspaces.projected import ProjectedWorkspace, projected_workspace
 from .errors import (
     AtlasError,
     ConfigError,

@@ -8,7 +8,7 @@ import pytest
 from hexapod_workspace import Manipulator
 from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import kernels
-from hexapod_workspace.core.loading import load_manipulator, manipulator_from_mapping
+from hexapod_workspace.core.evaluation.loading import load_manipulator, manipulator_from_mapping
 
 
 @pytest.fixture(scope="session", autouse=True)

@@ -1,6 +1,6 @@
 """Plain 4x4 homogeneous transforms written from the definitions, the independent reference of
 the tool and work frames (test/test_frames.py, test/ros/test_ros_cell.py): T&T matrices from
-their own Rz·Ry·Rz product, not from hexapod_workspace.core.rotations or core.frames."""
+their own Rz·Ry·Rz product, not from hexapod_workspace.core.base.rotations or core.cell.frames."""
 
 from __future__ import annotations
 

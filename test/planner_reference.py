@@ -1,7 +1,7 @@
 """The torsion planner's dynamic programmes in numpy: the oracle of the compiled ones.
 
-These are the programmes :class:`hexapod_workspace.core.path_planner._Planner` ran before they were
-compiled (:mod:`hexapod_workspace.core.planner_kernels`), kept verbatim: the tests compare the
+These are the programmes :class:`hexapod_workspace.core.motions.planner._Planner` ran before they
+were compiled (:mod:`hexapod_workspace.core.kernels.planner`), kept verbatim: the tests compare the
 kernels with them on seeded random tables, and ``benchmarks/paths.py`` times the planner with
 them in the same run. :func:`numpy_planner` swaps them into ``plan_torsion`` for a block.
 """
@@ -15,8 +15,8 @@ from collections.abc import Iterator
 import numpy as np
 from numpy.typing import NDArray
 
-from hexapod_workspace.core import path_planner as paths
-from hexapod_workspace.core.planner_kernels import KNOWN, NO, NONE, UNKNOWN
+from hexapod_workspace.core.kernels.planner import KNOWN, NO, NONE, UNKNOWN
+from hexapod_workspace.core.motions import planner as paths
 
 
 def forward(levels0, status, value, source, offsets: int, optimistic: bool) -> NDArray[np.int32]:

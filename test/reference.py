@@ -1,7 +1,7 @@
 """Literal, per-pose reference implementations (slow on purpose).
 
 They follow the definitions of docs/theory.md, line by line, one pose at a time, with a
-segment distance computed by a different method than :mod:`hexapod_workspace.core.constraints`
+segment distance computed by a different method than :mod:`hexapod_workspace.core.evaluation.check`
 (interior critical point plus the four edge cases). Tests use them as independent evidence
 for the batched code; the benchmarks use them as the "straightforward per-pose loop" and the
 paper's literal projected-workspace procedure.
@@ -17,9 +17,9 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hexapod_workspace.core.constraints import PAIRS_I, PAIRS_J
-from hexapod_workspace.core.manipulator import Manipulator
-from hexapod_workspace.core.rotations import tt_to_matrix
+from hexapod_workspace.core.base.rotations import tt_to_matrix
+from hexapod_workspace.core.evaluation.check import PAIRS_I, PAIRS_J
+from hexapod_workspace.core.model.manipulator import Manipulator
 
 __all__ = [
     "BatchedMargins",
@@ -209,7 +209,7 @@ def collision_literal(manipulator: Manipulator, rotation: NDArray, position: NDA
     scene = manipulator.collision
     if scene is None or scene.pair_count == 0:
         return math.inf
-    from hexapod_workspace.core.collision import scene_distances
+    from hexapod_workspace.core.model.collision import scene_distances
 
     return float(scene_distances(manipulator, scene, rotation, position).margin[0])
 

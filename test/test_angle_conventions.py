@@ -2,7 +2,7 @@
 
 The worked examples of docs/configuration.md are checked against rotation matrices written out
 here from the vendors' definitions (not from the package's functions), and through the CLI; the
-conversions of :mod:`hexapod_workspace.core.rotations` against the same matrices on random
+conversions of :mod:`hexapod_workspace.core.base.rotations` against the same matrices on random
 angles; the files' columns and ``--angles`` for being unambiguous.
 """
 
@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from cli_support import one_error_line, run_main
 
-from hexapod_workspace.core.rotations import ANGLE_CONVENTIONS, convention_to_tt, tt_to_matrix
+from hexapod_workspace.core.base.rotations import ANGLE_CONVENTIONS, convention_to_tt, tt_to_matrix
 
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "configuration.md"
 

@@ -24,7 +24,7 @@ import pytest
 import reference_arch as ra
 
 from hexapod_workspace import check_path, projected_workspace, torsion_range
-from hexapod_workspace.core.loading import load_manipulator
+from hexapod_workspace.core.evaluation.loading import load_manipulator
 
 CONFIG = Path(__file__).resolve().parents[1] / "config"
 EXAMPLES = {"ups": "example_gpm.yaml", "pus": "example_pus.yaml", "rus": "example_rus.yaml"}

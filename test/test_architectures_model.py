@@ -21,10 +21,10 @@ import yaml
 from cli_support import one_error_line, run_main
 
 from hexapod_workspace import check
-from hexapod_workspace.core.constraint_table import constraint_names
-from hexapod_workspace.core.legs import leg_endpoints
-from hexapod_workspace.core.loading import load_manipulator, manipulator_from_mapping
-from hexapod_workspace.core.rotations import tt_to_matrix
+from hexapod_workspace.core.base.rotations import tt_to_matrix
+from hexapod_workspace.core.constraints.table import constraint_names
+from hexapod_workspace.core.evaluation.loading import load_manipulator, manipulator_from_mapping
+from hexapod_workspace.core.model.legs import leg_endpoints
 from hexapod_workspace.errors import ConfigError, GeometryError
 
 CONFIG = Path(__file__).resolve().parents[1] / "config"
@@ -250,8 +250,8 @@ def test_rate_bounds_hold_along_moves(architecture, rng):
 def test_batch_check_equals_the_one_pose_kernel(architecture, singularity_min, rng):
     """The vectorised block path (legs without a solution included: NaN margins, the first
     unsolved leg) gives exactly what the one-pose kernel gives."""
-    from hexapod_workspace.core.constraint_table import INDEX
-    from hexapod_workspace.core.constraints import check_pose
+    from hexapod_workspace.core.constraints.table import INDEX
+    from hexapod_workspace.core.evaluation.check import check_pose
 
     base = load_manipulator(EXAMPLES[architecture]).to_parameters()
     model = manipulator_from_mapping({**base, "limits.singularity_min": singularity_min})

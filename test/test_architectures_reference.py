@@ -34,8 +34,8 @@ import reference_arch as ra
 import yaml
 
 from hexapod_workspace import Manipulator
-from hexapod_workspace.core.constraints import check
-from hexapod_workspace.core.loading import load_manipulator
+from hexapod_workspace.core.evaluation.check import check
+from hexapod_workspace.core.evaluation.loading import load_manipulator
 
 CONFIG = Path(__file__).resolve().parents[1] / "config"
 EXAMPLES = {"ups": "example_gpm.yaml", "pus": "example_pus.yaml", "rus": "example_rus.yaml"}

@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 
 from hexapod_workspace import InputError, check_path, plan_torsion
-from hexapod_workspace.core.constraints import pose_margins
-from hexapod_workspace.core.path_interpolation import _Arcs
-from hexapod_workspace.core.rotations import tt_to_matrix
-from hexapod_workspace.core.speeds import actuator_rates
+from hexapod_workspace.core.base.rotations import tt_to_matrix
+from hexapod_workspace.core.evaluation.check import pose_margins
+from hexapod_workspace.core.motions.interpolation import _Arcs
+from hexapod_workspace.core.motions.speeds import actuator_rates
 
 CENTRE = np.array([0.0, 0.0, -1.15])
 

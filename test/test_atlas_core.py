@@ -17,7 +17,11 @@ from hexapod_workspace import (
     projected_workspace,
     torsion_range,
 )
-from hexapod_workspace.core.atlas import dexterous_mask, position_capability, positions_capability
+from hexapod_workspace.core.workspaces.atlas import (
+    dexterous_mask,
+    position_capability,
+    positions_capability,
+)
 
 FAST = AtlasOptions(n_phi=24, tolerance=1e-3)
 

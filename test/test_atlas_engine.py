@@ -30,8 +30,8 @@ from hexapod_workspace import (
     workspace_atlas,
 )
 from hexapod_workspace.atlas.store import MARKER, open_atlas
-from hexapod_workspace.core.atlas import ATLAS_VARIABLES, position_capability
-from hexapod_workspace.core.loading import manipulator_from_mapping
+from hexapod_workspace.core.evaluation.loading import manipulator_from_mapping
+from hexapod_workspace.core.workspaces.atlas import ATLAS_VARIABLES, position_capability
 
 OPTIONS = AtlasOptions(n_phi=24, tolerance=1e-3)
 #: 3 × 2 × 3 = 18 positions around the home position, in 6 chunks of 3 (one z column each).

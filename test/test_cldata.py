@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from hexapod_workspace.cli.check_path import read_path_file
-from hexapod_workspace.core.cldata import looks_like_cldata, parse_cldata, read_cldata
+from hexapod_workspace.core.cell.cldata import looks_like_cldata, parse_cldata, read_cldata
 from hexapod_workspace.errors import InputError
 
 # Post-processor style: header records, mixed case, spaces, continuation lines, end-of-line

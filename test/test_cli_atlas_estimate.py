@@ -10,7 +10,7 @@ from cli_support import one_error_line, run_main
 
 from hexapod_workspace.cli.atlas import ESTIMATE_SAMPLES, MAX_POSITIONS
 from hexapod_workspace.cli.atlas import measured_seconds_per_position as measured
-from hexapod_workspace.core.atlas import AtlasGrid, AtlasOptions
+from hexapod_workspace.core.workspaces.atlas import AtlasGrid, AtlasOptions
 
 ESTIMATE = re.compile(
     r"give (\d+) positions, more than the cap of (\d+) \(about ([\d.e+]+) core-hours: "

@@ -14,7 +14,7 @@ from recording_support import plain, read_with_mcap_ros2, read_with_rosbags
 
 from hexapod_workspace import check_path
 from hexapod_workspace.cli.main import main
-from hexapod_workspace.core.rotations import approach_vector
+from hexapod_workspace.core.base.rotations import approach_vector
 
 WAYPOINT_KEYS = {
     "index",

@@ -14,9 +14,9 @@ import pytest
 from cli_support import run_main
 from test_paired_joints import LINUXCNC_BASE, LINUXCNC_PLATFORM
 
-from hexapod_workspace.core.constraints import inverse_kinematics
-from hexapod_workspace.core.loading import load_manipulator
-from hexapod_workspace.core.rotations import xyz_fixed_to_matrix
+from hexapod_workspace.core.base.rotations import xyz_fixed_to_matrix
+from hexapod_workspace.core.evaluation.check import inverse_kinematics
+from hexapod_workspace.core.evaluation.loading import load_manipulator
 
 SIM = Path(__file__).parent / "data" / "linuxcnc" / "hexapod-sim"
 INCH = 0.0254

@@ -16,7 +16,10 @@ import pytest
 
 from hexapod_workspace import Manipulator
 from hexapod_workspace._resources import example_config_path
-from hexapod_workspace.core.collision import (
+from hexapod_workspace.core.base.params import load_params_file
+from hexapod_workspace.core.base.rotations import tt_to_matrix
+from hexapod_workspace.core.evaluation.loading import manipulator_from_mapping
+from hexapod_workspace.core.model.collision import (
     collision_scene,
     pair_distances,
     pair_table,
@@ -25,10 +28,13 @@ from hexapod_workspace.core.collision import (
     require_free_home,
     scene_distances,
 )
-from hexapod_workspace.core.collision.distance import BOX, CYLINDER, GJK_GAP_BOUND, POINT, SEGMENT
-from hexapod_workspace.core.loading import manipulator_from_mapping
-from hexapod_workspace.core.params import load_params_file
-from hexapod_workspace.core.rotations import tt_to_matrix
+from hexapod_workspace.core.model.collision.distance import (
+    BOX,
+    CYLINDER,
+    GJK_GAP_BOUND,
+    POINT,
+    SEGMENT,
+)
 from hexapod_workspace.errors import ConfigError, InputError
 
 SHAPES = ("sphere", "capsule", "box", "cylinder")
@@ -519,7 +525,7 @@ def test_bad_poses_are_refused(manipulator: Manipulator) -> None:
 def test_capsule_box_closed_form_agrees_with_gjk() -> None:
     """The segment–box closed form (a segment apart from a box) lies within GJK's certified
     bounds on random placements, and applies to most of them (else GJK runs, as before)."""
-    from hexapod_workspace.core.collision import distance
+    from hexapod_workspace.core.model.collision import distance
 
     rng = np.random.default_rng(23)
     work = np.zeros((distance.WORK_ROWS, 3))

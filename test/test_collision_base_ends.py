@@ -10,12 +10,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from hexapod_workspace.core.collision import scene_distances
-from hexapod_workspace.core.constraints import check
-from hexapod_workspace.core.legs import leg_endpoints
-from hexapod_workspace.core.loading import manipulator_from_mapping
-from hexapod_workspace.core.params import flatten, load_params_file
-from hexapod_workspace.core.rotations import tt_to_matrix
+from hexapod_workspace.core.base.params import flatten, load_params_file
+from hexapod_workspace.core.base.rotations import tt_to_matrix
+from hexapod_workspace.core.evaluation.check import check
+from hexapod_workspace.core.evaluation.loading import manipulator_from_mapping
+from hexapod_workspace.core.model.collision import scene_distances
+from hexapod_workspace.core.model.legs import leg_endpoints
 from hexapod_workspace.errors import ConfigError
 
 CONFIG = Path(__file__).resolve().parents[1] / "config"

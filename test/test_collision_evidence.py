@@ -24,9 +24,9 @@ import reference_arch as ra
 from test_architectures_boundaries import interpolate
 
 from hexapod_workspace import check_path, projected_workspace
-from hexapod_workspace.core.loading import manipulator_from_mapping
-from hexapod_workspace.core.orientation import orientation_workspace
-from hexapod_workspace.core.params import flatten, load_params_file
+from hexapod_workspace.core.base.params import flatten, load_params_file
+from hexapod_workspace.core.evaluation.loading import manipulator_from_mapping
+from hexapod_workspace.core.workspaces.orientation import orientation_workspace
 
 CONFIG = Path(__file__).resolve().parents[1] / "config"
 EXAMPLES = {"ups": "example_gpm.yaml", "pus": "example_pus.yaml", "rus": "example_rus.yaml"}
@@ -113,7 +113,7 @@ def reachable(model, collision, angles, position) -> np.ndarray:
 def test_reference_scene_agrees_with_the_kernels() -> None:
     """The reference's collision margin equals the package's on random poses (every
     architecture): the two sides of the dense comparisons below measure the same thing."""
-    from hexapod_workspace.core.constraints import check
+    from hexapod_workspace.core.evaluation.check import check
 
     rng = np.random.default_rng(5)
     for architecture, legs in (("ups", (0, 3)), ("pus", (1, 4)), ("rus", (2,))):

@@ -1,4 +1,4 @@
-"""The lazy collision margin of the ray searches (``search_kernels.search_rays``): the search that
+"""The lazy collision margin of the ray searches (``kernels.searches.search_rays``): the search that
 evaluates the margin only where its Lipschitz bound cannot decide a probe, against the same
 search evaluating it at every probe (``RaySearch.lazy_collision = False``) and against dense
 sampling of the package's own pose check along each ray.
@@ -18,14 +18,14 @@ import pytest
 from test_collision_evidence import machines
 
 from hexapod_workspace import Manipulator
-from hexapod_workspace.core.collision.scene import _tool_ends
-from hexapod_workspace.core.constraint_table import COLLISION
-from hexapod_workspace.core.constraints import check
-from hexapod_workspace.core.loading import load_manipulator, manipulator_from_mapping
-from hexapod_workspace.core.orientation import torsion_range
-from hexapod_workspace.core.params import flatten, load_params_file
-from hexapod_workspace.core.rotations import tt_to_matrix
-from hexapod_workspace.core.search import DEFAULT_MIN_STEP, RaySearch
+from hexapod_workspace.core.base.params import flatten, load_params_file
+from hexapod_workspace.core.base.rotations import tt_to_matrix
+from hexapod_workspace.core.constraints.table import COLLISION
+from hexapod_workspace.core.evaluation.check import check
+from hexapod_workspace.core.evaluation.loading import load_manipulator, manipulator_from_mapping
+from hexapod_workspace.core.model.collision.scene import _tool_ends
+from hexapod_workspace.core.workspaces.orientation import torsion_range
+from hexapod_workspace.core.workspaces.search import DEFAULT_MIN_STEP, RaySearch
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "config" / "example_collision.yaml"
 TOLERANCE = 1e-6  # rad

@@ -16,19 +16,19 @@ import pytest
 from test_collision import coal_scene, random_poses, scene_parameters
 
 from hexapod_workspace import Manipulator
-from hexapod_workspace.core import constraints
-from hexapod_workspace.core.collision import scene_distances
-from hexapod_workspace.core.constraint_table import COLLISION, CONSTRAINTS, applicable
-from hexapod_workspace.core.loading import (
+from hexapod_workspace.core.base.params import flatten
+from hexapod_workspace.core.base.rotations import tt_to_matrix
+from hexapod_workspace.core.constraints.table import COLLISION, CONSTRAINTS, applicable
+from hexapod_workspace.core.evaluation import check as constraints
+from hexapod_workspace.core.evaluation.loading import (
     example_manipulator,
     load_manipulator,
     manipulator_from_mapping,
 )
-from hexapod_workspace.core.orientation import torsion_range
-from hexapod_workspace.core.params import flatten
-from hexapod_workspace.core.path_checks import check_path
-from hexapod_workspace.core.path_planner import plan_torsion
-from hexapod_workspace.core.rotations import tt_to_matrix
+from hexapod_workspace.core.model.collision import scene_distances
+from hexapod_workspace.core.motions.checks import check_path
+from hexapod_workspace.core.motions.planner import plan_torsion
+from hexapod_workspace.core.workspaces.orientation import torsion_range
 from hexapod_workspace.errors import ConfigError
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "config" / "example_collision.yaml"
@@ -296,7 +296,7 @@ def test_home_collision_checked_with_the_active_tool(plain: Manipulator) -> None
 def test_collision_row_adds_the_moving_base_joints_speed() -> None:
     """6-PUS with a spindle: the leg bodies' base ends slide, so the row adds ends·E (E the leg
     end rate of the constraint table) to the fixed-base bound."""
-    from hexapod_workspace.core.params import load_params_file
+    from hexapod_workspace.core.base.params import load_params_file
 
     parameters = load_params_file(EXAMPLE.parent / "example_pus.yaml")
     spindle = {"collision.tool.radius": 0.02, "collision.tool.length": 0.05}

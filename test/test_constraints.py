@@ -9,9 +9,13 @@ import pytest
 from reference import pose_margins_literal, segment_distance_literal
 
 from hexapod_workspace import InputError, check
-from hexapod_workspace.core.constraints import inverse_kinematics, pose_margins, segment_distance
-from hexapod_workspace.core.loading import manipulator_from_mapping
-from hexapod_workspace.core.rotations import tt_to_matrix
+from hexapod_workspace.core.base.rotations import tt_to_matrix
+from hexapod_workspace.core.evaluation.check import (
+    inverse_kinematics,
+    pose_margins,
+    segment_distance,
+)
+from hexapod_workspace.core.evaluation.loading import manipulator_from_mapping
 
 #: The 6-UPS model's constraints (the rows of the table that apply to it), as before the leg
 #: architectures: ``check`` gives exactly these names for a 6-UPS manipulator.

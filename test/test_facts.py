@@ -16,7 +16,7 @@ from mcap.reader import make_reader
 import hexapod_workspace
 from hexapod_workspace import logs
 from hexapod_workspace._version import __version__
-from hexapod_workspace.core import params
+from hexapod_workspace.core.base import params
 from hexapod_workspace.logs import interfaces, messages
 from hexapod_workspace.logs.writer import LIBRARY, LogWriter
 

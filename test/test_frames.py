@@ -1,7 +1,7 @@
 """Tool and work frames against an independent transform (plain 4x4 homogeneous matrices).
 
 The reference here composes homogeneous transforms written from the definitions (T&T matrices
-from their own Rz·Ry·Rz product), not from hexapod_workspace.core.frames: the platform pose a
+from their own Rz·Ry·Rz product), not from hexapod_workspace.core.cell.frames: the platform pose a
 tool pose denotes is ``T_OP = T_OC · T_PC⁻¹``, a work-frame pose is ``T_OC = T_OW · T_WC``.
 """
 
@@ -14,8 +14,8 @@ import pytest
 from frames_reference import homogeneous, tt
 
 from hexapod_workspace import check
-from hexapod_workspace.core.constraints import check_pose
-from hexapod_workspace.core.frames import (
+from hexapod_workspace.core.base.rotations import matrix_to_tt
+from hexapod_workspace.core.cell.frames import (
     Tool,
     WorkFrame,
     cell_from_mapping,
@@ -24,9 +24,9 @@ from hexapod_workspace.core.frames import (
     tool_pose,
     work_to_base,
 )
-from hexapod_workspace.core.loading import example_manipulator, load_manipulator
-from hexapod_workspace.core.manipulator import Manipulator
-from hexapod_workspace.core.rotations import matrix_to_tt
+from hexapod_workspace.core.evaluation.check import check_pose
+from hexapod_workspace.core.evaluation.loading import example_manipulator, load_manipulator
+from hexapod_workspace.core.model.manipulator import Manipulator
 from hexapod_workspace.errors import ConfigError, InputError
 
 TOOL_OFFSET = [0.012, -0.02, -0.16]

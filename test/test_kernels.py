@@ -22,20 +22,22 @@ import pytest
 from reference import BATCHED_NAMES, batched_margins, pose_margins_literal
 
 from hexapod_workspace import InputError, Manipulator, check
-from hexapod_workspace.core import constraints, kernels, margin_kernels
-from hexapod_workspace.core.constraint_table import CONSTRAINT_NAMES as TABLE_NAMES
-from hexapod_workspace.core.constraints import (
+from hexapod_workspace.core import kernels
+from hexapod_workspace.core.base.rotations import tt_to_matrix
+from hexapod_workspace.core.constraints.table import CONSTRAINT_NAMES as TABLE_NAMES
+from hexapod_workspace.core.evaluation import check as constraints
+from hexapod_workspace.core.evaluation.check import (
     check_pose,
     inverse_kinematics,
     pose_margins,
     segment_distance,
 )
-from hexapod_workspace.core.loading import (
+from hexapod_workspace.core.evaluation.loading import (
     load_manipulator,
     manipulator_from_mapping,
 )
-from hexapod_workspace.core.rotations import tt_to_matrix
-from hexapod_workspace.core.search import RaySearch
+from hexapod_workspace.core.kernels import margins as margin_kernels
+from hexapod_workspace.core.workspaces.search import RaySearch
 
 POSES = 1_000_000
 PACKAGE = Path(__file__).resolve().parents[1] / "hexapod_workspace"
@@ -304,7 +306,7 @@ def test_block_decisions_equal_the_per_probe_functions(name):
     """The search reads a block's estimates, verdicts and (fixed base) certified steps from
     planes computed row by row; they must be the per-probe functions' values, bit for bit, on
     margins of every kind (negative, zero, NaN, +inf, tiny and huge)."""
-    from hexapod_workspace.core import search_kernels
+    from hexapod_workspace.core.kernels import searches as search_kernels
 
     config = CONFIG.parent / f"{name if name.startswith('example') else 'example_gpm'}.yaml"
     machine = load_manipulator(config)
@@ -475,8 +477,8 @@ def test_one_signature_per_kernel_after_a_mixed_workload():
 import numpy as np
 from hexapod_workspace import check, example_manipulator, projected_workspace
 from hexapod_workspace.core import kernels
-from hexapod_workspace.core.constraints import check_pose, pose_margins
-from hexapod_workspace.core.orientation import torsion_range
+from hexapod_workspace.core.evaluation.check import check_pose, pose_margins
+from hexapod_workspace.core.workspaces.orientation import torsion_range
 m = example_manipulator()
 T = np.eye(4)
 T[:3, 3] = m.position
@@ -514,7 +516,7 @@ def test_a_6ups_check_compiles_no_stage_it_does_not_use(tmp_path):
     code = """
 import numpy as np
 from hexapod_workspace import check, example_manipulator
-from hexapod_workspace.core import collision_kernels, margin_kernels
+from hexapod_workspace.core.kernels import collision as collision_kernels, margins as margin_kernels
 check(example_manipulator(), np.radians([[0, 30, 0]]))
 for name in ("_pose_moving", "_pose_collision", "_block_collision", "_block_singularity",
              "_pose_singularity", "_leg_planes_pus", "_leg_planes_rus"):
@@ -532,7 +534,7 @@ print("_check_block", len(margin_kernels._check_block.signatures))
 def test_kernel_sources_name_every_module_with_compiled_code():
     """The cache directory is named by a hash of KERNEL_SOURCES: a module with compiled code
     missing from it would be loaded stale from the cache after a change."""
-    from hexapod_workspace.core import jit
+    from hexapod_workspace.core.base import jit
 
     decorated = set()
     for path in PACKAGE.rglob("*.py"):
@@ -549,7 +551,7 @@ def test_a_child_process_of_another_copy_uses_its_own_cache(tmp_path, monkeypatc
     colcon install space, started from a test of the source tree) uses the copy's own cache,
     where its kernels were compiled; a directory the user set after that is the user's. (The
     child's decision, taken with the inherited environment and the copy's folder.)"""
-    from hexapod_workspace.core import jit
+    from hexapod_workspace.core.base import jit
 
     inherited = dict(os.environ)
     assert jit.CACHE_DIRECTORY is not None

@@ -155,13 +155,58 @@ def test_imports_respect_the_layers(module: str) -> None:
     assert not problems, f"{module}:\n" + "\n".join(problems)
 
 
+#: Sub-packages of the core, inner to outer (CONTRIBUTING.md, *Package layout*): each imports
+#: only from itself and the ones before it.
+CORE_LAYERS = (
+    "base",
+    "model",
+    "constraints",
+    "kernels",
+    "evaluation",
+    "workspaces",
+    "motions",
+    "cell",
+)
+
+
+def core_layer_of(module: str) -> str | None:
+    """The core sub-package of a module (None outside the core or for the core package)."""
+    parts = module.split(".")
+    return parts[2] if len(parts) > 2 and parts[1] == "core" else None
+
+
+def test_every_core_module_sits_in_a_layer() -> None:
+    loose = sorted(
+        module
+        for module in GRAPH
+        if layer_of(module) == "core" and module != f"{PACKAGE}.core"
+        if core_layer_of(module) not in CORE_LAYERS
+    )
+    assert not loose, f"core modules outside the layers {CORE_LAYERS}: {loose}"
+
+
+@pytest.mark.parametrize("module", sorted(m for m in GRAPH if core_layer_of(m) in CORE_LAYERS))
+def test_core_layers_import_inward(module: str) -> None:
+    layer = core_layer_of(module)
+    assert layer is not None
+    rank = CORE_LAYERS.index(layer)
+    problems = []
+    for name, line in GRAPH[module]:
+        if name == f"{PACKAGE}.core":
+            problems.append(f"line {line}: imports the core package itself")
+        target = core_layer_of(name)
+        if target in CORE_LAYERS and CORE_LAYERS.index(target) > rank:
+            problems.append(f"line {line}: core.{layer} imports {name} (core.{target}, outer)")
+    assert not problems, f"{module}:\n" + "\n".join(problems)
+
+
 def test_core_reads_yaml_only_for_a_parameters_file() -> None:
     users = {
         module
         for module, names in GRAPH.items()
         if layer_of(module) == "core" and any(n.split(".")[0] == "yaml" for n, _ in names)
     }
-    assert users <= {"hexapod_workspace.core.params"}, users
+    assert users <= {"hexapod_workspace.core.base.params"}, users
 
 
 def test_no_import_cycles() -> None:

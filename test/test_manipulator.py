@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 
 from hexapod_workspace import ConfigError, GeometryError, HomePoseWarning, Manipulator
-from hexapod_workspace.core.loading import (
+from hexapod_workspace.core.base.params import load_params_file
+from hexapod_workspace.core.evaluation.loading import (
     example_manipulator,
     load_manipulator,
     manipulator_from_mapping,
 )
-from hexapod_workspace.core.params import load_params_file
 
 
 def build(parameters: dict, **changes) -> Manipulator:
@@ -345,8 +345,8 @@ def _ry(a: float) -> np.ndarray:
 
 def test_leg_endpoints_follow_the_pose_written_out_per_leg() -> None:
     """leg_endpoints against B_i = p + R·b_i written out leg by leg with a plain rotation."""
-    from hexapod_workspace.core.legs import leg_endpoints
-    from hexapod_workspace.core.rotations import tt_to_matrix
+    from hexapod_workspace.core.base.rotations import tt_to_matrix
+    from hexapod_workspace.core.model.legs import leg_endpoints
 
     m = example_manipulator()
     angles = np.radians([[30.0, 20.0, 10.0], [0.0, 0.0, 0.0]])

@@ -12,11 +12,11 @@ import dataclasses
 import numpy as np
 
 from hexapod_workspace._resources import example_config_path
-from hexapod_workspace.core.collision import collision_scene
-from hexapod_workspace.core.loading import load_manipulator
-from hexapod_workspace.core.projected import projected_workspace
-from hexapod_workspace.core.rotations import quaternion_to_matrix
-from hexapod_workspace.core.scene_view import cone_of, scene_view
+from hexapod_workspace.core.base.rotations import quaternion_to_matrix
+from hexapod_workspace.core.cell.scene_view import cone_of, scene_view
+from hexapod_workspace.core.evaluation.loading import load_manipulator
+from hexapod_workspace.core.model.collision import collision_scene
+from hexapod_workspace.core.workspaces.projected import projected_workspace
 from hexapod_workspace.logs import deserialize, serialize
 from hexapod_workspace.logs import markers as m
 

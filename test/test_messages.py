@@ -10,13 +10,13 @@ from recording_support import NAN, plain
 
 from hexapod_workspace import logs
 from hexapod_workspace._resources import example_config_path
-from hexapod_workspace.core import constraints
-from hexapod_workspace.core.constraint_table import CONSTRAINT_NAMES
-from hexapod_workspace.core.loading import load_manipulator
-from hexapod_workspace.core.manipulator import Manipulator
-from hexapod_workspace.core.orientation import OrientationSlice, OrientationWorkspace
-from hexapod_workspace.core.projected import ProjectedWorkspace
-from hexapod_workspace.core.resolution import WorkspaceKind
+from hexapod_workspace.core.base.resolution import WorkspaceKind
+from hexapod_workspace.core.constraints.table import CONSTRAINT_NAMES
+from hexapod_workspace.core.evaluation import check as constraints
+from hexapod_workspace.core.evaluation.loading import load_manipulator
+from hexapod_workspace.core.model.manipulator import Manipulator
+from hexapod_workspace.core.workspaces.orientation import OrientationSlice, OrientationWorkspace
+from hexapod_workspace.core.workspaces.projected import ProjectedWorkspace
 from hexapod_workspace.logs import messages
 
 

@@ -21,11 +21,11 @@ from test_paths import dense_poses
 
 from hexapod_workspace import GeometryError, Manipulator, check, check_path
 from hexapod_workspace._resources import example_config_path
-from hexapod_workspace.core.constraint_table import INDEX, rate_bounds
-from hexapod_workspace.core.constraints import pose_margins
-from hexapod_workspace.core.loading import load_manipulator, manipulator_from_mapping
-from hexapod_workspace.core.rotations import tt_to_matrix
-from hexapod_workspace.core.scene_view import scene_view
+from hexapod_workspace.core.base.rotations import tt_to_matrix
+from hexapod_workspace.core.cell.scene_view import scene_view
+from hexapod_workspace.core.constraints.table import INDEX, rate_bounds
+from hexapod_workspace.core.evaluation.check import pose_margins
+from hexapod_workspace.core.evaluation.loading import load_manipulator, manipulator_from_mapping
 
 INCH = 0.0254
 #: genhexkins.base.N / genhexkins.platform.N of kinematics.hal, inches.

@@ -15,17 +15,17 @@ import pytest
 from path_support import random_large_moves
 
 from hexapod_workspace import InputError, check, check_path, plan_torsion
-from hexapod_workspace.core.constraint_table import COLLISION, INDEX
-from hexapod_workspace.core.constraints import inverse_kinematics, pose_margins
-from hexapod_workspace.core.loading import manipulator_from_mapping
-from hexapod_workspace.core.path_certificate import _Certifier
-from hexapod_workspace.core.path_interpolation import _Moves
-from hexapod_workspace.core.rotations import (
+from hexapod_workspace.core.base.rotations import (
     approach_vector,
     matrix_to_quaternion,
     tt_to_matrix,
     wrap_angle,
 )
+from hexapod_workspace.core.constraints.table import COLLISION, INDEX
+from hexapod_workspace.core.evaluation.check import inverse_kinematics, pose_margins
+from hexapod_workspace.core.evaluation.loading import manipulator_from_mapping
+from hexapod_workspace.core.motions.certificate import _Certifier
+from hexapod_workspace.core.motions.interpolation import _Moves
 
 OFF_AXIS = np.array([0.2, 0.2, -0.95])
 
@@ -42,7 +42,7 @@ def rodrigues(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
 
 
 def dense_poses(p0, p1, angles0, angles1, interpolation, s):
-    """Poses along a move, computed independently of hexapod_workspace.core.paths."""
+    """Poses along a move, computed independently of hexapod_workspace.core.motions."""
     positions = p0 + s[:, None] * (p1 - p0)
     if interpolation == "slerp":
         r0, r1 = tt_to_matrix(angles0), tt_to_matrix(angles1)
@@ -132,7 +132,7 @@ def test_min_margin_is_where_it_says(example, random_moves):
     rotations, where = dense_poses(
         positions[k], positions[k + 1], angles[k], angles[k + 1], "slerp", np.array([s])
     )
-    from hexapod_workspace.core.constraints import relative_margins
+    from hexapod_workspace.core.evaluation.check import relative_margins
 
     margins = pose_margins(example, rotations, where).margins
     assert relative_margins(example, margins).min() == pytest.approx(
@@ -403,7 +403,7 @@ def test_plan_refuses_bad_axes(example, axes, match):
 
 
 def test_singular_ends_take_the_other_azimuth_and_keep_their_rotation():
-    from hexapod_workspace.core.path_interpolation import _align_singular
+    from hexapod_workspace.core.motions.interpolation import _align_singular
 
     angles = np.array([[0.3, np.pi, 0.7], [0.2, 0.0, -0.4], [0.1, 0.5, 0.2]])
     other = np.array([[1.1, 0.5, 0.0], [-2.0, 0.3, 0.1], [3.0, 0.4, 0.0]])
@@ -416,7 +416,7 @@ def test_singular_ends_take_the_other_azimuth_and_keep_their_rotation():
 def test_report_singularity_fills_the_waypoints_as_check_does(example):
     """At limits.singularity_min 0 the path leaves the singularity margin +inf; the report
     evaluates it at every waypoint (as check(..., singularity=True)) and changes nothing else."""
-    from hexapod_workspace.core.paths import report_singularity
+    from hexapod_workspace.core.motions import report_singularity
 
     rng = np.random.default_rng(5)
     positions = np.array([0.0, 0.0, -1.15]) + rng.uniform(-0.1, 0.1, (6, 3))

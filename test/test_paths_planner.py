@@ -20,10 +20,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import planner_reference as reference
 
 from hexapod_workspace import plan_torsion
-from hexapod_workspace.core import path_planner as paths
-from hexapod_workspace.core import planner_kernels as kernels
-from hexapod_workspace.core.path_planner import _best_first
-from hexapod_workspace.core.rotations import approach_vector, wrap_angle
+from hexapod_workspace.core.base.rotations import approach_vector, wrap_angle
+from hexapod_workspace.core.kernels import planner as kernels
+from hexapod_workspace.core.motions import planner as paths
+from hexapod_workspace.core.motions.planner import _best_first
 
 OFF_AXIS = np.array([0.2, 0.2, -0.95])
 

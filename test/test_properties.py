@@ -28,13 +28,13 @@ from hypothesis import strategies as st
 from reference import segment_distance_literal, segment_distance_squared_batch
 
 from hexapod_workspace import Manipulator, check, projected_workspace
-from hexapod_workspace.core.loading import example_manipulator, manipulator_from_mapping
-from hexapod_workspace.core.rotations import (
+from hexapod_workspace.core.base.rotations import (
     matrix_to_quaternion,
     matrix_to_tt,
     quaternion_to_matrix,
     tt_to_matrix,
 )
+from hexapod_workspace.core.evaluation.loading import example_manipulator, manipulator_from_mapping
 
 PROPERTY = settings(
     max_examples=60,

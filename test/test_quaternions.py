@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hexapod_workspace.core.rotations import (
+from hexapod_workspace.core.base.rotations import (
     approach_to_tilt,
     approach_vector,
     axis_angle_to_quaternion,

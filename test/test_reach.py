@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 
 from hexapod_workspace import check
-from hexapod_workspace.core.frames import Tool, WorkFrame, tool_model
-from hexapod_workspace.core.loading import example_manipulator
-from hexapod_workspace.core.manipulator import Manipulator
-from hexapod_workspace.core.orientation import torsion_range
-from hexapod_workspace.core.reach import AXES, axis_limits, reach
-from hexapod_workspace.core.rotations import matrix_to_tt, tt_to_matrix
+from hexapod_workspace.core.base.rotations import matrix_to_tt, tt_to_matrix
+from hexapod_workspace.core.cell.frames import Tool, WorkFrame, tool_model
+from hexapod_workspace.core.cell.reach import AXES, axis_limits, reach
+from hexapod_workspace.core.evaluation.loading import example_manipulator
+from hexapod_workspace.core.model.manipulator import Manipulator
+from hexapod_workspace.core.workspaces.orientation import torsion_range
 from hexapod_workspace.errors import InputError
 
 TOLERANCE = math.radians(0.01)

@@ -28,9 +28,9 @@ import numpy as np
 import pytest
 from cli_support import run_main
 
-from hexapod_workspace.core import resolution
-from hexapod_workspace.core.loading import example_manipulator
-from hexapod_workspace.core.resolution import WorkspaceKind
+from hexapod_workspace.core.base import resolution
+from hexapod_workspace.core.base.resolution import WorkspaceKind
+from hexapod_workspace.core.evaluation.loading import example_manipulator
 from hexapod_workspace.ros.worker import WorkspaceJob, compute_fields
 
 ROOT = Path(__file__).resolve().parents[1]

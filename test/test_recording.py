@@ -35,8 +35,8 @@ from rosbags.rosbag2.metadata import parse_qos
 from hexapod_workspace import logs
 from hexapod_workspace._resources import data_dir, example_config_path
 from hexapod_workspace.cli.replay import run_replay
-from hexapod_workspace.core import constraints
-from hexapod_workspace.core.loading import load_manipulator
+from hexapod_workspace.core.evaluation import check as constraints
+from hexapod_workspace.core.evaluation.loading import load_manipulator
 from hexapod_workspace.errors import LogReadError, RecordingError
 from hexapod_workspace.logs import messages
 

@@ -21,9 +21,9 @@ from test_messages import orientation_stub, projected_stub
 
 from hexapod_workspace import logs
 from hexapod_workspace.cli.replay import run_replay
-from hexapod_workspace.core import constraints
-from hexapod_workspace.core.loading import example_manipulator
-from hexapod_workspace.core.orientation import OrientationSlice
+from hexapod_workspace.core.evaluation import check as constraints
+from hexapod_workspace.core.evaluation.loading import example_manipulator
+from hexapod_workspace.core.workspaces.orientation import OrientationSlice
 from hexapod_workspace.logs import messages
 from hexapod_workspace.logs.record import record_results
 from hexapod_workspace.logs.summary import summarize_log
@@ -127,8 +127,8 @@ def test_summary_and_cloud_of_one_computation_are_paired(tmp_path: Path) -> None
 
 
 def test_record_real_workspaces_replay_and_plot(tmp_path: Path, example) -> None:
-    from hexapod_workspace.core.orientation import orientation_workspace
-    from hexapod_workspace.core.projected import projected_workspace
+    from hexapod_workspace.core.workspaces.orientation import orientation_workspace
+    from hexapod_workspace.core.workspaces.projected import projected_workspace
 
     results = [
         projected_workspace(example, method="torsion_zero", n_phi=72),

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hexapod_workspace.core.rotations import (
+from hexapod_workspace.core.base.rotations import (
     approach_vector,
     matrix_to_quaternion,
     matrix_to_tt,
@@ -198,7 +198,7 @@ def test_psi_survives_a_huge_phi():
 
 
 def test_degrees_reduce_exactly_modulo_360():
-    from hexapod_workspace.core.rotations import degrees_to_radians
+    from hexapod_workspace.core.base.rotations import degrees_to_radians
 
     for typed, principal in ((1e20, -80.0), (-1e20, 80.0), (720.5, 0.5), (-190.0, 170.0)):
         assert float(degrees_to_radians(typed)) == np.radians(principal)

@@ -16,10 +16,14 @@ from cli_support import run_cli
 
 from hexapod_workspace import check
 from hexapod_workspace._resources import example_config_path
-from hexapod_workspace.core.collision import collision_scene, require_free_home, scene_distances
-from hexapod_workspace.core.loading import load_manipulator
-from hexapod_workspace.core.rotations import tt_to_matrix
-from hexapod_workspace.core.scene_view import scene_view
+from hexapod_workspace.core.base.rotations import tt_to_matrix
+from hexapod_workspace.core.cell.scene_view import scene_view
+from hexapod_workspace.core.evaluation.loading import load_manipulator
+from hexapod_workspace.core.model.collision import (
+    collision_scene,
+    require_free_home,
+    scene_distances,
+)
 
 SCENE = {
     "collision.clearance": 0.005,

@@ -2,7 +2,7 @@
 
 Independent evidence: numpy's SVD of the matrix written from its definition
 (``reference.singularity_literal``), finite differences against the rate bound derived in
-``core/constraint_table.py``, and boundaries and moves against dense sampling.
+``core/constraints/table.py``, and boundaries and moves against dense sampling.
 """
 
 from __future__ import annotations
@@ -21,10 +21,10 @@ from hexapod_workspace import (
     projected_workspace,
     torsion_range,
 )
-from hexapod_workspace.core.constraint_table import INDEX, SINGULARITY
-from hexapod_workspace.core.constraints import check_pose, inverse_kinematics, pose_margins
-from hexapod_workspace.core.loading import manipulator_from_mapping
-from hexapod_workspace.core.rotations import tt_to_matrix
+from hexapod_workspace.core.base.rotations import tt_to_matrix
+from hexapod_workspace.core.constraints.table import INDEX, SINGULARITY
+from hexapod_workspace.core.evaluation.check import check_pose, inverse_kinematics, pose_margins
+from hexapod_workspace.core.evaluation.loading import manipulator_from_mapping
 
 LIMIT = 0.4  # limits the example near (0, 0, -1.3) m: σ_min 0.46 at the centre, 0.36 at the edge
 
@@ -109,7 +109,7 @@ def test_smallest_singular_value_kernel_against_numpy_svd(rng):
     6ε·(|M|ᵀ|M|)_ij, so its eigenvalues by at most 36 ε·‖G‖ (‖|M|‖² ≤ 6‖M‖²); the reduction and
     the iteration add a few ε·‖G‖ (numpy's eigvalsh of the same G is off by as much on the
     clusters). NaN in, NaN out."""
-    from hexapod_workspace.core.margin_kernels import ROWS_SCRATCH, _smallest_singular_value
+    from hexapod_workspace.core.kernels.margins import ROWS_SCRATCH, _smallest_singular_value
 
     matrices = _hard_matrices(rng)
     expected = np.linalg.svd(matrices, compute_uv=False)

@@ -18,11 +18,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from hexapod_workspace.core.frames import Tool, tool_model
-from hexapod_workspace.core.loading import example_manipulator, load_manipulator
-from hexapod_workspace.core.manipulator import Manipulator
-from hexapod_workspace.core.rotations import tt_to_matrix
-from hexapod_workspace.core.speeds import actuator_rates, feed_limits
+from hexapod_workspace.core.base.rotations import tt_to_matrix
+from hexapod_workspace.core.cell.frames import Tool, tool_model
+from hexapod_workspace.core.evaluation.loading import example_manipulator, load_manipulator
+from hexapod_workspace.core.model.manipulator import Manipulator
+from hexapod_workspace.core.motions.speeds import actuator_rates, feed_limits
 from hexapod_workspace.errors import InputError
 
 DENSE = 20_001

@@ -14,9 +14,9 @@ import pytest
 from cli_support import one_error_line, run_main
 
 from hexapod_workspace import Manipulator
-from hexapod_workspace.core.frames import cell_from_mapping, cell_unit_reason
-from hexapod_workspace.core.loading import manipulator_from_mapping
-from hexapod_workspace.core.validation import machine_size, millimetre_reason
+from hexapod_workspace.core.base.validation import machine_size, millimetre_reason
+from hexapod_workspace.core.cell.frames import cell_from_mapping, cell_unit_reason
+from hexapod_workspace.core.evaluation.loading import manipulator_from_mapping
 from hexapod_workspace.errors import ConfigError, GeometryError
 
 

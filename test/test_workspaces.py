@@ -21,7 +21,7 @@ from hexapod_workspace import (
     projected_workspace,
     torsion_range,
 )
-from hexapod_workspace.core.loading import load_manipulator
+from hexapod_workspace.core.evaluation.loading import load_manipulator
 
 ON_AXIS = np.array([0.0, 0.0, -1.3])
 OFF_AXIS = np.array([0.2, 0.2, -0.95])
@@ -261,7 +261,7 @@ def test_volume_and_boundary_points(solid_off):
 
 
 def test_slice_centres_are_previous_centroids(example, solid_off):
-    from hexapod_workspace.core.orientation import _polygon_area_centroid
+    from hexapod_workspace.core.workspaces.orientation import _polygon_area_centroid
 
     slices = solid_off.slices
     zero = int(np.argmin(np.abs([piece.psi for piece in slices])))
@@ -381,8 +381,8 @@ def test_leg_length_boundary_closed_form(example, tz_off):
     K0 + K1 cos(theta) + K2 sin(theta) (R is linear in cos and sin of theta). Where the search
     reports leg_length as the limiting constraint, its boundary must equal the first root of
     l_i(theta)^2 = l_min^2 or l_max^2 over the legs (from three samples, solved in closed form)."""
-    from hexapod_workspace.core.constraints import inverse_kinematics
-    from hexapod_workspace.core.rotations import tt_to_matrix
+    from hexapod_workspace.core.base.rotations import tt_to_matrix
+    from hexapod_workspace.core.evaluation.check import inverse_kinematics
 
     checked = 0
     for k in np.flatnonzero(np.array(tz_off.limiting) == "leg_length"):

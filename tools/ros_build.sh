@@ -42,7 +42,7 @@ start=$SECONDS
 log "compiling the install space's kernels for the packaged examples (numba cache)"
 "$ROOT/tools/with_ros_env.sh" python -P -c "
 from hexapod_workspace._resources import data_path
-from hexapod_workspace.core.loading import load_manipulator
+from hexapod_workspace.core.evaluation.loading import load_manipulator
 from hexapod_workspace.ros.node import warm_up_kernels
 names = ('example_gpm', 'example_collision', 'example_pus', 'example_rus')
 warm_up_kernels(*(load_manipulator(data_path('config', f'{n}.yaml')) for n in names))

@@ -3,7 +3,7 @@
 ``import hexapod_workspace`` never imports Dask, xarray or Zarr: :func:`workspace_atlas` loads
 the engine (:mod:`hexapod_workspace.atlas.engine`) on first call and, when the extra is missing,
 raises :class:`~hexapod_workspace.errors.MissingExtraError` saying how to install it. The
-per-position computation is numpy-only and lives in :mod:`hexapod_workspace.core.atlas`.
+per-position computation is numpy-only and lives in :mod:`hexapod_workspace.core.workspaces.atlas`.
 """
 
 from __future__ import annotations
@@ -15,8 +15,8 @@ from typing import TYPE_CHECKING, Any
 from ..errors import MissingExtraError
 
 if TYPE_CHECKING:
-    from ..core.atlas import AtlasGrid
-    from ..core.manipulator import Manipulator
+    from ..core.model.manipulator import Manipulator
+    from ..core.workspaces.atlas import AtlasGrid
     from .engine import AtlasRun
 
 __all__ = ["EXTRA_REQUIREMENTS", "install_hint", "require_extra", "workspace_atlas"]

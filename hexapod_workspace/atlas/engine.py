@@ -28,8 +28,13 @@ from pathlib import Path
 import xarray as xr
 
 from ..core import kernels
-from ..core.atlas import AtlasGrid, AtlasOptions, dexterous_mask, positions_capability
-from ..core.manipulator import Manipulator
+from ..core.model.manipulator import Manipulator
+from ..core.workspaces.atlas import (
+    AtlasGrid,
+    AtlasOptions,
+    dexterous_mask,
+    positions_capability,
+)
 from ..errors import AtlasError, InputError
 from .store import (
     ChunkLayout,

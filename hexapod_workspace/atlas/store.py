@@ -4,7 +4,7 @@ Layout of ``STORE.zarr``:
 
 * a Zarr group holding an xarray Dataset: dims ``x, y, z`` (box grids, coordinates in m) or
   ``position`` (explicit positions, with coordinates ``x, y, z`` along it); one variable per
-  atlas value (:data:`~hexapod_workspace.core.atlas.ATLAS_VARIABLES`) with ``units`` and
+  atlas value (:data:`~hexapod_workspace.core.workspaces.atlas.ATLAS_VARIABLES`) with ``units`` and
   ``long_name``; store attributes: the manipulator parameters, the grid, the options, the
   software version, the chunk shape and ``complete``;
 * ``chunk_done`` (dims ``chunk_x, chunk_y, chunk_z`` or ``chunk``, one Zarr chunk per element):
@@ -28,8 +28,8 @@ import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
 
-from ..core.atlas import ATLAS_VARIABLES, AtlasGrid, AtlasOptions
-from ..core.manipulator import Manipulator
+from ..core.model.manipulator import Manipulator
+from ..core.workspaces.atlas import ATLAS_VARIABLES, AtlasGrid, AtlasOptions
 from ..errors import AtlasError
 
 __all__ = [
@@ -252,7 +252,7 @@ def check_resumable(path: Path, attrs: dict[str, Any]) -> None:
 
 def open_atlas(path: str | Path) -> xr.Dataset:
     """Open an atlas store (lazily, Dask-backed) as an xarray Dataset, variables in the order
-    of :data:`~hexapod_workspace.core.atlas.ATLAS_VARIABLES`, markers last."""
+    of :data:`~hexapod_workspace.core.workspaces.atlas.ATLAS_VARIABLES`, markers last."""
     dataset = xr.open_zarr(Path(path), consolidated=False)
     order = [v.name for v in ATLAS_VARIABLES if v.name in dataset.data_vars]
     rest = [name for name in dataset.data_vars if name not in order]

@@ -23,8 +23,13 @@ from typing import IO, Any
 
 import numpy as np
 
-from ..core.atlas import AtlasGrid, AtlasOptions, dexterous_mask, positions_capability
-from ..core.manipulator import Manipulator
+from ..core.model.manipulator import Manipulator
+from ..core.workspaces.atlas import (
+    AtlasGrid,
+    AtlasOptions,
+    dexterous_mask,
+    positions_capability,
+)
 from ..errors import InputError
 from .inputs import CliError, configured_manipulator, finite, tolerance_flag
 from .progress import ProgressBar

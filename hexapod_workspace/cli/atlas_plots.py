@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
-from ..core.atlas import AtlasGrid
+from ..core.workspaces.atlas import AtlasGrid
 
 if TYPE_CHECKING:
     from matplotlib.artist import Artist

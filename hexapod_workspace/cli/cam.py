@@ -44,8 +44,20 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._resources import example_config_path
-from ..core.cldata import CL_SUFFIXES, CL_UNITS, CLProgram, looks_like_cldata, read_cldata
-from ..core.frames import (
+from ..core.base.rotations import (
+    degrees_to_radians,
+    matrix_to_quaternion,
+    matrix_to_tt,
+    tt_to_matrix,
+)
+from ..core.cell.cldata import (
+    CL_SUFFIXES,
+    CL_UNITS,
+    CLProgram,
+    looks_like_cldata,
+    read_cldata,
+)
+from ..core.cell.frames import (
     CellFrames,
     Tool,
     WorkFrame,
@@ -54,8 +66,8 @@ from ..core.frames import (
     vectors_to_base,
     work_to_base,
 )
-from ..core.manipulator import Manipulator
-from ..core.paths import (
+from ..core.model.manipulator import Manipulator
+from ..core.motions import (
     DEFAULT_PATH_TOLERANCE,
     PathCheck,
     TorsionPlan,
@@ -63,8 +75,7 @@ from ..core.paths import (
     plan_torsion,
     reported_parts,
 )
-from ..core.rotations import degrees_to_radians, matrix_to_quaternion, matrix_to_tt, tt_to_matrix
-from ..core.speeds import ACTUATOR_MODELS, FeedLimits, actuator_rates, feed_limits
+from ..core.motions.speeds import ACTUATOR_MODELS, FeedLimits, actuator_rates, feed_limits
 from .check_path import (
     _degrees_flag,
     _text,
@@ -77,7 +88,13 @@ from .check_path import (
     record_path_calls,
 )
 from .commands import PROG
-from .inputs import PLOT_FORMATS, CliError, configured_manipulator, finite, output_file
+from .inputs import (
+    PLOT_FORMATS,
+    CliError,
+    configured_manipulator,
+    finite,
+    output_file,
+)
 
 __all__ = [
     "FRAMES",

@@ -25,9 +25,9 @@ from typing import IO, TYPE_CHECKING, Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.baseline import psi_zero_baseline, reported_baseline
-from ..core.manipulator import Manipulator
-from ..core.paths import (
+from ..core.base.rotations import matrix_to_quaternion, tt_to_matrix
+from ..core.model.manipulator import Manipulator
+from ..core.motions import (
     DEFAULT_PATH_TOLERANCE,
     DEFAULT_PLAN_PSI_STEP,
     INTERPOLATIONS,
@@ -37,7 +37,7 @@ from ..core.paths import (
     plan_torsion,
     reported_parts,
 )
-from ..core.rotations import matrix_to_quaternion, tt_to_matrix
+from ..core.motions.baseline import psi_zero_baseline, reported_baseline
 from ..errors import InputError
 from .commands import PROG
 from .inputs import (
@@ -411,7 +411,7 @@ def path_figure(
     """The figure of :func:`plot_path` (a :class:`matplotlib.figure.Figure`), not saved."""
     from matplotlib.figure import Figure
 
-    from ..core.projected import projected_workspace
+    from ..core.workspaces.projected import projected_workspace
     from .plotting import label_rings
 
     checked, plan = reported_parts(result)
@@ -538,7 +538,7 @@ def record_path(
         Log time of the request, ns since the epoch (default now).
     baseline : PathCheck, optional
         The ψ = 0 baseline of a path of fixed orientations
-        (:func:`~hexapod_workspace.core.baseline.psi_zero_baseline`).
+        (:func:`~hexapod_workspace.core.motions.baseline.psi_zero_baseline`).
     """
     from ..logs import paths as path_fields
 

@@ -18,11 +18,11 @@ from typing import IO, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core import resolution
-from ..core.constraints import check
-from ..core.manipulator import Manipulator
-from ..core.orientation import orientation_workspace, torsion_range
-from ..core.projected import projected_workspace
+from ..core.base import resolution
+from ..core.evaluation.check import check
+from ..core.model.manipulator import Manipulator
+from ..core.workspaces.orientation import orientation_workspace, torsion_range
+from ..core.workspaces.projected import projected_workspace
 from ..errors import ResolutionError, UnreachableReferenceError
 from . import reports
 from .inputs import CliError, GivenPoses, poses_from_degrees

@@ -22,9 +22,9 @@ from typing import IO, Any
 import numpy as np
 
 from ..core import kernels
-from ..core.manipulator import Manipulator
-from ..core.orientation import orientation_workspace
-from ..core.projected import projected_workspace
+from ..core.model.manipulator import Manipulator
+from ..core.workspaces.orientation import orientation_workspace
+from ..core.workspaces.projected import projected_workspace
 from ..errors import UnreachableReferenceError
 from . import reports
 from .inputs import CliError, output_file

@@ -19,17 +19,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._resources import example_config_path
-from ..core import resolution
-from ..core.frames import cell_from_params_file, require_plausible_cell, tool_model
-from ..core.loading import load_manipulator
-from ..core.manipulator import Manipulator
-from ..core.rotations import (
+from ..core.base import resolution
+from ..core.base.rotations import (
     ANGLE_CONVENTIONS,
     convention_to_tt,
     degrees_to_radians,
     tt_to_matrix,
 )
-from ..core.validation import machine_size, millimetre_reason
+from ..core.base.validation import machine_size, millimetre_reason
+from ..core.cell.frames import cell_from_params_file, require_plausible_cell, tool_model
+from ..core.evaluation.loading import load_manipulator
+from ..core.model.manipulator import Manipulator
 from ..errors import HexapodWorkspaceError, InputError
 from .tables import (
     ORIENTATION_QUANTITIES,
@@ -253,7 +253,7 @@ def configured_manipulator(
 
     Warnings of the model (an unreachable home pose) go to ``err`` as one line each. With
     ``tool.offset`` / ``tool.orientation`` in the file, the model answers for the tool frame's
-    poses (:func:`hexapod_workspace.core.frames.tool_model`), unless ``with_tool`` is False
+    poses (:func:`hexapod_workspace.core.cell.frames.tool_model`), unless ``with_tool`` is False
     (the platform frame's model).
     """
     path = Path(config) if config else example_config_path()
@@ -281,7 +281,7 @@ def plausible_positions(
     manipulator: Manipulator, positions: NDArray[np.float64], where: str
 ) -> None:
     """Refuse positions (m) that fit the machine only once divided by 1000, with the unit
-    hint (:func:`~hexapod_workspace.core.validation.millimetre_reason`), naming ``where``."""
+    hint (:func:`~hexapod_workspace.core.base.validation.millimetre_reason`), naming ``where``."""
     size = machine_size(
         manipulator.base_joints, manipulator.platform_joints, manipulator.home_position
     )

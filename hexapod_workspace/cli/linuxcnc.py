@@ -1,6 +1,6 @@
 """``hexapod-workspace import-genhexkins``: a LinuxCNC genhexkins machine as a parameters file.
 
-The reading and the conversion are :func:`hexapod_workspace.core.genhexkins.read_genhexkins`;
+The reading and the conversion are :func:`hexapod_workspace.core.model.genhexkins.read_genhexkins`;
 this writes the result as a ROS 2 parameters file (the one ``--config`` and the node read),
 after building the model from it, so that a file it writes is one the package accepts.
 """
@@ -15,8 +15,8 @@ from typing import IO, Any
 
 import numpy as np
 
-from ..core.genhexkins import read_genhexkins
-from ..core.loading import manipulator_from_mapping, require_usable
+from ..core.evaluation.loading import manipulator_from_mapping, require_usable
+from ..core.model.genhexkins import read_genhexkins
 from .inputs import CliError
 
 __all__ = ["IMPORT_DESCRIPTION", "IMPORT_HELP", "cmd_import_genhexkins", "import_arguments"]

@@ -25,7 +25,8 @@ from typing import IO, Any
 import numpy as np
 
 from .. import __version__
-from ..core import kernels, resolution
+from ..core import kernels
+from ..core.base import resolution
 from ..errors import HexapodWorkspaceError
 from . import atlas, cam, check_path, commands, linuxcnc, reach, scene
 from .inputs import (

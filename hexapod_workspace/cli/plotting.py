@@ -22,8 +22,8 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core.orientation import OrientationWorkspace
-from ..core.projected import ProjectedWorkspace
+from ..core.workspaces.orientation import OrientationWorkspace
+from ..core.workspaces.projected import ProjectedWorkspace
 
 if TYPE_CHECKING:
     from matplotlib.projections.polar import PolarAxes

@@ -1,5 +1,5 @@
 """``reach`` and ``axis-limits``: how far the tool can move from a pose along a direction or
-along the six axes of a frame (:mod:`hexapod_workspace.core.reach`).
+along the six axes of a frame (:mod:`hexapod_workspace.core.cell.reach`).
 
 JSON (``--json``):
 
@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._resources import example_config_path
-from ..core.frames import (
+from ..core.cell.frames import (
     CellFrames,
     Tool,
     cell_from_params_file,
@@ -38,8 +38,7 @@ from ..core.frames import (
     tool_model,
     work_to_base,
 )
-from ..core.manipulator import Manipulator
-from ..core.reach import (
+from ..core.cell.reach import (
     AXES,
     DEFAULT_T_MAX,
     DEFAULT_T_MAX_ROTATION,
@@ -49,6 +48,7 @@ from ..core.reach import (
     axis_limits,
     reach,
 )
+from ..core.model.manipulator import Manipulator
 from .cam import tool_json, work_json
 from .commands import PROG
 from .inputs import (

@@ -14,7 +14,7 @@ from typing import IO, Any
 
 import numpy as np
 
-from hexapod_workspace.core.resolution import WorkspaceKind
+from hexapod_workspace.core.base.resolution import WorkspaceKind
 from hexapod_workspace.errors import LogReadError
 from hexapod_workspace.logs.summary import LogSummary, WorkspaceRecord, summarize_log
 
@@ -33,7 +33,7 @@ def _rebuild(record: WorkspaceRecord) -> Any:
     position = np.array([summary["position"][k] for k in "xyz"])
     kind = int(summary["kind"])
     if kind == WorkspaceKind.ORIENTATION:
-        from hexapod_workspace.core.orientation import (
+        from hexapod_workspace.core.workspaces.orientation import (
             OrientationSlice,
             OrientationWorkspace,
         )
@@ -64,7 +64,7 @@ def _rebuild(record: WorkspaceRecord) -> Any:
             tolerance=summary["tolerance"],
             elapsed=summary["elapsed"],
         )
-    from hexapod_workspace.core.projected import ProjectedWorkspace
+    from hexapod_workspace.core.workspaces.projected import ProjectedWorkspace
 
     return ProjectedWorkspace(
         method=WorkspaceKind(kind).label,

@@ -16,12 +16,12 @@ from typing import IO, TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.constraint_table import CONSTRAINTS, SINGULARITY
-from ..core.constraints import CheckResult
-from ..core.manipulator import Manipulator
-from ..core.orientation import OrientationWorkspace, TorsionRange
-from ..core.projected import ProjectedWorkspace
-from ..core.resolution import WorkspaceKind
+from ..core.base.resolution import WorkspaceKind
+from ..core.constraints.table import CONSTRAINTS, SINGULARITY
+from ..core.evaluation.check import CheckResult
+from ..core.model.manipulator import Manipulator
+from ..core.workspaces.orientation import OrientationWorkspace, TorsionRange
+from ..core.workspaces.projected import ProjectedWorkspace
 
 if TYPE_CHECKING:  # the log reports only: `check` need not load the logs layer
     from ..logs.summary import AtlasRecord, LogSummary, PoseCheckCall, WorkspaceRecord

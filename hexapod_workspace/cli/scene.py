@@ -19,16 +19,22 @@ from typing import IO, Any
 
 import numpy as np
 
-from ..core.collision import CollisionScene, collision_scene, require_free_home
-from ..core.frames import cell_from_params_file
-from ..core.manipulator import Manipulator
-from ..core.params import load_params_file
-from ..core.projected import projected_workspace
-from ..core.resolution import Method
-from ..core.rotations import tt_to_matrix
-from ..core.scene_view import SceneView, cone_of, scene_view
+from ..core.base.params import load_params_file
+from ..core.base.resolution import Method
+from ..core.base.rotations import tt_to_matrix
+from ..core.cell.frames import cell_from_params_file
+from ..core.cell.scene_view import SceneView, cone_of, scene_view
+from ..core.model.collision import CollisionScene, collision_scene, require_free_home
+from ..core.model.manipulator import Manipulator
+from ..core.workspaces.projected import projected_workspace
 from ..errors import UnreachableReferenceError
-from .inputs import PLOT_FORMATS, CliError, configured_manipulator, finite, output_file
+from .inputs import (
+    PLOT_FORMATS,
+    CliError,
+    configured_manipulator,
+    finite,
+    output_file,
+)
 from .reports import write_json
 
 __all__ = ["CONE_AZIMUTHS", "cmd_scene", "config_scene", "scene_arguments", "view_at"]
@@ -166,7 +172,7 @@ def first_violation(result: Any) -> tuple[str, np.ndarray, np.ndarray] | None:
     ``what`` is ``"waypoint k"`` or ``"move k at s = …"`` (0-based, as the report); None when
     the path runs.
     """
-    from ..core.path_results import reported_parts
+    from ..core.motions.results import reported_parts
 
     path, _ = reported_parts(result)
     waypoints, segments = path.waypoints, path.segments

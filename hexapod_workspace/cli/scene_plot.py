@@ -1,6 +1,6 @@
 """The scene in 3-D: machine, tool, obstacles, the closest pair, the cone of tool directions.
 
-Draws a :class:`~hexapod_workspace.core.scene_view.SceneView` on a 3-D axes of matplotlib's
+Draws a :class:`~hexapod_workspace.core.cell.scene_view.SceneView` on a 3-D axes of matplotlib's
 object API (no pyplot, no global backend: the module is safe inside applications that use
 matplotlib themselves). Used by ``scene --plot`` (one pose) and by ``check-path --plot`` (the
 machine at the path's first violation, beside the margins).
@@ -20,8 +20,8 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.rotations import matrix_to_tt
-from ..core.scene_view import Body, SceneView
+from ..core.base.rotations import matrix_to_tt
+from ..core.cell.scene_view import Body, SceneView
 
 if TYPE_CHECKING:
     from mpl_toolkits.mplot3d import Axes3D

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.rotations import ANGLE_CONVENTIONS
+from ..core.base.rotations import ANGLE_CONVENTIONS
 from ..errors import InputError
 
 __all__ = [

@@ -12,7 +12,14 @@ Adds mcap and rosbags to the core; imports nothing from :mod:`hexapod_workspace.
 """
 
 from .fields import build_message, deserialize, message_to_fields, serialize
-from .reader import LogContents, LogMessage, TopicInfo, iter_log, read_log, recover_log
+from .reader import (
+    LogContents,
+    LogMessage,
+    TopicInfo,
+    iter_log,
+    read_log,
+    recover_log,
+)
 from .typestore import (
     INTERFACE_PACKAGE,
     REQUEST_QOS,

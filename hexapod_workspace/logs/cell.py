@@ -14,9 +14,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..core.frames import CellFrames
-from ..core.reach import AXES, Reach
-from ..core.speeds import FeedLimits
+from ..core.cell.frames import CellFrames
+from ..core.cell.reach import AXES, Reach
+from ..core.motions.speeds import FeedLimits
 from . import messages
 
 __all__ = [
@@ -60,7 +60,7 @@ def segment_speed_fields(
     Parameters
     ----------
     speeds : FeedLimits
-        :func:`hexapod_workspace.core.speeds.feed_limits` of the moves.
+        :func:`hexapod_workspace.core.motions.speeds.feed_limits` of the moves.
     rapid : array_like of bool, shape (M,)
     feeds : array_like, shape (M,)
         Feed used per move, m/s (NaN: none).
@@ -113,8 +113,9 @@ def axis_limits_fields(
     cell: CellFrames | None,
     message: str,
 ) -> dict[str, Any]:
-    """hexapod_workspace_msgs/msg/AxisLimits of :func:`hexapod_workspace.core.reach.axis_limits`
-    (``limits`` None: a failure, ``message`` the reason)."""
+    """hexapod_workspace_msgs/msg/AxisLimits of
+    :func:`hexapod_workspace.core.cell.reach.axis_limits` (``limits`` None: a failure, ``message``
+    the reason)."""
     x, y, z, w = (float(v) for v in np.asarray(quaternion, dtype=float).reshape(4))
     fields: dict[str, Any] = {
         "header": messages.header_fields(stamp_ns, frame_id),

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..core.params import NODE_NAME
+from ..core.base.params import NODE_NAME
 
 __all__ = [
     "INTERFACES",

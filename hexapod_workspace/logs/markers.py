@@ -1,4 +1,4 @@
-"""A scene (:class:`~hexapod_workspace.core.scene_view.SceneView`) as
+"""A scene (:class:`~hexapod_workspace.core.cell.scene_view.SceneView`) as
 ``visualization_msgs/MarkerArray`` fields: what the node publishes on ``~/markers`` and
 records. ROS-free (field dicts; the node turns them into rclpy messages, the logs into CDR).
 
@@ -32,8 +32,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.rotations import matrix_to_quaternion
-from ..core.scene_view import Body, SceneView
+from ..core.base.rotations import matrix_to_quaternion
+from ..core.cell.scene_view import Body, SceneView
 
 __all__ = ["MARKER_ARRAY_TYPE", "NAMESPACES", "marker_array_fields"]
 

@@ -17,16 +17,16 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
-from ..core.orientation import OrientationWorkspace
-from ..core.projected import ProjectedWorkspace
-from ..core.resolution import WorkspaceKind
-from ..core.rotations import approach_vector
+from ..core.base.resolution import WorkspaceKind
+from ..core.base.rotations import approach_vector
+from ..core.workspaces.orientation import OrientationWorkspace
+from ..core.workspaces.projected import ProjectedWorkspace
 from .interfaces import TOPICS, TYPES
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike, NDArray
 
-    from hexapod_workspace.core.constraints import CheckResult
+    from hexapod_workspace.core.evaluation.check import CheckResult
 
 __all__ = [
     "POINT_FIELD_NAMES",

@@ -15,8 +15,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core.paths import INTERPOLATIONS, PathCheck, SegmentChecks, TorsionPlan, reported_parts
-from ..core.rotations import matrix_to_quaternion, tt_to_matrix
+from ..core.base.rotations import matrix_to_quaternion, tt_to_matrix
+from ..core.motions import (
+    INTERPOLATIONS,
+    PathCheck,
+    SegmentChecks,
+    TorsionPlan,
+    reported_parts,
+)
 from . import messages
 from .interfaces import interface
 
@@ -181,7 +187,7 @@ def check_path_response_fields(
         Default: a one-line verdict (see :func:`path_verdict`).
     baseline : PathCheck, optional
         The ψ = 0 baseline of a path of fixed orientations
-        (:func:`hexapod_workspace.core.baseline.reported_baseline`); a plan's is its own.
+        (:func:`hexapod_workspace.core.motions.baseline.reported_baseline`); a plan's is its own.
     """
     path, plan = reported_parts(result)
     waypoints = path.waypoints

@@ -6,7 +6,7 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from hexapod_workspace.core.resolution import WorkspaceKind
+from hexapod_workspace.core.base.resolution import WorkspaceKind
 from hexapod_workspace.errors import RecordingError
 from hexapod_workspace.logs import (
     RESULT_QOS,

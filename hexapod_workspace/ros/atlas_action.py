@@ -33,7 +33,7 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import PointCloud2, PointField
 
-from ..core.atlas import ATLAS_VARIABLES, AtlasGrid, AtlasOptions, dexterous_mask
+from ..core.workspaces.atlas import ATLAS_VARIABLES, AtlasGrid, AtlasOptions, dexterous_mask
 from ..errors import HexapodWorkspaceError
 from ..logs import qos_profile_text
 from ..logs.interfaces import relative_name
@@ -109,7 +109,7 @@ def attach_atlas_action(
     node : rclpy.node.Node
         Spun by a multi-threaded executor (the action runs in its own callback group).
     manipulator : callable
-        Returns the node's current :class:`~hexapod_workspace.core.manipulator.Manipulator`
+        Returns the node's current :class:`~hexapod_workspace.core.model.manipulator.Manipulator`
         (read when a goal starts, so a parameter change applies to the next goal).
     recorder : object, optional
         With ``add_channel(topic, msgtype, qos_text)`` and ``write(topic, message)`` (the node's

@@ -2,8 +2,8 @@
 ``~/axis_limits``, and the cell's lines on ``/diagnostics``.
 
 Frames
-    The node's model is the tool model (:func:`hexapod_workspace.core.frames.tool_model`) of the
-    parameters' platform and the active tool (``tool.number``: 0 = ``tool.offset`` and
+    The node's model is the tool model (:func:`hexapod_workspace.core.cell.frames.tool_model`) of
+    the parameters' platform and the active tool (``tool.number``: 0 = ``tool.offset`` and
     ``tool.orientation``, n = ``tools.T<n>.*``), so every pose it takes and returns is the tool
     centre point's. A request's poses are in the frame its ``header.frame_id`` names: the base
     frame ``frame_id`` (or ``""``, as before frames existed), or the work frame
@@ -14,9 +14,9 @@ Frames
 Run-time changes
     ``tool.*``, ``tools.T<n>.*``, ``work.*`` and ``limits.actuator_speed_max`` are parameters like
     the model's: validated as a whole set (the model by
-    :func:`~hexapod_workspace.core.loading.require_usable`, the cell by
-    :func:`~hexapod_workspace.core.frames.cell_from_mapping`), swapped in as one state between two
-    requests, and every change, accepted or refused, is recorded in the log
+    :func:`~hexapod_workspace.core.evaluation.loading.require_usable`, the cell by
+    :func:`~hexapod_workspace.core.cell.frames.cell_from_mapping`), swapped in as one state between
+    two requests, and every change, accepted or refused, is recorded in the log
     (``/hexapod_workspace/parameter_changes``, ``ParameterChange``) and shown on
     ``/diagnostics`` (:class:`CellStatus`). A tool-table entry not given at start is declared
     when a client first sets it (:func:`new_dynamic_parameters`).
@@ -24,7 +24,7 @@ Run-time changes
     ``collision.obstacles.names`` plus one group ``collision.obstacles.<name>.*`` per name) is
     declared the same way: the names the parameters file gives, and any a client sets (an
     obstacle added: its name in the list and its group in one atomic call). The whole scene
-    is checked by :func:`~hexapod_workspace.core.collision.params.collision_scene` as part of
+    is checked by :func:`~hexapod_workspace.core.model.collision.params.collision_scene` as part of
     the model (the CLI's one validation); an obstacle is removed by taking its name off the
     list and unsetting its group in one call.
 Feeds
@@ -54,16 +54,16 @@ import numpy as np
 from hexapod_workspace_msgs.msg import AxisLimits, CellFrames, ParameterChange
 from numpy.typing import NDArray
 
-from hexapod_workspace.core.frames import work_to_base
-from hexapod_workspace.core.paths import PathCheck, TorsionPlan, reported_parts
-from hexapod_workspace.core.reach import axis_limits
-from hexapod_workspace.core.rotations import (
+from hexapod_workspace.core.base.rotations import (
     matrix_to_quaternion,
     matrix_to_tt,
     quaternion_to_matrix,
     tt_to_matrix,
 )
-from hexapod_workspace.core.speeds import actuator_rates, feed_limits
+from hexapod_workspace.core.cell.frames import work_to_base
+from hexapod_workspace.core.cell.reach import axis_limits
+from hexapod_workspace.core.motions import PathCheck, TorsionPlan, reported_parts
+from hexapod_workspace.core.motions.speeds import actuator_rates, feed_limits
 from hexapod_workspace.errors import InputError
 from hexapod_workspace.logs import REQUEST_QOS
 from hexapod_workspace.logs.cell import (
@@ -390,7 +390,7 @@ class AxisLimitsPublisher:
         frame: str,
         work: Any,
     ) -> dict[str, Any]:
-        """:func:`~hexapod_workspace.core.reach.axis_limits` in the spawned process."""
+        """:func:`~hexapod_workspace.core.cell.reach.axis_limits` in the spawned process."""
         if self._pool is None:
             self._pool = ProcessPoolExecutor(  # the worker's policy, under a real-time node too
                 max_workers=1,

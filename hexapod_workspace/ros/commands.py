@@ -29,8 +29,8 @@ from numpy.typing import NDArray
 from rclpy.exceptions import InvalidHandle
 from rclpy.serialization import deserialize_message
 
-from hexapod_workspace.core.constraint_table import constraint_names
-from hexapod_workspace.core.constraints import check
+from hexapod_workspace.core.constraints.table import constraint_names
+from hexapod_workspace.core.evaluation.check import check
 from hexapod_workspace.errors import InputError
 from hexapod_workspace.logs import messages
 

@@ -4,7 +4,7 @@ The nested ``~/check_poses`` builds and (de)serialises one ``PoseCheck`` message
 10 µs a pose in rclpy, a hundred times the compiled check itself. This form carries the same
 verdicts in a handful of arrays: the request's angles as one ``float64[]`` (N × 3, row-major),
 the answer's margins as one ``float64[]`` (N × K, row-major) with the K constraint names once
-(``constraint_names``: the rows of :data:`hexapod_workspace.core.constraints.CONSTRAINT_NAMES`
+(``constraint_names``: the rows of :data:`hexapod_workspace.core.evaluation.check.CONSTRAINT_NAMES`
 that apply to the model, never counted here), ``reachable`` and ``limiting_leg`` one value per
 pose. The arrays go in and out of the messages as numpy buffers (``array.array`` for rclpy),
 with no Python loop per pose.
@@ -24,8 +24,8 @@ import numpy as np
 from hexapod_workspace_msgs.srv import CheckPosesFlat
 from numpy.typing import NDArray
 
-from hexapod_workspace.core.constraint_table import constraint_names
-from hexapod_workspace.core.constraints import CONSTRAINT_NAMES, CheckResult, check
+from hexapod_workspace.core.constraints.table import constraint_names
+from hexapod_workspace.core.evaluation.check import CONSTRAINT_NAMES, CheckResult, check
 from hexapod_workspace.errors import InputError
 
 from .cell import angles_to_base, frames_message

@@ -46,7 +46,7 @@ import rclpy
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.lifecycle import LifecycleState, TransitionCallbackReturn
 
-from hexapod_workspace.core import jit
+from hexapod_workspace.core.base import jit
 from hexapod_workspace.errors import ConfigError, InputError
 
 from .parameters import state_from

@@ -36,10 +36,10 @@ from typing import Any
 import numpy as np
 from visualization_msgs.msg import MarkerArray
 
-from ..core.collision import CollisionScene
-from ..core.projected import projected_workspace
-from ..core.rotations import quaternion_to_matrix
-from ..core.scene_view import Cone, cone_of, scene_view
+from ..core.base.rotations import quaternion_to_matrix
+from ..core.cell.scene_view import Cone, cone_of, scene_view
+from ..core.model.collision import CollisionScene
+from ..core.workspaces.projected import projected_workspace
 from ..errors import HexapodWorkspaceError
 from ..logs.interfaces import relative_name
 from ..logs.markers import marker_array_fields
@@ -57,7 +57,7 @@ def node_scene(state: Any) -> CollisionScene | None:
     """The collision scene of the node's configured state, or None.
 
     The one place the markers learn the scene: the model's own scene
-    (:attr:`~hexapod_workspace.core.manipulator.Manipulator.collision`, read from
+    (:attr:`~hexapod_workspace.core.model.manipulator.Manipulator.collision`, read from
     ``collision.*``); None without one (the machine is then drawn without obstacles).
     """
     scene = getattr(getattr(state, "manipulator", None), "collision", None)

@@ -82,10 +82,12 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from rclpy.serialization import serialize_message
 
 from hexapod_workspace._resources import example_config_path
-from hexapod_workspace.core import kernels, params, planner_kernels
-from hexapod_workspace.core.constraints import check
-from hexapod_workspace.core.manipulator import Manipulator
-from hexapod_workspace.core.params import NODE_PARAMETERS, ROS_PARAMETERS, unknown_parameter
+from hexapod_workspace.core import kernels
+from hexapod_workspace.core.base import params
+from hexapod_workspace.core.base.params import NODE_PARAMETERS, ROS_PARAMETERS, unknown_parameter
+from hexapod_workspace.core.evaluation.check import check
+from hexapod_workspace.core.kernels import planner as planner_kernels
+from hexapod_workspace.core.model.manipulator import Manipulator
 from hexapod_workspace.errors import ConfigError, InputError
 from hexapod_workspace.logs import (
     REQUEST_QOS,
@@ -99,7 +101,12 @@ from hexapod_workspace.logs.interfaces import relative_name
 
 from . import cell, health
 from .commands import CommandStream
-from .conversions import angles_from_orientations, position_from_point, to_message, type_name
+from .conversions import (
+    angles_from_orientations,
+    position_from_point,
+    to_message,
+    type_name,
+)
 from .flat import attach as attach_flat
 from .lifecycle import ManagedTransitions, autostart_from_argv
 from .parameters import (

@@ -3,12 +3,13 @@
 One table (:func:`parameter_specs`) declares every parameter: name, default, description and the
 range or read-only flag shown by ``ros2 param describe``. The manipulator model's names and
 defaults are those of :meth:`hexapod_workspace.Manipulator.to_parameters` for the packaged
-example GPM; the resolution bounds and defaults come from :mod:`hexapod_workspace.core.resolution`.
+example GPM; the resolution bounds and defaults come from
+:mod:`hexapod_workspace.core.base.resolution`.
 
 :func:`refusal` checks one parameter as a client sent it (unknown name, wrong type, read-only,
 out of range) and :func:`state_from` the would-be full set (it builds the
 :class:`~hexapod_workspace.Manipulator` and refuses an unusable one with
-:func:`~hexapod_workspace.core.loading.require_usable`): the node's start-up and run-time
+:func:`~hexapod_workspace.core.evaluation.loading.require_usable`): the node's start-up and run-time
 validation are this one function, and every refusal names the parameter and the value given.
 
 The packaged example stands in for the model only when the node is given no model parameter at
@@ -32,21 +33,21 @@ from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescri
 from rclpy.parameter import Parameter
 
 from hexapod_workspace._resources import example_config_path
-from hexapod_workspace.core import resolution
-from hexapod_workspace.core.architectures import ARCHITECTURES
-from hexapod_workspace.core.frames import (
+from hexapod_workspace.core.base import resolution
+from hexapod_workspace.core.cell.frames import (
     CELL_DEFAULTS,
     CellFrames,
     cell_from_mapping,
     require_plausible_cell,
     tool_model,
 )
-from hexapod_workspace.core.loading import (
+from hexapod_workspace.core.evaluation.loading import (
     load_manipulator,
     manipulator_from_mapping,
     require_usable,
 )
-from hexapod_workspace.core.manipulator import (
+from hexapod_workspace.core.model.architectures import ARCHITECTURES
+from hexapod_workspace.core.model.manipulator import (
     ARCHITECTURE_PARAMETERS,
     PARAMETER_DEFAULTS,
     Manipulator,
@@ -73,7 +74,7 @@ __all__ = [
     "tool_table_specs",
 ]
 
-#: Parameter ranges: the core's resolution bounds (one definition, core/resolution.py).
+#: Parameter ranges: the core's resolution bounds (one definition, core/base/resolution.py).
 RAYS_RANGE = (resolution.MIN_RAYS, resolution.MAX_RAYS)
 PROJECTED_METHODS = tuple(method.value for method in resolution.Method)
 
@@ -334,7 +335,7 @@ def parameter_specs() -> dict[str, Spec]:
     return {spec.name: spec for spec in specs}
 
 
-#: The machining cell's parameters (hexapod_workspace.core.frames), settable at run time.
+#: The machining cell's parameters (hexapod_workspace.core.cell.frames), settable at run time.
 CELL_DESCRIPTIONS = {
     "tool.offset": (
         "Tool centre point C in the platform frame (the frame of geometry.platform_joints), m, "
@@ -419,7 +420,7 @@ def tool_table_specs(names: Iterable[str]) -> dict[str, Spec]:
 #: The collision scene's parameter names (``collision.*``): declared like the tool table, from
 #: the parameters given at start or when a client first sets one (an obstacle added at run
 #: time); their names and values are checked as a whole by
-#: :func:`~hexapod_workspace.core.collision.params.collision_scene`.
+#: :func:`~hexapod_workspace.core.model.collision.params.collision_scene`.
 COLLISION_NAME = re.compile(r"^collision\.[A-Za-z0-9_.]+$")
 #: Descriptions of the collision parameters by their last name part.
 COLLISION_DESCRIPTIONS = {
@@ -480,7 +481,7 @@ class State:
     ----------
     manipulator : Manipulator
         The model that answers for tool-frame poses
-        (:func:`~hexapod_workspace.core.frames.tool_model` of ``platform`` and the active
+        (:func:`~hexapod_workspace.core.cell.frames.tool_model` of ``platform`` and the active
         tool): what every check uses.
     settings : Settings
     platform : Manipulator

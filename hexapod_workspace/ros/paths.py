@@ -35,9 +35,9 @@ from numpy.typing import NDArray
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.callback_groups import ReentrantCallbackGroup
 
-from ..core.baseline import reported_baseline
-from ..core.manipulator import Manipulator
-from ..core.paths import (
+from ..core.base.rotations import matrix_to_tt, quaternion_to_matrix, tt_to_matrix, wrap_angle
+from ..core.model.manipulator import Manipulator
+from ..core.motions import (
     DEFAULT_PATH_TOLERANCE,
     DEFAULT_PLAN_PSI_STEP,
     INTERPOLATIONS,
@@ -48,9 +48,15 @@ from ..core.paths import (
     plan_torsion,
     report_singularity,
 )
-from ..core.rotations import matrix_to_tt, quaternion_to_matrix, tt_to_matrix, wrap_angle
+from ..core.motions.baseline import reported_baseline
 from ..errors import HexapodWorkspaceError, InputError
-from ..logs import REQUEST_QOS, SERVICE_QOS, messages, recorded_type, service_topics
+from ..logs import (
+    REQUEST_QOS,
+    SERVICE_QOS,
+    messages,
+    recorded_type,
+    service_topics,
+)
 from ..logs import paths as path_fields
 from ..logs.interfaces import relative_name
 from . import cell

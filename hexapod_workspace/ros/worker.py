@@ -27,10 +27,13 @@ from typing import Any
 
 import numpy as np
 
-from hexapod_workspace.core.manipulator import Manipulator
-from hexapod_workspace.core.orientation import OrientationWorkspace, orientation_workspace
-from hexapod_workspace.core.projected import ProjectedWorkspace, projected_workspace
-from hexapod_workspace.core.resolution import WorkspaceKind
+from hexapod_workspace.core.base.resolution import WorkspaceKind
+from hexapod_workspace.core.model.manipulator import Manipulator
+from hexapod_workspace.core.workspaces.orientation import (
+    OrientationWorkspace,
+    orientation_workspace,
+)
+from hexapod_workspace.core.workspaces.projected import ProjectedWorkspace, projected_workspace
 from hexapod_workspace.errors import HexapodWorkspaceError
 from hexapod_workspace.logs import messages
 

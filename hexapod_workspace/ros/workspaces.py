@@ -29,7 +29,7 @@ from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from sensor_msgs.msg import PointCloud2
 from std_srvs.srv import Trigger
 
-from hexapod_workspace.core.resolution import WorkspaceKind
+from hexapod_workspace.core.base.resolution import WorkspaceKind
 from hexapod_workspace.errors import InputError, UnreachableReferenceError
 from hexapod_workspace.logs import messages, qos_profile_text
 from hexapod_workspace.logs.cell import cell_frames_fields

@@ -25,7 +25,7 @@ from hexapod_workspace import (
     projected_workspace,
     torsion_range,
 )
-from hexapod_workspace.core.loading import example_manipulator, manipulator_from_mapping
+from hexapod_workspace.core.evaluation.loading import example_manipulator, manipulator_from_mapping
 
 CONSTRAINTS = ("leg_length", "base_joint", "platform_joint", "leg_interference")
 

@@ -15,7 +15,7 @@ from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.serialization import serialize_message
 
 from hexapod_workspace._resources import example_config_path
-from hexapod_workspace.core.loading import load_manipulator
+from hexapod_workspace.core.evaluation.loading import load_manipulator
 from hexapod_workspace.logs import LogWriter
 from hexapod_workspace.ros.atlas_action import attach_atlas_action
 

@@ -17,7 +17,7 @@ import pytest
 from ros_support import RosClient, domain_selector, running_node
 
 from hexapod_workspace import Manipulator
-from hexapod_workspace.core.loading import load_manipulator
+from hexapod_workspace.core.evaluation.loading import load_manipulator
 
 
 @pytest.fixture(scope="module")

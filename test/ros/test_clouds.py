@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hexapod_workspace.core.loading import load_manipulator
+from hexapod_workspace.core.evaluation.loading import load_manipulator
 from hexapod_workspace.logs import messages
 from hexapod_workspace.ros.clouds import decimated_cloud_fields
 
@@ -46,7 +46,7 @@ def test_the_worker_hands_the_log_a_cloud_bounded_to_record_points(
     from sensor_msgs.msg import PointCloud2
 
     from hexapod_workspace._resources import example_config_path
-    from hexapod_workspace.core.resolution import WorkspaceKind
+    from hexapod_workspace.core.base.resolution import WorkspaceKind
     from hexapod_workspace.ros.clouds import CloudTopics
     from hexapod_workspace.ros.worker import WorkspaceJob, WorkspaceWorker
 

@@ -24,7 +24,10 @@ from rclpy.parameter import Parameter  # noqa: E402
 
 from hexapod_workspace import check  # noqa: E402
 from hexapod_workspace._resources import example_config_path  # noqa: E402
-from hexapod_workspace.core.loading import example_manipulator, load_manipulator  # noqa: E402
+from hexapod_workspace.core.evaluation.loading import (  # noqa: E402
+    example_manipulator,
+    load_manipulator,
+)
 from hexapod_workspace.errors import ConfigError  # noqa: E402
 from hexapod_workspace.ros.node import WorkspaceNode  # noqa: E402
 from hexapod_workspace.ros.parameters import command_line_override_names  # noqa: E402

@@ -39,7 +39,7 @@ from std_msgs.msg import Empty  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 
 from hexapod_workspace import logs  # noqa: E402
-from hexapod_workspace.core.resolution import WorkspaceKind  # noqa: E402
+from hexapod_workspace.core.base.resolution import WorkspaceKind  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # test/recording_support.py
 from recording_support import (  # noqa: E402

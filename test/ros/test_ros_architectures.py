@@ -23,8 +23,8 @@ from hexapod_workspace_msgs.msg import TiltTorsion, WorkspaceRequest  # noqa: E4
 from hexapod_workspace_msgs.srv import CheckPath, CheckPoses  # noqa: E402
 
 from hexapod_workspace import check, projected_workspace  # noqa: E402
-from hexapod_workspace.core.loading import load_manipulator  # noqa: E402
-from hexapod_workspace.core.rotations import matrix_to_quaternion, tt_to_matrix  # noqa: E402
+from hexapod_workspace.core.base.rotations import matrix_to_quaternion, tt_to_matrix  # noqa: E402
+from hexapod_workspace.core.evaluation.loading import load_manipulator  # noqa: E402
 from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402
 
 NODE = "/hexapod_workspace"

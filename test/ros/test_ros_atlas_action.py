@@ -22,7 +22,7 @@ from rclpy.action import ActionClient  # noqa: E402
 from sensor_msgs.msg import PointCloud2  # noqa: E402
 
 from hexapod_workspace import AtlasOptions  # noqa: E402
-from hexapod_workspace.core.atlas import position_capability  # noqa: E402
+from hexapod_workspace.core.workspaces.atlas import position_capability  # noqa: E402
 from hexapod_workspace.logs import read_log  # noqa: E402
 from hexapod_workspace.ros.atlas_action import CLOUD_FIELDS  # noqa: E402
 

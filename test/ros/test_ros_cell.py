@@ -4,7 +4,7 @@ on ~/check_path, ~/axis_limits.
 The node runs from the install space (another process) with a cell parameters file; every
 verdict is compared with the ROS-free core on the *platform* model at the platform pose the tool
 pose denotes, computed here with plain 4x4 homogeneous transforms written from the definitions
-(``T_OP = T_OC · T_PC⁻¹``, ``T_OC = T_OW · T_WC``), not with hexapod_workspace.core.frames.
+(``T_OP = T_OC · T_PC⁻¹``, ``T_OC = T_OW · T_WC``), not with hexapod_workspace.core.cell.frames.
 """
 
 from __future__ import annotations
@@ -35,15 +35,15 @@ from rcl_interfaces.msg import ParameterType, ParameterValue  # noqa: E402
 from rcl_interfaces.srv import GetParameters, SetParameters  # noqa: E402
 
 from hexapod_workspace import check, check_path  # noqa: E402
-from hexapod_workspace.core.frames import cell_from_params_file, tool_model  # noqa: E402
-from hexapod_workspace.core.loading import load_manipulator  # noqa: E402
-from hexapod_workspace.core.manipulator import Manipulator  # noqa: E402
-from hexapod_workspace.core.reach import AXES, axis_limits  # noqa: E402
-from hexapod_workspace.core.rotations import (  # noqa: E402
+from hexapod_workspace.core.base.rotations import (  # noqa: E402
     matrix_to_quaternion,
     matrix_to_tt,
 )
-from hexapod_workspace.core.speeds import actuator_rates, feed_limits  # noqa: E402
+from hexapod_workspace.core.cell.frames import cell_from_params_file, tool_model  # noqa: E402
+from hexapod_workspace.core.cell.reach import AXES, axis_limits  # noqa: E402
+from hexapod_workspace.core.evaluation.loading import load_manipulator  # noqa: E402
+from hexapod_workspace.core.model.manipulator import Manipulator  # noqa: E402
+from hexapod_workspace.core.motions.speeds import actuator_rates, feed_limits  # noqa: E402
 from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402
 
 NODE = "/hexapod_workspace"
@@ -295,7 +295,7 @@ def test_work_frame_poses_on_every_interface(client, ros_client, platform):
 
 
 def cell_tool():
-    from hexapod_workspace.core.frames import Tool
+    from hexapod_workspace.core.cell.frames import Tool
 
     return Tool(np.array(TOOL_OFFSET), np.array(TOOL_ANGLES))
 
@@ -494,7 +494,7 @@ def test_a_workspace_is_the_tool_centre_points_and_says_its_frames(client, platf
     from std_srvs.srv import Trigger
 
     from hexapod_workspace import projected_workspace
-    from hexapod_workspace.core import resolution
+    from hexapod_workspace.core.base import resolution
 
     summaries = client.collect(WorkspaceSummary, f"{NODE}/workspace_summary")
     response = client.call(Trigger, f"{NODE}/compute_projected_workspace", Trigger.Request())

@@ -34,9 +34,9 @@ from rcl_interfaces.srv import SetParameters  # noqa: E402
 from visualization_msgs.msg import Marker, MarkerArray  # noqa: E402
 
 from hexapod_workspace import Manipulator, check, check_path  # noqa: E402
-from hexapod_workspace.core.loading import manipulator_from_mapping  # noqa: E402
-from hexapod_workspace.core.params import flatten  # noqa: E402
-from hexapod_workspace.core.rotations import matrix_to_quaternion, tt_to_matrix  # noqa: E402
+from hexapod_workspace.core.base.params import flatten  # noqa: E402
+from hexapod_workspace.core.base.rotations import matrix_to_quaternion, tt_to_matrix  # noqa: E402
+from hexapod_workspace.core.evaluation.loading import manipulator_from_mapping  # noqa: E402
 from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402
 
 NODE = "/hexapod_workspace"

@@ -17,7 +17,7 @@ from rclpy.serialization import deserialize_message, serialize_message  # noqa: 
 from sensor_msgs.msg import PointCloud2  # noqa: E402
 
 from hexapod_workspace import check  # noqa: E402
-from hexapod_workspace.core.resolution import WorkspaceKind  # noqa: E402
+from hexapod_workspace.core.base.resolution import WorkspaceKind  # noqa: E402
 from hexapod_workspace.logs import messages  # noqa: E402
 from hexapod_workspace.ros.conversions import (  # noqa: E402
     angles_from_orientations,

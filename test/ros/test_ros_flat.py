@@ -18,7 +18,7 @@ from hexapod_workspace_msgs.srv import CheckPoses, CheckPosesFlat  # noqa: E402
 from test_ros_node import check_request, sample_angles  # noqa: E402
 
 from hexapod_workspace import check, logs  # noqa: E402
-from hexapod_workspace.core.loading import load_manipulator  # noqa: E402
+from hexapod_workspace.core.evaluation.loading import load_manipulator  # noqa: E402
 from hexapod_workspace.errors import InputError  # noqa: E402
 from hexapod_workspace.logs.summary import summarize_log  # noqa: E402
 from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402

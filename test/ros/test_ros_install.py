@@ -73,17 +73,15 @@ def node_graph(ros_client, tmp_path_factory):
                 **dict(ros_client.node.get_service_names_and_types()),
             }
 
-        service = messages.TOPICS["compute_projected_workspace"]
-        action = messages.TOPICS["compute_workspace"] + "/_action/send_goal"
+        # Every unconditional row of the table, subscriptions included: discovery announces a
+        # node's endpoints one by one, so waiting for a few of them raced the rest under load.
+        expected = {
+            f"{r.name}/_action/send_goal" if r.kind == "action" else r.name
+            for r in interfaces.INTERFACES
+            if not r.condition
+        }
         ros_client.spin_until(
-            lambda: {
-                wanted,
-                service,
-                action,
-                "/diagnostics",
-                f"{NODE}/compute_atlas/_action/send_goal",
-            }
-            <= set(offered()),
+            lambda: {wanted, "/diagnostics", *expected} <= set(offered()),
             what="the node's interfaces",
             timeout=60.0,
         )

@@ -29,7 +29,7 @@ from rcl_interfaces.msg import ParameterType, ParameterValue  # noqa: E402
 from rcl_interfaces.srv import SetParameters  # noqa: E402
 
 from hexapod_workspace import check, logs  # noqa: E402
-from hexapod_workspace.core.loading import load_manipulator  # noqa: E402
+from hexapod_workspace.core.evaluation.loading import load_manipulator  # noqa: E402
 
 NODE = "/hexapod_workspace"
 MANUAL = ["--autostart=false"]

@@ -2,7 +2,7 @@
 and the same scene in its MCAP log as rosbags, mcap_ros2 and Foxglove's libraries read it.
 
 Every marker is compared with the ROS-free geometry computed here from the same parameters file
-(:func:`hexapod_workspace.core.legs.leg_endpoints`, the projected workspace of the core).
+(:func:`hexapod_workspace.core.model.legs.leg_endpoints`, the projected workspace of the core).
 """
 
 from __future__ import annotations
@@ -20,13 +20,13 @@ require_ros()
 from geometry_msgs.msg import PoseStamped  # noqa: E402
 from visualization_msgs.msg import Marker, MarkerArray  # noqa: E402
 
-from hexapod_workspace.core.legs import leg_endpoints  # noqa: E402
-from hexapod_workspace.core.projected import projected_workspace  # noqa: E402
-from hexapod_workspace.core.rotations import (  # noqa: E402
+from hexapod_workspace.core.base.rotations import (  # noqa: E402
     matrix_to_quaternion,
     quaternion_to_matrix,
     tt_to_matrix,
 )
+from hexapod_workspace.core.model.legs import leg_endpoints  # noqa: E402
+from hexapod_workspace.core.workspaces.projected import projected_workspace  # noqa: E402
 from hexapod_workspace.ros.markers import CONE_AZIMUTHS  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # test/recording_support.py
@@ -154,7 +154,7 @@ def test_obstacles_appear_once_the_state_carries_a_collision_scene(ros_context, 
 
     from rclpy.parameter import Parameter
 
-    from hexapod_workspace.core.collision import collision_scene
+    from hexapod_workspace.core.model.collision import collision_scene
     from hexapod_workspace.ros.markers import attach
     from hexapod_workspace.ros.node import WorkspaceNode
 

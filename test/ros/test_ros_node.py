@@ -29,7 +29,7 @@ from hexapod_workspace import (  # noqa: E402
     check,
     logs,
 )
-from hexapod_workspace.core.loading import manipulator_from_mapping  # noqa: E402
+from hexapod_workspace.core.evaluation.loading import manipulator_from_mapping  # noqa: E402
 from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402
 
 #: The constraints of a 6-UPS model: the names the node gives for the example (the rows of the
@@ -302,15 +302,15 @@ def test_parameters_have_descriptors(client):
 
 def test_a_parameters_file_check_knows_every_parameter_of_the_node(client):
     """The CLI refuses unknown names in a parameters file, so it must know every name
-    the node declares (core.params.NODE_PARAMETERS + the model's + the machining cell's + ROS's
+    the node declares (core.base.params.NODE_PARAMETERS + the model's + the machining cell's + ROS's
     own), and no more."""
-    from hexapod_workspace.core.manipulator import PARAMETER_DEFAULTS
-    from hexapod_workspace.core.params import (
+    from hexapod_workspace.core.base.params import (
         CELL_PARAMETERS,
         NODE_PARAMETERS,
         ROS_PARAMETERS,
         unknown_parameter,
     )
+    from hexapod_workspace.core.model.manipulator import PARAMETER_DEFAULTS
 
     listed = client.call(ListParameters, f"{NODE}/list_parameters", ListParameters.Request())
     names = set(listed.result.names)

@@ -27,13 +27,13 @@ from hexapod_workspace_msgs.msg import (  # noqa: E402
 from hexapod_workspace_msgs.srv import CheckPath, CheckPoses  # noqa: E402
 
 from hexapod_workspace import check, check_path, plan_torsion  # noqa: E402
-from hexapod_workspace.core.baseline import psi_zero_baseline  # noqa: E402
-from hexapod_workspace.core.rotations import (  # noqa: E402
+from hexapod_workspace.core.base.rotations import (  # noqa: E402
     approach_vector,
     matrix_to_quaternion,
     quaternion_to_matrix,
     tt_to_matrix,
 )
+from hexapod_workspace.core.motions.baseline import psi_zero_baseline  # noqa: E402
 from hexapod_workspace.ros.conversions import margins_by_name  # noqa: E402
 
 NODE = "/hexapod_workspace"

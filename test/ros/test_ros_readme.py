@@ -27,7 +27,7 @@ require_ros()
 from rclpy.parameter import Parameter  # noqa: E402
 
 from hexapod_workspace import logs  # noqa: E402
-from hexapod_workspace.core.loading import example_manipulator  # noqa: E402
+from hexapod_workspace.core.evaluation.loading import example_manipulator  # noqa: E402
 from hexapod_workspace.ros.node import EXTENSIONS, NODE_NAME, WorkspaceNode  # noqa: E402
 from hexapod_workspace.ros.parameters import MODEL_DESCRIPTIONS, parameter_specs  # noqa: E402
 

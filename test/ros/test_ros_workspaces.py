@@ -31,9 +31,9 @@ from hexapod_workspace_msgs.srv import CheckPoses  # noqa: E402
 from sensor_msgs.msg import PointCloud2, PointField  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 
-from hexapod_workspace.core.orientation import orientation_workspace  # noqa: E402
-from hexapod_workspace.core.projected import projected_workspace  # noqa: E402
-from hexapod_workspace.core.resolution import WorkspaceKind  # noqa: E402
+from hexapod_workspace.core.base.resolution import WorkspaceKind  # noqa: E402
+from hexapod_workspace.core.workspaces.orientation import orientation_workspace  # noqa: E402
+from hexapod_workspace.core.workspaces.projected import projected_workspace  # noqa: E402
 from hexapod_workspace.logs import messages  # noqa: E402
 
 NODE = "/hexapod_workspace"

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from hexapod_workspace._resources import example_config_path
-from hexapod_workspace.core.loading import load_manipulator
-from hexapod_workspace.core.orientation import orientation_workspace
-from hexapod_workspace.core.resolution import WorkspaceKind
+from hexapod_workspace.core.base.resolution import WorkspaceKind
+from hexapod_workspace.core.evaluation.loading import load_manipulator
+from hexapod_workspace.core.workspaces.orientation import orientation_workspace
 from hexapod_workspace.ros.worker import (
     CanceledError,
     WorkspaceJob,
