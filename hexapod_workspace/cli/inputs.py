@@ -248,8 +248,12 @@ def configured_manipulator(
     err: IO[str],
     *,
     with_tool: bool = True,
+    loads_read: bool = False,
 ) -> Manipulator:
     """The manipulator of ``--config`` (default: the packaged example), at ``--position``.
+
+    ``loads_read``: the caller reads the loads' limits (``loads``), which the other commands
+    refuse (:func:`~hexapod_workspace.core.evaluation.loading.manipulator_from_mapping`).
 
     Warnings of the model (an unreachable home pose) go to ``err`` as one line each. With
     ``tool.offset`` / ``tool.orientation`` in the file, the model answers for the tool frame's
@@ -259,7 +263,7 @@ def configured_manipulator(
     path = Path(config) if config else example_config_path()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        manipulator = load_manipulator(path)
+        manipulator = load_manipulator(path, loads_read=loads_read)
     cell = require_plausible_cell(manipulator, cell_from_params_file(path))
     if with_tool:
         manipulator = tool_model(manipulator, cell.tool)
@@ -275,6 +279,18 @@ def configured_manipulator(
         msg = "--position" + str(error).removeprefix("position")
         raise CliError(msg) from error
     return manipulator.with_position(position)
+
+
+def tool_position(
+    given: NDArray[np.float64] | None, manipulator: Manipulator, platform: Manipulator
+) -> NDArray[np.float64]:
+    """``--position`` (m, base frame), refused when it fits only in millimetres, or the tool
+    model's ``pose.position`` when not given (``platform``: the model the hint sizes)."""
+    if given is None:
+        return manipulator.position
+    position = finite(given, "--position", "m")
+    plausible_positions(platform, position, "--position")
+    return position
 
 
 def plausible_positions(

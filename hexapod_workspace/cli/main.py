@@ -28,7 +28,7 @@ from .. import __version__
 from ..core import kernels
 from ..core.base import resolution
 from ..errors import HexapodWorkspaceError
-from . import atlas, cam, check_path, commands, linuxcnc, reach, scene
+from . import atlas, cam, check_path, commands, linuxcnc, loads, reach, scene
 from .inputs import (
     PLOT_FORMATS,
     CliError,
@@ -475,6 +475,13 @@ for _command in (
         reach.REACH_DESCRIPTION,
         reach.reach_arguments,
         reach.cmd_reach,
+    ),
+    Command(
+        "loads",
+        loads.LOADS_HELP,
+        loads.LOADS_DESCRIPTION,
+        loads.loads_arguments,
+        loads.cmd_loads,
     ),
     Command(
         "axis-limits",

@@ -57,8 +57,8 @@ from .inputs import (
     add_angles_option,
     configured_manipulator,
     finite,
-    plausible_positions,
     pose_flag,
+    tool_position,
 )
 
 __all__ = [
@@ -185,13 +185,7 @@ def _pose(
     )
     tool = cell.tool if options.tool is None else cell.select(options.tool)
     manipulator = tool_model(platform, tool)
-    position = (
-        manipulator.position
-        if options.position is None
-        else finite(options.position, "--position", "m")
-    )
-    if options.position is not None:
-        plausible_positions(platform, position, "--position")
+    position = tool_position(options.position, manipulator, platform)
     rotation = _given_pose(options).matrices()[0]
     frame_rotation = np.eye(3)
     if options.frame == "work":

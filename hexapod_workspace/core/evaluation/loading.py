@@ -80,6 +80,7 @@ from ..model.manipulator import (
     Manipulator,
 )
 from .check import home_pose_violations
+from .loads import LOAD_LIMITS, LOAD_PARAMETERS
 
 __all__ = [
     "HomePoseWarning",
@@ -92,7 +93,9 @@ __all__ = [
 ]
 
 
-def manipulator_from_mapping(parameters: Mapping[str, Any], *, warn: bool = True) -> Manipulator:
+def manipulator_from_mapping(
+    parameters: Mapping[str, Any], *, warn: bool = True, loads_read: bool = False
+) -> Manipulator:
     """Build and validate a manipulator from parameters.
 
     Parameters
@@ -106,6 +109,12 @@ def manipulator_from_mapping(parameters: Mapping[str, Any], *, warn: bool = True
         Emit a :class:`HomePoseWarning` when the home pose violates a constraint or the
         platform is singular there (:func:`unusable_reason`).
         The node and :func:`load_manipulator` refuse such a model instead.
+    loads_read : bool
+        The caller reads the loads' limits (``limits.actuator_force_max``,
+        ``limits.deflection_max``, ...: :mod:`~hexapod_workspace.core.evaluation.loads`), as
+        ``hexapod-workspace loads`` does. Otherwise a limit set to a value is refused: the
+        constraint table, the searches, the motions and the node do not take it yet, and a
+        verdict that ignored it would be for another machine.
 
     Returns
     -------
@@ -126,10 +135,20 @@ def manipulator_from_mapping(parameters: Mapping[str, Any], *, warn: bool = True
         if name.startswith(MODEL_GROUPS)
         and name not in PARAMETER_DEFAULTS
         and name not in CELL_PARAMETERS
+        and name not in LOAD_PARAMETERS
     )
     if unknown:
         msg = f"{unknown[0]}: unknown parameter (expected one of {_model_names()})"
         raise ConfigError(msg)
+    if not loads_read:
+        given = [name for name in LOAD_LIMITS if name in flat and not _unset_limit(flat[name])]
+        if given:
+            msg = (
+                f"{given[0]}: a loads limit, read by 'hexapod-workspace loads' only; the "
+                "geometric checks, searches, motions and the node do not take it as a "
+                "constraint yet (leave it out of this file)"
+            )
+            raise ConfigError(msg)
     values = dict(PARAMETER_DEFAULTS)
     values.update({k: v for k, v in flat.items() if k in PARAMETER_DEFAULTS})
     if values["pose.position"] is None:
@@ -255,7 +274,7 @@ def manipulator_from_mapping(parameters: Mapping[str, Any], *, warn: bool = True
     return manipulator
 
 
-def load_manipulator(path: str | Path) -> Manipulator:
+def load_manipulator(path: str | Path, *, loads_read: bool = False) -> Manipulator:
     """Build a manipulator from a ROS 2 parameters file (root key ``hexapod_workspace``
     or ``/**``).
 
@@ -270,9 +289,8 @@ def load_manipulator(path: str | Path) -> Manipulator:
     ----------
     path : str or pathlib.Path
         YAML parameters file, as in docs/configuration.md.
-    warn : bool
-        No effect (a file's unusable model is refused, not warned about); accepted so that
-        callers written when it warned keep working.
+    loads_read : bool
+        As for :func:`manipulator_from_mapping`: the caller reads the loads' limits.
 
     Returns
     -------
@@ -293,13 +311,16 @@ def load_manipulator(path: str | Path) -> Manipulator:
             *CELL_PARAMETERS,
             *COLLISION_PARAMETERS,
             *ROS_PARAMETERS,
+            *LOAD_PARAMETERS,
         ),
     )
     if unknown is not None:
         msg = f"parameters file {path}: {unknown}"
         raise ConfigError(msg)
     try:
-        return require_usable(manipulator_from_mapping(parameters, warn=False))
+        return require_usable(
+            manipulator_from_mapping(parameters, warn=False, loads_read=loads_read)
+        )
     except ConfigError as error:
         msg = f"parameters file {path}: {error}"
         raise type(error)(msg) from error
@@ -392,6 +413,13 @@ def _unset(value: Any) -> bool:
     if isinstance(value, (str, bytes)):
         return False
     return bool(np.ndim(value)) and np.size(value) == 0
+
+
+def _unset_limit(value: Any) -> bool:
+    """A loads limit left at its "not set" value: absent, an empty list or 0."""
+    if value is None or (isinstance(value, (list, tuple)) and len(value) == 0):
+        return True
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and value == 0
 
 
 def _foreign_parameter(architecture: str, flat: Mapping[str, Any]) -> str | None:
