@@ -267,7 +267,8 @@ def _write(tmp_path, parameters: dict, extra: str = "") -> object:
     [
         (
             "limitz.leg_length_min",
-            "limitz: unknown section (expected one of accuracy, axis_limits, check, collision, frame_id, ",
+            "limitz: unknown section (expected one of accuracy, axis_limits, check, collision, "
+            "frame_id, ",
         ),
         ("limits.leg_lenght_min", "limits.leg_lenght_min: unknown parameter (expected one of "),
         ("resolution.n_phy", "resolution.n_phy: unknown parameter (expected one of resolution."),
