@@ -36,7 +36,9 @@ from hexapod_workspace.core.evaluation.loading import (
     load_manipulator,
     manipulator_from_mapping,
 )
-from hexapod_workspace.core.kernels import margins as margin_kernels
+from hexapod_workspace.core.kernels import blocks as block_kernels
+from hexapod_workspace.core.kernels import pose as pose_kernels
+from hexapod_workspace.core.kernels import trig as trig_kernels
 from hexapod_workspace.core.workspaces.search import RaySearch
 
 POSES = 1_000_000
@@ -317,9 +319,9 @@ def test_block_decisions_equal_the_per_probe_functions(name):
     model = kernels.model_vector(machine)
     used = int(model[kernels.ROWS_USED])
     fixed = machine.architecture == "ups"
-    block = margin_kernels.BLOCK
+    block = block_kernels.BLOCK
     rng = np.random.default_rng(11)
-    work = np.full(margin_kernels._BLOCK_ROWS * block, np.inf)
+    work = np.full(block_kernels._BLOCK_ROWS * block, np.inf)
     special = np.array([0.0, -0.0, np.nan, np.inf, 1e-300, -1e-300, 1e300, 5e-324])
     for c in range(used):
         # Mostly feasible (the steps matter there), some violated, some special values.
@@ -335,12 +337,12 @@ def test_block_decisions_equal_the_per_probe_functions(name):
     search_kernels._block_decisions(
         model, work, block, used, fixed, estimates, verdicts, steps, np.empty(2 * block)
     )
-    out = np.full(margin_kernels.OUT_SIZE, np.inf)
+    out = np.full(pose_kernels.OUT_SIZE, np.inf)
     for m in range(block):
         out[:used] = work[m : used * block : block]
         expected = search_kernels._estimate(model, out)
         assert estimates[m] == expected or (math.isnan(estimates[m]) and math.isnan(expected))
-        assert verdicts[m] == float(margin_kernels._feasible(out, used))
+        assert verdicts[m] == float(pose_kernels._feasible(out, used))
         if fixed:
             step = search_kernels.certified_step(model, out, None)
             assert steps[m] == step and math.copysign(1.0, steps[m]) == math.copysign(1.0, step)
@@ -355,7 +357,7 @@ def test_sincos_within_an_ulp_of_libm():
     )
     rotations = np.empty((x.size, 9))
     for index in range(0, x.size, 997):
-        margin_kernels._tt_matrix(x[index], 0.0, x[index], rotations[index])
+        trig_kernels._tt_matrix(x[index], 0.0, x[index], rotations[index])
         # R(φ, 0, φ) = Rz(φ): [cos, -sin, 0; sin, cos, 0; 0, 0, 1].
         assert rotations[index, 0] == pytest.approx(math.cos(x[index]), abs=2.3e-16)
         assert rotations[index, 3] == pytest.approx(math.sin(x[index]), abs=2.3e-16)
@@ -516,13 +518,15 @@ def test_a_6ups_check_compiles_no_stage_it_does_not_use(tmp_path):
     code = """
 import numpy as np
 from hexapod_workspace import check, example_manipulator
-from hexapod_workspace.core.kernels import collision as collision_kernels, margins as margin_kernels
+from hexapod_workspace.core.kernels import blocks as block_kernels, collision as collision_kernels
+from hexapod_workspace.core.kernels import pose as pose_kernels
 check(example_manipulator(), np.radians([[0, 30, 0]]))
 for name in ("_pose_moving", "_pose_collision", "_block_collision", "_block_singularity",
              "_pose_singularity", "_leg_planes_pus", "_leg_planes_rus"):
-    print(name, len(getattr(margin_kernels, name).signatures))
+    owner = pose_kernels if hasattr(pose_kernels, name) else block_kernels
+    print(name, len(getattr(owner, name).signatures))
 print("collision_margin", len(collision_kernels.collision_margin.signatures))
-print("_check_block", len(margin_kernels._check_block.signatures))
+print("_check_block", len(block_kernels._check_block.signatures))
 """
     done = _python(code, NUMBA_CACHE_DIR=str(tmp_path))
     assert done.returncode == 0, done.stderr
@@ -556,11 +560,11 @@ def test_a_child_process_of_another_copy_uses_its_own_cache(tmp_path, monkeypatc
     inherited = dict(os.environ)
     assert jit.CACHE_DIRECTORY is not None
     assert inherited["NUMBA_CACHE_DIR"] == str(jit.CACHE_DIRECTORY)
-    assert inherited["HEXAPOD_WORKSPACE_CACHE_OWNER"].startswith(str(jit._HERE) + os.pathsep)
+    assert inherited["HEXAPOD_WORKSPACE_CACHE_OWNER"].startswith(str(jit._CORE) + os.pathsep)
     assert jit._cache_directory() == jit.CACHE_DIRECTORY  # the same tree
 
     core = tmp_path / "install" / "hexapod_workspace" / "core"  # the other copy
-    monkeypatch.setattr(jit, "_HERE", core)
+    monkeypatch.setattr(jit, "_CORE", core)
     assert jit._cache_directory() == core / "__pycache__" / jit.CACHE_NAME
     users = tmp_path / "users"
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(users))

@@ -109,7 +109,7 @@ def test_smallest_singular_value_kernel_against_numpy_svd(rng):
     6ε·(|M|ᵀ|M|)_ij, so its eigenvalues by at most 36 ε·‖G‖ (‖|M|‖² ≤ 6‖M‖²); the reduction and
     the iteration add a few ε·‖G‖ (numpy's eigvalsh of the same G is off by as much on the
     clusters). NaN in, NaN out."""
-    from hexapod_workspace.core.kernels.margins import ROWS_SCRATCH, _smallest_singular_value
+    from hexapod_workspace.core.kernels.singularity import ROWS_SCRATCH, _smallest_singular_value
 
     matrices = _hard_matrices(rng)
     expected = np.linalg.svd(matrices, compute_uv=False)

@@ -61,8 +61,8 @@ __all__ = [
     "jit",
 ]
 
-_HERE = Path(__file__).resolve().parent
-_CORE = _HERE.parent
+#: The core package folder: the owner of the in-tree cache and the root of KERNEL_SOURCES.
+_CORE = Path(__file__).resolve().parent.parent
 
 #: The modules whose code ends up in the compiled kernels (relative to the core package). A test
 #: checks that every module of the package that defines a kernel is listed.
@@ -75,6 +75,12 @@ KERNEL_SOURCES: tuple[Path, ...] = tuple(
         "kernels/collision.py",
         "model/collision/distance.py",
         "model/collision/scene.py",
+        "kernels/trig.py",
+        "kernels/singularity.py",
+        "kernels/segments.py",
+        "kernels/moving_base.py",
+        "kernels/pose.py",
+        "kernels/blocks.py",
         "kernels/margins.py",
         "kernels/searches.py",
         "kernels/planner.py",
@@ -124,7 +130,7 @@ def _cache_directory() -> Path | None:
     """Where numba caches the kernels (None: nowhere writable, no cache)."""
     configured = os.environ.get("NUMBA_CACHE_DIR")
     owner, _, directory = os.environ.get(_OWNER_VARIABLE, "").partition(os.pathsep)
-    if configured and configured == directory and owner != str(_HERE):
+    if configured and configured == directory and owner != str(_CORE):
         configured = None  # set by another copy of the package for itself (module docstring)
     if configured:
         given = Path(configured)
@@ -145,7 +151,7 @@ def _cache_directory() -> Path | None:
 CACHE_DIRECTORY = _cache_directory()
 if CACHE_DIRECTORY is not None:
     os.environ["NUMBA_CACHE_DIR"] = str(CACHE_DIRECTORY)  # read by numba at import
-    os.environ[_OWNER_VARIABLE] = f"{_HERE}{os.pathsep}{CACHE_DIRECTORY}"
+    os.environ[_OWNER_VARIABLE] = f"{_CORE}{os.pathsep}{CACHE_DIRECTORY}"
     if "numba" in sys.modules:  # imported earlier by someone else: its runtime setting
         import numba
 

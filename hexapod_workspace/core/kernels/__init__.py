@@ -44,7 +44,7 @@ from .layout import (
     B,
     model_vector,
 )
-from .margins import FAST_TRIG_LIMIT, margin_entry_points
+from .margins import margin_entry_points
 from .searches import (
     KIND_CYLINDRICAL,
     KIND_TT,
@@ -52,6 +52,7 @@ from .searches import (
     SAFETY,
     search_entry_points,
 )
+from .trig import FAST_TRIG_LIMIT
 
 __all__ = [
     "ALL_SWITCHES",

@@ -23,6 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..constraints.table import COLLISION, IK, LEG_LENGTH, N_CONSTRAINTS, TRANSMISSION
+from .blocks import _BLOCK_ROWS, BLOCK, _check_block
 from .collision import SEARCH_RATE
 from .layout import (
     ARCH,
@@ -37,19 +38,16 @@ from .layout import (
     ROWS_USED,
     TAU_MIN,
 )
-from .margins import (
-    _BLOCK_ROWS,
-    BLOCK,
+from .pose import (
     OUT_GAP,
     OUT_SHORTEST,
     OUT_SIZE,
     SCRATCH_ROWS,
-    _check_block,
     _feasible,
     _limiting_constraint,
     _pose,
-    _tt_matrix,
 )
+from .trig import _tt_matrix
 
 __all__ = [
     "KIND_CYLINDRICAL",
