@@ -17,11 +17,9 @@ from test_collision import random_poses, scene_parameters
 from hexapod_workspace import Manipulator
 from hexapod_workspace.core.base.params import flatten
 from hexapod_workspace.core.evaluation.loading import example_manipulator, manipulator_from_mapping
-from hexapod_workspace.core.kernels.collision import (
-    KEPT_BOUNDS,
-    collision_margins,
-)
+from hexapod_workspace.core.kernels.collision import collision_margins
 from hexapod_workspace.core.kernels.layout import MODEL_SIZE, B, model_vector
+from hexapod_workspace.core.kernels.scene_layout import KEPT_BOUNDS
 from hexapod_workspace.core.model.legs import leg_endpoints
 from hexapod_workspace.errors import ConfigError
 

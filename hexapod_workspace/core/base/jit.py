@@ -72,6 +72,7 @@ KERNEL_SOURCES: tuple[Path, ...] = tuple(
         "base/jit.py",
         "constraints/table.py",
         "kernels/layout.py",
+        "kernels/scene_layout.py",
         "kernels/collision.py",
         "model/collision/distance.py",
         "model/collision/scene.py",
@@ -82,6 +83,8 @@ KERNEL_SOURCES: tuple[Path, ...] = tuple(
         "kernels/pose.py",
         "kernels/blocks.py",
         "kernels/margins.py",
+        "kernels/steps.py",
+        "kernels/lazy_collision.py",
         "kernels/searches.py",
         "kernels/planner.py",
     )

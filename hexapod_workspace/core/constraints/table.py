@@ -64,7 +64,7 @@ smallest and largest distance from B_i to the crank circle, both 1-Lipschitz in 
 
 *Transmission floor.* The rates of the pus/rus rows depend on τ_f, which the searches obtain
 like the leg-length floor of 6-UPS: from the rate of ``|τ|`` itself, ``N + K`` with τ_f in it. Along
-a ray from a feasible pose (:func:`~hexapod_workspace.core.kernels.searches.certified_step`),
+a ray from a feasible pose (:func:`~hexapod_workspace.core.kernels.steps.certified_step`),
 τ_f = max(τ_lim, τ_now/2) and the step is limited to (τ_now − τ_f)/rate_τ(τ_f): the first
 point where ``|τ|`` fell to τ_f would contradict the rate that holds until then. Over an interval
 [a, b] of a move (:mod:`~hexapod_workspace.core.motions.certificate`), any τ_f ≤ min(τ(a), τ(b))
@@ -505,7 +505,7 @@ def rate_bounds(
     whose coefficient is 0 is left out (so an infinite N, no leg floor, only affects the rows
     that turn with it). Left out, Q and E are V (6-UPS: the leg length changes at most at V, the
     platform joints are the fastest leg ends) and K is 0 (no crank). The kernels compute the
-    same sum for one pose (``kernels.searches._rate``).
+    same sum for one pose (``kernels.steps._rate``).
     """
     quantities = (
         speed,

@@ -3,7 +3,7 @@
 The kernels take a handful of arrays, which keeps numba's dispatch cheap (a few microseconds per
 call): :func:`model_vector` packs the model once per manipulator at the offsets below. A model
 with a collision scene has its scene appended after ``MODEL_SIZE``
-(:func:`hexapod_workspace.core.kernels.collision.pack_scene`; ``COLLISION_ON`` says so).
+(:func:`hexapod_workspace.core.kernels.scene_layout.pack_scene`; ``COLLISION_ON`` says so).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 from ..constraints.table import CONSTRAINTS, N_CONSTRAINTS, applicable, scales
 from ..model.architectures import CODES
-from .collision import pack_scene
+from .scene_layout import pack_scene
 
 if TYPE_CHECKING:
     from ..model.manipulator import Manipulator

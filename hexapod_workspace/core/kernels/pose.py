@@ -29,7 +29,6 @@ from ..constraints.table import (
     SINGULARITY,
     TRANSMISSION,
 )
-from .collision import SCRATCH_FLOATS
 from .layout import (
     ALPHA,
     ALPHA_EQUAL,
@@ -74,6 +73,7 @@ from .moving_base import (
     _slide_leg,
     _vector,
 )
+from .scene_layout import SCRATCH_FLOATS
 from .segments import (
     _clamp01,
     _free_squared,
