@@ -375,6 +375,15 @@ def test_loads_command_answers_the_pose_and_geometric_commands_refuse_its_limits
     assert code == 0 and "payload capacity" in text and "deflection" in text
 
 
+def test_a_centre_of_mass_in_millimetres_is_refused_with_the_unit_hint(tmp_path):
+    path = loads_file(tmp_path, {"load": {"mass": 40.0, "center_of_mass": [0.0, 0.0, 200.0]}})
+    code, _, err = run_main("--config", str(path), "loads", "--pose", "0", "0", "0")
+    assert code == 2
+    line = one_error_line(err)
+    assert f"parameters file {path}: load.center_of_mass: expected m" in line
+    assert "it looks like millimetres" in line
+
+
 def test_loads_command_refuses_a_bad_loads_parameter_naming_the_file(tmp_path):
     path = loads_file(tmp_path, {"load": {"mass": -3.0}})
     code, _, err = run_main("--config", str(path), "loads", "--pose", "0", "0", "0")

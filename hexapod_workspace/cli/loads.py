@@ -36,7 +36,12 @@ from numpy.typing import NDArray
 from .._resources import example_config_path
 from ..core.base.params import load_params_file
 from ..core.cell.frames import cell_from_params_file, require_plausible_cell, tool_model
-from ..core.evaluation.loads import Loads, load_case_from_mapping, loads_at
+from ..core.evaluation.loads import (
+    Loads,
+    load_case_from_mapping,
+    loads_at,
+    require_plausible_loads,
+)
 from ..errors import ConfigError
 from .cam import tool_json
 from .commands import PROG
@@ -105,7 +110,7 @@ def cmd_loads(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
     cell = require_plausible_cell(platform, cell_from_params_file(path))
     manipulator = tool_model(platform, cell.tool)
     try:
-        case = load_case_from_mapping(load_params_file(path))
+        case = require_plausible_loads(platform, load_case_from_mapping(load_params_file(path)))
     except ConfigError as error:
         msg = f"parameters file {path}: {error}"
         raise CliError(msg) from error

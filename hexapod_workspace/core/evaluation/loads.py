@@ -55,6 +55,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ...errors import ConfigError
 from ..base.params import flatten
+from ..base.validation import machine_size, millimetre_reason
 from ..base.values import describe, frozen, numbers
 from ..model.architectures import module as architecture_module
 from ..model.legs import leg_endpoints
@@ -69,6 +70,7 @@ __all__ = [
     "actuator_jacobian",
     "load_case_from_mapping",
     "loads_at",
+    "require_plausible_loads",
 ]
 
 #: The parameters of the loads (``load.*``, ``process.*``, ``stiffness.*``, ``accuracy.*`` and
@@ -264,6 +266,32 @@ def load_case_from_mapping(parameters: Mapping[str, Any]) -> LoadCase:
         actuator_error=error,
         accuracy_max=accuracy_max,
     )
+
+
+def require_plausible_loads(manipulator: Manipulator, case: LoadCase) -> LoadCase:
+    """Refuse a centre of mass that fits the machine only once divided by 1000 (written in
+    millimetres), with the unit hint of
+    :func:`~hexapod_workspace.core.base.validation.millimetre_reason`; the case otherwise.
+
+    Parameters
+    ----------
+    manipulator : Manipulator
+        The platform-frame model (its size, m).
+    case : LoadCase
+        As :func:`load_case_from_mapping` read it (centre of mass in the platform frame).
+
+    Raises
+    ------
+    ConfigError
+        One line naming ``load.center_of_mass``.
+    """
+    size = machine_size(
+        manipulator.base_joints, manipulator.platform_joints, manipulator.home_position
+    )
+    reason = millimetre_reason("load.center_of_mass", case.center_of_mass, size)
+    if reason is not None:
+        raise ConfigError(reason)
+    return case
 
 
 def actuator_jacobian(
