@@ -42,6 +42,7 @@ from ..core.evaluation.loads import (
     loads_at,
     require_plausible_loads,
 )
+from ..core.model.architectures import module as architecture_module
 from ..errors import ConfigError
 from .cam import tool_json
 from .commands import PROG
@@ -167,7 +168,7 @@ def _text(
     )
     if result.singular:
         out.write("singular pose (or a leg out of reach): the actuators cannot hold any load\n")
-    unit = "N·m" if architecture == "rus" else "N"
+    unit = architecture_module(architecture).FORCE_UNIT
     out.write(f"actuator force, {unit} (> 0 pushes):  {_row(document['actuator_force_n'])}\n")
     out.write(f"worst |force| over the process box: {_row(document['actuator_force_worst_n'])}\n")
     if result.force_margin is None:

@@ -59,6 +59,7 @@ from ..base.values import (
     unknown_tool,
     vector3,
 )
+from ..model.architectures import module as architecture_module
 from ..model.manipulator import Manipulator
 
 __all__ = [
@@ -433,7 +434,7 @@ def cell_unit_reason(manipulator: Manipulator, cell: CellFrames) -> str | None:
         *((f"tools.T{n}.offset", t.offset, "m", "") for n, t in sorted(cell.tools.items())),
         ("work.origin", cell.work.origin, "m", ""),
     ]
-    if manipulator.architecture in ("ups", "pus"):
+    if architecture_module(manipulator.architecture).ACTUATOR_UNIT == "m":
         checks.append(("limits.actuator_speed_max", cell.actuator_speed_max, "m/s", "/s"))
     for name, values, unit, per in checks:
         reason = millimetre_reason(name, values, size, unit, per)

@@ -130,6 +130,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from ..model.architectures import module as architecture_module
+
 if TYPE_CHECKING:
     from ..model.manipulator import Manipulator
 
@@ -237,7 +239,7 @@ class Constraint:
 
 def _actuator_report(manipulator: Manipulator) -> tuple[str, float]:
     """The stroke of a slide in mm, the range of a crank in deg."""
-    if manipulator.architecture == "rus":
+    if architecture_module(manipulator.architecture).ACTUATOR_UNIT == "rad":
         return "deg", float(np.degrees(1.0))
     return "mm", 1e3
 
@@ -269,7 +271,7 @@ def _collision_spin(manipulator: Manipulator) -> float:
 
 def _collision_ends(manipulator: Manipulator) -> float:
     """1 where the leg architecture moves the base joints (module documentation), else 0."""
-    return 1.0 if _has_scene(manipulator) and manipulator.architecture != "ups" else 0.0
+    return 1.0 if _has_scene(manipulator) and _moving_base(manipulator) else 0.0
 
 
 def _collision_scale(manipulator: Manipulator) -> float:
@@ -281,11 +283,11 @@ def _collision_scale(manipulator: Manipulator) -> float:
 
 
 def _moving_base(manipulator: Manipulator) -> bool:
-    return manipulator.architecture != "ups"
+    return architecture_module(manipulator.architecture).MOVING_BASE
 
 
 def _fixed_base(manipulator: Manipulator) -> bool:
-    return manipulator.architecture == "ups"
+    return not _moving_base(manipulator)
 
 
 def _half_actuator_range(manipulator: Manipulator) -> float:

@@ -590,7 +590,7 @@ def _with_home_axes(manipulator: Manipulator, base: bool, platform: bool) -> Man
     changes: dict[str, Any] = {}
     if base:
         axes = directions
-        if manipulator.architecture == "rus":
+        if legs.TURNING_BASE:
             assert manipulator.crank_axes is not None
             axes = rotate_about(manipulator.crank_axes, -q, directions)
         changes["base_joint_axes"] = frozen(axes)

@@ -322,10 +322,7 @@ def actuator_jacobian(
     n = leg / np.linalg.norm(leg, axis=-1, keepdims=True)
     legs = architecture_module(manipulator.architecture)
     q, _ = legs.inverse_kinematics(manipulator, platform)
-    divisor = legs.transmission(manipulator, n, q)
-    if manipulator.architecture == "rus":
-        assert manipulator.crank_lengths is not None
-        divisor = divisor * manipulator.crank_lengths
+    divisor = legs.transmission(manipulator, n, q) * legs.actuator_lever(manipulator)
     rows = np.concatenate([n, np.cross(arm, n)], axis=-1) / divisor[..., None]
     return np.asarray(rows, dtype=np.float64)
 

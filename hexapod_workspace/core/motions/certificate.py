@@ -85,6 +85,7 @@ from ..constraints.table import (
     rate_bounds,
 )
 from ..evaluation.check import PoseMargins, pose_margins, relative_margins
+from ..model.architectures import module as architecture_module
 from ..model.manipulator import Manipulator
 from .interpolation import _Moves
 
@@ -106,7 +107,8 @@ class _Certifier:
         self.manipulator = manipulator
         self.rho = float(np.max(np.linalg.norm(manipulator.platform_joints, axis=1)))
         self.length_min = float(np.min(manipulator.leg_length_min))
-        self.moving = manipulator.architecture != "ups"
+        legs = architecture_module(manipulator.architecture)
+        self.moving = legs.MOVING_BASE
         # The certificate works on the leading rows up to the last one that applies and is
         # evaluated by :meth:`margins` (an unenforced singularity margin is not: it is +inf at
         # every pose, as are the rows past the last one that applies). Those later rows have a
@@ -118,11 +120,10 @@ class _Certifier:
             if row != SINGULARITY or manipulator.singularity_min > 0.0
         ]
         self.rows = max(evaluated) + 1
-        self.crank_inverse = (
-            1.0 / float(np.min(manipulator.crank_lengths))
-            if manipulator.crank_lengths is not None
-            else 0.0
-        )
+        # 1 / min r_i: the actuator's rate per unit speed of the base-side end along the leg
+        # line (1 for legs and slides); the turning term only where that end turns (a crank).
+        self.actuate_gain = 1.0 / float(np.min(legs.actuator_lever(manipulator)))
+        self.crank_inverse = self.actuate_gain if legs.TURNING_BASE else 0.0
 
     def margins(
         self, rotations: NDArray[np.float64], positions: NDArray[np.float64]
@@ -195,7 +196,7 @@ class _Certifier:
                 & (ik_low >= 0.0)
             )
             inverse = np.where(valid, 1.0 / np.where(valid, tau_f, 1.0), np.inf)
-            gain = crank if self.manipulator.architecture == "rus" else 1.0
+            gain = self.actuate_gain
             lipschitz_travel = rate_bounds(
                 self.manipulator,
                 travel,

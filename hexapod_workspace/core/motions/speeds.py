@@ -229,7 +229,8 @@ def _ups_rate_bound(
 def _fixed_leg_evaluate(
     manipulator: Manipulator, motion: LegMotion
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """g_i = n_i·v_i / (r_i·τ_i) (r = 1 for pus) and |τ_i| (module documentation)."""
+    """g_i = n_i·v_i / (r_i·τ_i) (r = 1 for pus, the architecture's ``actuator_lever``) and
+    |τ_i| (module documentation)."""
     arch = architectures.module(manipulator.architecture)
     q, _ = arch.inverse_kinematics(manipulator, motion.platform)
     solved = np.isfinite(q)
@@ -240,17 +241,8 @@ def _fixed_leg_evaluate(
     usable = solved & (tau != 0.0)
     along = np.einsum("nij,nij->ni", directions, motion.joint_velocities)
     with np.errstate(divide="ignore", invalid="ignore"):
-        rates = along / (_crank_radius(manipulator) * tau)
+        rates = along / (arch.actuator_lever(manipulator) * tau)
     return np.where(usable, rates, np.inf), np.where(usable, np.abs(tau), 0.0)
-
-
-def _crank_radius(manipulator: Manipulator) -> NDArray[np.float64]:
-    """r_i for rus, 1 for pus (dq = n·dB / (r·τ))."""
-    if manipulator.architecture == "rus":
-        radius = manipulator.crank_lengths
-        assert radius is not None
-        return radius
-    return np.ones(6)
 
 
 def _tau_rate(
@@ -259,8 +251,9 @@ def _tau_rate(
     """(c₀, c₁) with |dτ_i/ds| ≤ c₀ + c₁/τ_f (module documentation)."""
     length = manipulator.leg_lengths
     assert length is not None
+    arch = architectures.module(manipulator.architecture)
     c0 = speed / length
-    c1 = c0 + (speed / _crank_radius(manipulator) if manipulator.architecture == "rus" else 0.0)
+    c1 = c0 + (speed / arch.actuator_lever(manipulator) if arch.TURNING_BASE else 0.0)
     return c0, c1
 
 
@@ -288,23 +281,39 @@ def _fixed_leg_rate_bound(
     accel: NDArray[np.float64],
     floor: NDArray[np.float64],
 ) -> NDArray[np.float64]:
-    """K_i = (V²(1 + 1/τ_f)²/L + A [+ V²/(r τ_f²)]) / (r τ_f) (module documentation)."""
+    """K_i = (V²(1 + 1/τ_f)²/L + A [+ V²/(r τ_f²)]) / (r τ_f) (module documentation; the
+    bracket where the base-side end turns, a crank)."""
     length = manipulator.leg_lengths
     assert length is not None
-    radius = _crank_radius(manipulator)
+    arch = architectures.module(manipulator.architecture)
+    radius = arch.actuator_lever(manipulator)
     numerator = speed**2 * (1.0 + 1.0 / floor) ** 2 / length + accel
-    if manipulator.architecture == "rus":
+    if arch.TURNING_BASE:
         numerator = numerator + speed**2 / (radius * floor**2)
     bound: NDArray[np.float64] = numerator / (radius * floor)
     return bound
 
 
 #: 6-UPS legs: the actuated coordinate is the leg length (m).
-UPS = ActuatorModel("ups", "m", _ups_evaluate, _ups_floor, _ups_rate_bound)
+UPS = ActuatorModel(
+    "ups", architectures.ups.ACTUATOR_UNIT, _ups_evaluate, _ups_floor, _ups_rate_bound
+)
 #: 6-PUS slides: the actuated coordinate is the slide position on its rail (m).
-PUS = ActuatorModel("pus", "m", _fixed_leg_evaluate, _fixed_leg_floor, _fixed_leg_rate_bound)
+PUS = ActuatorModel(
+    "pus",
+    architectures.pus.ACTUATOR_UNIT,
+    _fixed_leg_evaluate,
+    _fixed_leg_floor,
+    _fixed_leg_rate_bound,
+)
 #: 6-RUS cranks: the actuated coordinate is the crank angle (rad).
-RUS = ActuatorModel("rus", "rad", _fixed_leg_evaluate, _fixed_leg_floor, _fixed_leg_rate_bound)
+RUS = ActuatorModel(
+    "rus",
+    architectures.rus.ACTUATOR_UNIT,
+    _fixed_leg_evaluate,
+    _fixed_leg_floor,
+    _fixed_leg_rate_bound,
+)
 #: Actuator models by architecture name.
 ACTUATOR_MODELS: dict[str, ActuatorModel] = {m.name: m for m in (UPS, PUS, RUS)}
 

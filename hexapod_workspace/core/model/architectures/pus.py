@@ -23,7 +23,22 @@ from numpy.typing import NDArray
 if TYPE_CHECKING:
     from ..manipulator import Manipulator
 
-__all__ = ["base_axes", "base_ends", "inverse_kinematics", "transmission"]
+__all__ = [
+    "ACTUATOR_UNIT",
+    "FORCE_UNIT",
+    "MOVING_BASE",
+    "TURNING_BASE",
+    "actuator_lever",
+    "base_axes",
+    "base_ends",
+    "inverse_kinematics",
+    "transmission",
+]
+
+#: The actuated coordinate, the slide position on its rail, in m; its force in N.
+ACTUATOR_UNIT, FORCE_UNIT = "m", "N"
+#: The slide joints move with the actuators and translate without turning.
+MOVING_BASE, TURNING_BASE = True, False
 
 
 def _rails(manipulator: Manipulator) -> NDArray[np.float64]:
@@ -64,3 +79,8 @@ def transmission(
 def base_axes(manipulator: Manipulator, q: NDArray[np.float64]) -> NDArray[np.float64]:
     """The slide joint axes translate with the slide: constant, (..., 6, 3)."""
     return np.broadcast_to(manipulator.base_joint_axes, (*np.shape(q), 3)).copy()
+
+
+def actuator_lever(manipulator: Manipulator) -> NDArray[np.float64]:
+    """r_i = 1 (m): the slide moves by dq = n·dB / τ."""
+    return np.ones(6)

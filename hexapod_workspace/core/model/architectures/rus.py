@@ -29,7 +29,23 @@ from numpy.typing import NDArray
 if TYPE_CHECKING:
     from ..manipulator import Manipulator
 
-__all__ = ["base_axes", "base_ends", "inverse_kinematics", "rotate_about", "transmission"]
+__all__ = [
+    "ACTUATOR_UNIT",
+    "FORCE_UNIT",
+    "MOVING_BASE",
+    "TURNING_BASE",
+    "actuator_lever",
+    "base_axes",
+    "base_ends",
+    "inverse_kinematics",
+    "rotate_about",
+    "transmission",
+]
+
+#: The actuated coordinate, the crank angle, in rad; its torque in N·m.
+ACTUATOR_UNIT, FORCE_UNIT = "rad", "N·m"
+#: The crank ends move with the cranks and turn about the crank axes.
+MOVING_BASE, TURNING_BASE = True, True
 
 
 def _crank(
@@ -100,3 +116,10 @@ def base_axes(manipulator: Manipulator, q: NDArray[np.float64]) -> NDArray[np.fl
     w, _, _, _ = _crank(manipulator)
     q = np.asarray(q)
     return rotate_about(w, q, np.broadcast_to(manipulator.base_joint_axes, (*q.shape, 3)))
+
+
+def actuator_lever(manipulator: Manipulator) -> NDArray[np.float64]:
+    """r_i = the crank length (m): the crank turns by dq = n·dB / (r·τ)."""
+    radius = manipulator.crank_lengths
+    assert radius is not None
+    return radius

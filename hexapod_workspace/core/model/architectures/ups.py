@@ -10,7 +10,23 @@ from numpy.typing import NDArray
 if TYPE_CHECKING:
     from ..manipulator import Manipulator
 
-__all__ = ["base_axes", "base_ends", "inverse_kinematics", "transmission"]
+__all__ = [
+    "ACTUATOR_UNIT",
+    "FORCE_UNIT",
+    "MOVING_BASE",
+    "TURNING_BASE",
+    "actuator_lever",
+    "base_axes",
+    "base_ends",
+    "inverse_kinematics",
+    "transmission",
+]
+
+#: The actuated coordinate, the leg length, in m; its force in N (the interface:
+#: :class:`~hexapod_workspace.core.model.architectures.Architecture`).
+ACTUATOR_UNIT, FORCE_UNIT = "m", "N"
+#: The base joints are fixed: neither moving nor turning base-side ends.
+MOVING_BASE, TURNING_BASE = False, False
 
 
 def inverse_kinematics(
@@ -36,3 +52,8 @@ def transmission(
 def base_axes(manipulator: Manipulator, q: NDArray[np.float64]) -> NDArray[np.float64]:
     """The fixed base joint axes, (..., 6, 3)."""
     return np.broadcast_to(manipulator.base_joint_axes, (*np.shape(q), 3)).copy()
+
+
+def actuator_lever(manipulator: Manipulator) -> NDArray[np.float64]:
+    """r_i = 1 (m): the leg length changes by n·dB."""
+    return np.ones(6)
