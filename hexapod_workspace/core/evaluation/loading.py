@@ -129,6 +129,73 @@ def manipulator_from_mapping(
         Missing or unknown model parameters, non-numbers, non-finite values.
     """
     flat = flatten(parameters)
+    values = _checked_values(flat, loads_read)
+    architecture = values["geometry.architecture"]
+    base_joints = joint_array("geometry.base_joints", values["geometry.base_joints"])
+    platform_joints = joint_array("geometry.platform_joints", values["geometry.platform_joints"])
+    paired = paired_joints_reason(base_joints, platform_joints, architecture)
+    if paired is not None:
+        raise GeometryError(paired)
+    home = vector3("geometry.home_position", values["geometry.home_position"])
+    position = vector3("pose.position", values["pose.position"])
+    if architecture == "ups":
+        length_min, length_max = _leg_stroke(values, base_joints, platform_joints, home)
+        legs: dict[str, Any] = {}
+    else:
+        legs = _architecture_parts(architecture, values)
+        length_min = length_max = legs["leg_lengths"]
+    angles = _joint_angles(values)
+    diameter = _leg_diameter(values)
+    paired_length = _paired_joint_length(
+        values["geometry.paired_joint_length"],
+        base_joints,
+        platform_joints,
+        diameter,
+        length_min,
+        machine_size(base_joints, platform_joints, home),
+    )
+
+    base_axes = unit_axes("geometry.base_joint_axes", values["geometry.base_joint_axes"])
+    platform_axes = unit_axes(
+        "geometry.platform_joint_axes", values["geometry.platform_joint_axes"]
+    )
+    frozen_legs: dict[str, Any] = {
+        key: frozen(value) if isinstance(value, np.ndarray) else value
+        for key, value in legs.items()
+    }
+    manipulator = Manipulator(
+        base_joints=frozen(base_joints),
+        platform_joints=frozen(platform_joints),
+        base_joint_axes=frozen(np.zeros((6, 3)) if base_axes is None else base_axes),
+        platform_joint_axes=frozen(np.zeros((6, 3)) if platform_axes is None else platform_axes),
+        leg_length_min=frozen(length_min),
+        leg_length_max=frozen(length_max),
+        base_joint_max_angle=frozen(angles["limits.base_joint_max_angle"]),
+        platform_joint_max_angle=frozen(angles["limits.platform_joint_max_angle"]),
+        leg_diameter=diameter,
+        paired_joint_length=paired_length,
+        home_position=frozen(home),
+        position=frozen(position),
+        frame_id=values["frame_id"],
+        axes_from_home=(base_axes is None, platform_axes is None),
+        singularity_min=_singularity_min(values["limits.singularity_min"]),
+        architecture=architecture,
+        **frozen_legs,
+    )
+    manipulator = _with_home_axes(manipulator, base_axes is None, platform_axes is None)
+    if any(name.startswith(COLLISION_PARAMETERS) for name in flat):
+        manipulator = _with_scene(manipulator, flat)
+    if warn:
+        reason = unusable_reason(manipulator)
+        if reason is not None:
+            warnings.warn(reason, HomePoseWarning, stacklevel=2)
+    return manipulator
+
+
+def _checked_values(flat: Mapping[str, Any], loads_read: bool) -> dict[str, Any]:
+    """The model's parameters with their defaults, after the refusals that need no geometry:
+    unknown names, a loads limit the caller does not read, the architecture and its own
+    parameters, a missing required parameter, the frame id."""
     unknown = sorted(
         name
         for name in flat
@@ -178,36 +245,40 @@ def manipulator_from_mapping(
     if not isinstance(frame_id, str) or not frame_id.strip():
         msg = f"frame_id: expected a non-empty string, got {describe(frame_id)}"
         raise ConfigError(msg)
+    return values
 
-    base_joints = joint_array("geometry.base_joints", values["geometry.base_joints"])
-    platform_joints = joint_array("geometry.platform_joints", values["geometry.platform_joints"])
-    paired = paired_joints_reason(base_joints, platform_joints, architecture)
-    if paired is not None:
-        raise GeometryError(paired)
-    home = vector3("geometry.home_position", values["geometry.home_position"])
-    position = vector3("pose.position", values["pose.position"])
-    if architecture == "ups":
-        length_min, length_max = _stroke(
-            "limits.leg_length_min",
-            values["limits.leg_length_min"],
-            "limits.leg_length_max",
-            values["limits.leg_length_max"],
-        )
-        if np.any(length_min < 0.0):
-            msg = f"limits.leg_length_min: expected values >= 0 m, got {length_min.min():g}"
-            raise GeometryError(msg)
-        size = machine_size(base_joints, platform_joints, home)
-        for name, limit in (
-            ("limits.leg_length_min", length_min),
-            ("limits.leg_length_max", length_max),
-        ):
-            unit_reason = millimetre_reason(name, limit, size)
-            if unit_reason is not None:
-                raise GeometryError(unit_reason)
-        legs: dict[str, Any] = {}
-    else:
-        legs = _architecture_parts(architecture, values)
-        length_min = length_max = legs["leg_lengths"]
+
+def _leg_stroke(
+    values: Mapping[str, Any],
+    base_joints: NDArray[np.float64],
+    platform_joints: NDArray[np.float64],
+    home: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """6-UPS: ``limits.leg_length_min`` and ``_max`` (m, per leg), refused when negative or
+    when they fit the machine only once divided by 1000."""
+    length_min, length_max = _stroke(
+        "limits.leg_length_min",
+        values["limits.leg_length_min"],
+        "limits.leg_length_max",
+        values["limits.leg_length_max"],
+    )
+    if np.any(length_min < 0.0):
+        msg = f"limits.leg_length_min: expected values >= 0 m, got {length_min.min():g}"
+        raise GeometryError(msg)
+    size = machine_size(base_joints, platform_joints, home)
+    for name, limit in (
+        ("limits.leg_length_min", length_min),
+        ("limits.leg_length_max", length_max),
+    ):
+        unit_reason = millimetre_reason(name, limit, size)
+        if unit_reason is not None:
+            raise GeometryError(unit_reason)
+    return length_min, length_max
+
+
+def _joint_angles(values: Mapping[str, Any]) -> dict[str, NDArray[np.float64]]:
+    """``limits.base_joint_max_angle`` and ``limits.platform_joint_max_angle`` (rad, per leg,
+    in (0, π))."""
     angles = {}
     for name in ("limits.base_joint_max_angle", "limits.platform_joint_max_angle"):
         angle = per_leg(name, values[name])
@@ -219,6 +290,11 @@ def manipulator_from_mapping(
             )
             raise GeometryError(msg)
         angles[name] = angle
+    return angles
+
+
+def _leg_diameter(values: Mapping[str, Any]) -> float:
+    """``limits.leg_diameter``: one length >= 0, m."""
     diameter = bounded_lengths(
         "limits.leg_diameter", numbers("limits.leg_diameter", values["limits.leg_diameter"])
     )
@@ -228,50 +304,7 @@ def manipulator_from_mapping(
     if diameter[0] < 0.0:
         msg = f"limits.leg_diameter: expected a value >= 0 m, got {diameter[0]:g}"
         raise GeometryError(msg)
-    paired_length = _paired_joint_length(
-        values["geometry.paired_joint_length"],
-        base_joints,
-        platform_joints,
-        float(diameter[0]),
-        length_min,
-        machine_size(base_joints, platform_joints, home),
-    )
-
-    base_axes = unit_axes("geometry.base_joint_axes", values["geometry.base_joint_axes"])
-    platform_axes = unit_axes(
-        "geometry.platform_joint_axes", values["geometry.platform_joint_axes"]
-    )
-    frozen_legs: dict[str, Any] = {
-        key: frozen(value) if isinstance(value, np.ndarray) else value
-        for key, value in legs.items()
-    }
-    manipulator = Manipulator(
-        base_joints=frozen(base_joints),
-        platform_joints=frozen(platform_joints),
-        base_joint_axes=frozen(np.zeros((6, 3)) if base_axes is None else base_axes),
-        platform_joint_axes=frozen(np.zeros((6, 3)) if platform_axes is None else platform_axes),
-        leg_length_min=frozen(length_min),
-        leg_length_max=frozen(length_max),
-        base_joint_max_angle=frozen(angles["limits.base_joint_max_angle"]),
-        platform_joint_max_angle=frozen(angles["limits.platform_joint_max_angle"]),
-        leg_diameter=float(diameter[0]),
-        paired_joint_length=paired_length,
-        home_position=frozen(home),
-        position=frozen(position),
-        frame_id=frame_id,
-        axes_from_home=(base_axes is None, platform_axes is None),
-        singularity_min=_singularity_min(values["limits.singularity_min"]),
-        architecture=architecture,
-        **frozen_legs,
-    )
-    manipulator = _with_home_axes(manipulator, base_axes is None, platform_axes is None)
-    if any(name.startswith(COLLISION_PARAMETERS) for name in flat):
-        manipulator = _with_scene(manipulator, flat)
-    if warn:
-        reason = unusable_reason(manipulator)
-        if reason is not None:
-            warnings.warn(reason, HomePoseWarning, stacklevel=2)
-    return manipulator
+    return float(diameter[0])
 
 
 def load_manipulator(path: str | Path, *, loads_read: bool = False) -> Manipulator:
