@@ -339,7 +339,7 @@ WORKED = {
 }
 
 
-def test_loads_command_answers_the_pose_and_geometric_commands_refuse_its_limits(tmp_path):
+def test_loads_command_answers_the_pose_and_the_searches_refuse_its_limits(tmp_path):
     path = loads_file(tmp_path, WORKED)
     code, out, err = run_main("--config", str(path), "--json", "loads", "--pose", "0", "0", "0")
     assert code == 0, err
@@ -352,27 +352,71 @@ def test_loads_command_answers_the_pose_and_geometric_commands_refuse_its_limits
     code, out, err = run_main("--config", str(path), "--json", "loads", "--pose", "0", "30", "0")
     assert code == 1 and "actuator_force" in json.loads(out)["violated"]
     assert "limits exceeded at this pose: actuator_force" in err
-    code, _, err = run_main("--config", str(path), "check", "--pose", "0", "30", "0")
+    code, _, err = run_main("--config", str(path), "projected", "--n-phi", "8")
     assert code == 2
     assert one_error_line(err).endswith(
-        "limits.actuator_force_max: a loads limit, read by 'hexapod-workspace loads' only; the "
-        "geometric checks, searches, motions and the node do not take it as a constraint yet "
-        "(leave it out of this file)"
+        "limits.actuator_force_max: a loads limit, read by 'hexapod-workspace loads' and "
+        "'check' only; the workspace searches, motions and the node do not take it as a "
+        "constraint yet (leave it out of this file)"
     )
     # Without the limits, the same file's loads do not change a geometric verdict.
     relaxed = dict(WORKED, limits=dict(WORKED["limits"], actuator_force_max=[]))
-    code, _, err = run_main(
-        "--config",
-        str(loads_file(tmp_path, relaxed, "relaxed.yaml")),
-        "check",
-        "--pose",
-        "0",
-        "30",
-        "0",
+    relaxed_path = loads_file(tmp_path, relaxed, "relaxed.yaml")
+    code, out, err = run_main(
+        "--config", str(relaxed_path), "--json", "check", "--pose", "0", "30", "0"
     )
     assert code == 0, err
+    assert "loads" not in json.loads(out)["poses"][0]
     code, text, _ = run_main("--config", str(path), "loads", "--pose", "0", "0", "0")
     assert code == 0 and "payload capacity" in text and "deflection" in text
+
+
+def test_check_counts_the_loads_limits_in_each_verdict_with_the_loads_margins(tmp_path):
+    """The worked example through ``check``: at θ = 30° the geometry holds but legs of 700 N do
+    not (exit 1, ``actuator_force`` violated, leg 6 limiting) and the tool deflects 91.8 µm
+    under the process box, over a limit of 80 µm (65.6 µm at the home pose); the margins are
+    those ``loads`` gives at the same pose, the deflection and accuracy rows the limit less the
+    worst translation ``loads`` reports."""
+    limits = dict(WORKED["limits"], deflection_max=8e-5, accuracy_max=2e-5)
+    path = loads_file(tmp_path, dict(WORKED, limits=limits))
+    code, out, err = run_main(
+        "--config", str(path), "--json", "check", "--pose", "0", "0", "0", "--pose", "0", "30", "0"
+    )
+    assert code == 1, err
+    assert "1 of 2 poses unreachable or beyond the loads' limits" in err
+    home, tilted = json.loads(out)["poses"]
+    assert home["reachable"] is True and home["violated"] == []
+    assert tilted["reachable"] is False
+    assert tilted["violated"] == ["actuator_force", "deflection"]
+    assert not any(v < 0 for v in tilted["margins"].values() if v is not None)
+    for pose, document in zip(("0", "30"), (home, tilted), strict=True):
+        _, answer, _ = run_main("--config", str(path), "--json", "loads", "--pose", "0", pose, "0")
+        loads = json.loads(answer)
+        assert set(document["loads"]) == {
+            "actuator_force",
+            "deflection",
+            "accuracy",
+            "limiting_actuator",
+        }
+        assert document["loads"]["actuator_force"] == pytest.approx(loads["force_margin_n"])
+        assert document["loads"]["limiting_actuator"] == loads["limiting_actuator"]
+        assert document["loads"]["deflection"] == pytest.approx(8e-5 - loads["deflection_m"])
+        assert document["loads"]["accuracy"] == pytest.approx(2e-5 - loads["accuracy_m"])
+    assert tilted["loads"]["actuator_force"] == pytest.approx(-30.9, abs=0.05)
+    assert tilted["loads"]["limiting_actuator"] == 6
+    # The table shows the rows in N and mm and counts them in its verdict.
+    code, text, _ = run_main("--config", str(path), "check", "--pose", "0", "30", "0")
+    assert code == 1
+    assert "force" in text and "[N]" in text and "deflection" in text
+    assert "0/1 poses reachable and within the loads' limits" in text
+    assert text.splitlines()[4].endswith("actuator_force,deflection")
+    # The log's check messages carry no loads rows: refused before any work.
+    record = tmp_path / "check.mcap"
+    code, _, err = run_main(
+        "--config", str(path), "check", "--pose", "0", "0", "0", "--record", str(record)
+    )
+    assert code == 2 and not record.exists()
+    assert "--record: the log's check messages carry no loads rows" in one_error_line(err)
 
 
 def test_a_centre_of_mass_in_millimetres_is_refused_with_the_unit_hint(tmp_path):
@@ -408,7 +452,7 @@ def test_the_worked_example_of_the_loads_page_is_what_the_command_prints(tmp_pat
     examples = re.findall(
         r"```text\n\$ (hexapod-workspace [^\n]*)\n(.*?)```", LOADS_PAGE, re.DOTALL
     )
-    assert len(examples) == 2
+    assert len(examples) == 3
     for command, shown in examples:
         lines = shown.splitlines()
         status = 0

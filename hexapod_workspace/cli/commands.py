@@ -19,7 +19,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core.base import resolution
+from ..core.base.rotations import tt_to_matrix
 from ..core.evaluation.check import check
+from ..core.evaluation.loads import LoadCase, load_rows
 from ..core.model.manipulator import Manipulator
 from ..core.workspaces.orientation import orientation_workspace, torsion_range
 from ..core.workspaces.projected import projected_workspace
@@ -71,6 +73,7 @@ def check_command(
     as_json: bool = False,
     record: Path | None = None,
     singularity: bool = False,
+    loads: LoadCase | None = None,
     out: IO[str],
     err: IO[str],
 ) -> int:
@@ -79,22 +82,37 @@ def check_command(
     beside their T&T angles).
 
     ``singularity`` reports the singularity margin even when ``limits.singularity_min`` is 0.
-    Returns 0 when every pose is reachable, 1 when some is not (the count on ``err``).
+    ``loads`` (centre of mass in the model's tool frame) adds the loads' rows it sets
+    (:func:`~hexapod_workspace.core.evaluation.loads.load_rows`) to each pose's verdict; the log
+    does not carry them, so ``record`` must be None then.
+    Returns 0 when every pose is reachable (within the loads' limits), 1 when some is not (the
+    count on ``err``).
     """
     started = time.time_ns()
     poses = poses_deg if isinstance(poses_deg, GivenPoses) else GivenPoses("tt", poses_deg)
     degrees = poses.tt_degrees()
     given = None if poses.is_tt else (poses.keys, poses.values)
     radians = poses_from_degrees(degrees) if poses.is_tt else poses.radians()
+    if loads is not None and record is not None:
+        msg = (
+            "--record: the log's check messages carry no loads rows; drop --record or the "
+            "loads' limits"
+        )
+        raise CliError(msg)
     result = check(manipulator, radians, singularity=singularity)
+    rows = None
+    if loads is not None:
+        rows = load_rows(manipulator, loads, tt_to_matrix(radians), manipulator.position)
     _record(record, manipulator, [result], started, err)
     if as_json:
-        reports.check_json(result, out, degrees, given)
+        reports.check_json(result, out, degrees, given, rows)
     else:
-        reports.check_table(result, out, degrees, manipulator, given)
-    unreachable = len(result) - int(np.count_nonzero(result.reachable))
+        reports.check_table(result, out, degrees, manipulator, given, rows)
+    held = result.reachable if rows is None else result.reachable & rows.holds
+    unreachable = len(result) - int(np.count_nonzero(held))
     if unreachable:
-        err.write(f"{PROG}: {unreachable} of {len(result)} poses unreachable\n")
+        what = "unreachable" if rows is None else "unreachable or beyond the loads' limits"
+        err.write(f"{PROG}: {unreachable} of {len(result)} poses {what}\n")
         return 1
     return 0
 

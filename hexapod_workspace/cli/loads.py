@@ -35,14 +35,17 @@ from numpy.typing import NDArray
 
 from .._resources import example_config_path
 from ..core.base.params import load_params_file
-from ..core.cell.frames import cell_from_params_file, require_plausible_cell, tool_model
+from ..core.cell.frames import Tool, cell_from_params_file, require_plausible_cell, tool_model
+from ..core.evaluation.loading import load_manipulator
 from ..core.evaluation.loads import (
+    LoadCase,
     Loads,
     load_case_from_mapping,
     loads_at,
     require_plausible_loads,
 )
 from ..core.model.architectures import module as architecture_module
+from ..core.model.manipulator import Manipulator
 from ..errors import ConfigError
 from .cam import tool_json
 from .commands import PROG
@@ -54,7 +57,14 @@ from .inputs import (
     tool_position,
 )
 
-__all__ = ["LOADS_DESCRIPTION", "LOADS_HELP", "cmd_loads", "loads_arguments"]
+__all__ = [
+    "LOADS_DESCRIPTION",
+    "LOADS_HELP",
+    "check_load_case",
+    "cmd_loads",
+    "configured_load_case",
+    "loads_arguments",
+]
 
 LOADS_HELP = "actuator forces, payload capacity, deflection and accuracy at one pose"
 LOADS_DESCRIPTION = (
@@ -104,18 +114,39 @@ def _violated(result: Loads, deflection_max: float, accuracy_max: float) -> list
     return names
 
 
+def configured_load_case(path: Path, platform: Manipulator, tool: Tool) -> LoadCase:
+    """The loads of the parameters file ``path``, refused in one line naming the file (a centre
+    of mass that fits ``platform``, the platform-frame model, only in millimetres included),
+    with the centre of mass moved into the frame of ``tool``."""
+    try:
+        case = require_plausible_loads(platform, load_case_from_mapping(load_params_file(path)))
+    except ConfigError as error:
+        msg = f"parameters file {path}: {error}"
+        raise CliError(msg) from error
+    return case.in_tool_frame(tool.offset, tool.rotation)
+
+
+def check_load_case(config: str | None) -> LoadCase | None:
+    """The loads of ``--config`` for ``check`` when it sets one of the loads' limits
+    (``limits.actuator_force_max``, ``limits.deflection_max``, ``limits.accuracy_max``),
+    centre of mass in the tool frame; None without a file or without such a limit."""
+    if not config:
+        return None
+    path = Path(config)
+    platform = load_manipulator(path, loads_read=True)
+    case = configured_load_case(path, platform, cell_from_params_file(path).tool)
+    if case.force_max is None and case.deflection_max <= 0.0 and case.accuracy_max <= 0.0:
+        return None
+    return case
+
+
 def cmd_loads(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
     """``loads``: the loads at one pose."""
     path = Path(options.config) if options.config else example_config_path()
     platform = configured_manipulator(path, None, err, with_tool=False, loads_read=True)
     cell = require_plausible_cell(platform, cell_from_params_file(path))
     manipulator = tool_model(platform, cell.tool)
-    try:
-        case = require_plausible_loads(platform, load_case_from_mapping(load_params_file(path)))
-    except ConfigError as error:
-        msg = f"parameters file {path}: {error}"
-        raise CliError(msg) from error
-    case = case.in_tool_frame(cell.tool.offset, cell.tool.rotation)
+    case = configured_load_case(path, platform, cell.tool)
     position = tool_position(options.position, manipulator, platform)
     given = pose_flag(options.pose, options.angles)
     rotation = given.matrices()[0]

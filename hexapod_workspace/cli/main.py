@@ -201,12 +201,15 @@ def _check_run(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
         raise CliError(msg)
     record = _record_path(options)
     poses = GivenPoses(parts[-1].convention, np.concatenate([part.values for part in parts]))
+    manipulator = configured_manipulator(options.config, options.position, err, loads_read=True)
+    case = loads.check_load_case(options.config)
     return commands.check_command(
-        _manipulator(options, err),
+        manipulator,
         poses,
         as_json=options.json,
         record=record,
         singularity=options.singularity,
+        loads=case,
         out=out,
         err=err,
     )

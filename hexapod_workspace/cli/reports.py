@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 from ..core.base.resolution import WorkspaceKind
 from ..core.constraints.table import CONSTRAINTS, SINGULARITY
 from ..core.evaluation.check import CheckResult
+from ..core.evaluation.loads import LoadRows
 from ..core.model.manipulator import Manipulator
 from ..core.workspaces.orientation import OrientationWorkspace, TorsionRange
 from ..core.workspaces.projected import ProjectedWorkspace
@@ -91,11 +92,35 @@ def _write_rows(out: IO[str], template: str, columns: Sequence[Sequence[Any]], s
         out.write(text if start + block >= count else text + sep)
 
 
+def _verdicts(
+    result: CheckResult, loads: LoadRows | None
+) -> tuple[NDArray[np.bool_], list[list[str]]]:
+    """Per pose, whether every row holds and the names of the violated ones: the geometric
+    rows, then the loads' rows the parameters file sets."""
+    if loads is None:
+        return result.reachable, result.violated
+    violated = [a + b if b else a for a, b in zip(result.violated, loads.violated, strict=True)]
+    return result.reachable & loads.holds, violated
+
+
+def _load_cells(loads: LoadRows, template: str) -> list[str]:
+    """Per pose, the margins of the loads' rows formatted into ``template`` (null: -inf)."""
+
+    def number(value: float) -> str:
+        return f"{value:.12g}" if math.isfinite(value) else "null"
+
+    columns = [[number(v) for v in margin.tolist()] for margin in loads.margins.values()]
+    if "actuator_force" in loads.margins:
+        columns.append([str(k) for k in loads.limiting_actuator.tolist()])
+    return [template % row for row in zip(*columns, strict=True)]
+
+
 def check_json(
     result: CheckResult,
     out: IO[str],
     degrees: NDArray[np.float64],
     given: tuple[list[str], NDArray[np.float64]] | None = None,
+    loads: LoadRows | None = None,
 ) -> None:
     """Write ``{"position": [...], "poses": [...]}`` for a check result, streaming.
 
@@ -113,9 +138,15 @@ def check_json(
         The poses in T&T angles, degrees (as the user gave them for T&T).
     given : (list of str, ndarray of shape (N, k)), optional
         The JSON keys and the values of the convention the poses were given in, when not T&T.
+    loads : LoadRows, optional
+        The loads' rows the parameters file sets: ``"loads": {"actuator_force": …,
+        "limiting_actuator": …, "deflection": …, "accuracy": …}`` (the rows set; N or N·m, m;
+        null for −inf at a singular pose) after the margins, and ``reachable`` and
+        ``violated`` count them.
     """
+    reachable, violated_names = _verdicts(result, loads)
     texts: dict[tuple[str, ...], str] = {}
-    violated = [texts.setdefault(tuple(v), json.dumps(v)) for v in result.violated]
+    violated = [texts.setdefault(tuple(v), json.dumps(v)) for v in violated_names]
     names = reported_names(result)
     finite = {name: bool(np.all(np.isfinite(result.margins[name]))) for name in names}
     margins = [
@@ -127,20 +158,26 @@ def check_json(
     # 12 significant digits: exact to 1e-12 relative, and twice as fast to format as repr().
     margin_fields = ", ".join(f'"{name}": {"%.12g" if finite[name] else "%s"}' for name in names)
     pair = ', "collision_pair": %s' if result.collision_pairs else ""
+    load_field = ', "loads": %s' if loads is not None else ""
     given_fields = "".join(f'"{key}": %.12g, ' for key in given[0]) if given else ""
     template = (
         f'{{{given_fields}"phi_deg": %.12g, "theta_deg": %.12g, "psi_deg": %.12g, '
         '"reachable": %s, "violated": %s, '
-        f'"margins": {{{margin_fields}}}, "limiting_leg": %d{pair}}}'
+        f'"margins": {{{margin_fields}}}, "limiting_leg": %d{load_field}{pair}}}'
     )
     columns = [
         *(np.asarray(given[1]).T.tolist() if given else []),
         *np.asarray(degrees).T.tolist(),
-        np.where(result.reachable, "true", "false").tolist(),
+        np.where(reachable, "true", "false").tolist(),
         violated,
         *margins,
         result.limiting_leg.tolist(),
     ]
+    if loads is not None:
+        fields = [f'"{name}": %s' for name in loads.margins]
+        if "actuator_force" in loads.margins:
+            fields.append('"limiting_actuator": %s')
+        columns.append(_load_cells(loads, "{" + ", ".join(fields) + "}"))
     if result.collision_pairs:
         quoted = {name: json.dumps(name) for name in ("", *result.collision_pairs)}
         columns.append([quoted[name] for name in result.collision_pair])
@@ -155,6 +192,7 @@ def check_table(
     degrees: NDArray[np.float64],
     manipulator: Manipulator,
     given: tuple[list[str], NDArray[np.float64]] | None = None,
+    loads: LoadRows | None = None,
 ) -> None:
     """Write a readable table: angles in degrees, margins (distance to each limit) in mm and
     degrees, the limiting leg and the violated constraints.
@@ -162,8 +200,11 @@ def check_table(
     Parameters are those of :func:`check_json`, and the model the result is of (the unit of a
     row can depend on it: the ``actuator`` stroke in mm for slides, deg for cranks). Poses given
     in another convention than T&T get their own columns first (``u``, ``v``, ``w`` [deg],
-    ``qx`` ... [1]), then the T&T angles they denote.
+    ``qx`` ... [1]), then the T&T angles they denote. The loads' rows the file sets follow the
+    geometric ones (``force`` in N or N·m, ``deflection`` and ``accuracy`` in mm; -inf at a
+    singular pose) and count in ``reachable`` and ``violated``.
     """
+    reachable, violated = _verdicts(result, loads)
     x, y, z = result.position
     out.write(f"position: ({x:.4f}, {y:.4f}, {z:.4f}) m\n")
     # The singularity margin is a column only where it was evaluated (enforced by
@@ -179,8 +220,14 @@ def check_table(
         )
     ]
     report = [row.report(manipulator) for row in shown]  # (unit, factor), read once
-    names = " ".join(f"{row.column:>11}" for row in shown)
-    units = " ".join(f"{'[' + unit + ']':>11}" for unit, _ in report)
+    columns_shown = [row.column for row in shown]
+    load_report: list[tuple[str, float]] = []
+    if loads is not None:
+        for name in loads.margins:
+            columns_shown.append("force" if name == "actuator_force" else name)
+            load_report.append((loads.force_unit, 1.0) if name == "actuator_force" else ("mm", 1e3))
+    names = " ".join(f"{column:>11}" for column in columns_shown)
+    units = " ".join(f"{'[' + unit + ']':>11}" for unit, _ in [*report, *load_report])
     given_names, given_units, given_format, given_columns = "", "", "", []
     if given is not None:
         keys, values = given
@@ -208,21 +255,29 @@ def check_table(
     columns = [
         *given_columns,
         *angle_columns,
-        np.where(result.reachable, "yes", "NO").tolist(),
+        np.where(reachable, "yes", "NO").tolist(),
         *(
             (result.margins[row.name] * factor).tolist()
             for row, (_, factor) in zip(shown, report, strict=True)
         ),
+        *(
+            (margin * factor).tolist()
+            for margin, (_, factor) in zip(
+                loads.margins.values() if loads is not None else (), load_report, strict=True
+            )
+        ),
         result.limiting_leg.tolist(),
-        [",".join(v) or "-" for v in result.violated],
+        [",".join(v) or "-" for v in violated],
     ]
-    template = angle_format + "  %-9s  " + " ".join(["%11.3f"] * len(shown)) + "  %8d  %s"
+    count = len(columns_shown)
+    template = angle_format + "  %-9s  " + " ".join(["%11.3f"] * count) + "  %8d  %s"
     if result.collision_pairs:
         template += "  %s"
         columns.append(result.collision_pair)
     _write_rows(out, template, columns, "\n")
-    reachable = int(np.count_nonzero(result.reachable))
-    out.write(f"\n{reachable}/{len(result)} poses reachable\n")
+    held = int(np.count_nonzero(reachable))
+    what = "reachable and within the loads' limits" if loads is not None else "reachable"
+    out.write(f"\n{held}/{len(result)} poses {what}\n")
 
 
 # ---------------------------------------------------------------------------- workspaces

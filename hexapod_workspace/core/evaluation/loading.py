@@ -112,9 +112,9 @@ def manipulator_from_mapping(
     loads_read : bool
         The caller reads the loads' limits (``limits.actuator_force_max``,
         ``limits.deflection_max``, ...: :mod:`~hexapod_workspace.core.evaluation.loads`), as
-        ``hexapod-workspace loads`` does. Otherwise a limit set to a value is refused: the
-        constraint table, the searches, the motions and the node do not take it yet, and a
-        verdict that ignored it would be for another machine.
+        ``hexapod-workspace loads`` and ``check`` do. Otherwise a limit set to a value is
+        refused: the constraint table, the searches, the motions and the node do not take it
+        yet, and a verdict that ignored it would be for another machine.
 
     Returns
     -------
@@ -211,8 +211,8 @@ def _checked_values(flat: Mapping[str, Any], loads_read: bool) -> dict[str, Any]
         given = [name for name in LOAD_LIMITS if name in flat and not _unset_limit(flat[name])]
         if given:
             msg = (
-                f"{given[0]}: a loads limit, read by 'hexapod-workspace loads' only; the "
-                "geometric checks, searches, motions and the node do not take it as a "
+                f"{given[0]}: a loads limit, read by 'hexapod-workspace loads' and 'check' "
+                "only; the workspace searches, motions and the node do not take it as a "
                 "constraint yet (leave it out of this file)"
             )
             raise ConfigError(msg)

@@ -38,12 +38,21 @@ below :data:`SINGULAR_RATIO`) or a leg has no inverse-kinematics solution answer
 deflections and errors of +inf, a force margin of −inf and a capacity of 0, never a finite
 wrong value.
 
-This module is numpy only; the constraint rows of :mod:`~hexapod_workspace.core.constraints`
-do not take these limits yet (the loader refuses them for geometric checks).
+**Rows at poses.** :func:`load_rows` gives the three limits a case sets as margins at N poses,
+the way ``hexapod-workspace check`` reports them beside the geometric rows: ``actuator_force``
+(N or N·m, the smallest distance of the worst τ_i over the process box to its limits, the
+limiting actuator named), ``deflection`` and ``accuracy`` (m, the limit less the worst
+translation). Each is exact at its pose (no sampling inside a pose). They are not rows of
+:mod:`~hexapod_workspace.core.constraints` yet: the searches, the move certificate and the
+planner need their rate bounds, so the loader refuses a loads limit for every command but
+``check`` and ``loads``.
+
+This module is numpy only.
 """
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from collections.abc import Mapping
@@ -64,11 +73,14 @@ from ..model.manipulator import Manipulator
 __all__ = [
     "LOAD_LIMITS",
     "LOAD_PARAMETERS",
+    "LOAD_ROWS",
     "SINGULAR_RATIO",
     "LoadCase",
+    "LoadRows",
     "Loads",
     "actuator_jacobian",
     "load_case_from_mapping",
+    "load_rows",
     "loads_at",
     "require_plausible_loads",
 ]
@@ -496,3 +508,97 @@ def loads_at(
         accuracy_m=accuracy_m,
         accuracy_rad=accuracy_rad,
     )
+
+
+#: The loads' rows, in report order: the actuator force margin (N, or N·m for cranks), the
+#: deflection margin and the accuracy margin (m).
+LOAD_ROWS = ("actuator_force", "deflection", "accuracy")
+
+
+@dataclass(frozen=True)
+class LoadRows:
+    """The loads' limits of one case as margins at N poses (module documentation, *Rows at
+    poses*).
+
+    Attributes
+    ----------
+    margins : dict of str to ndarray, shape (N,)
+        The rows the case sets, in :data:`LOAD_ROWS` order: ``actuator_force`` (N or N·m),
+        ``deflection`` and ``accuracy`` (m); >= 0 holds; −inf at a singular pose or where a leg
+        has no inverse-kinematics solution.
+    limiting_actuator : ndarray, shape (N,), int
+        1-based actuator of ``actuator_force`` (0 when that row is not set).
+    force_unit : str
+        ``"N"`` or ``"N·m"`` (the architecture's).
+    """
+
+    margins: dict[str, NDArray[np.float64]]
+    limiting_actuator: NDArray[np.int64]
+    force_unit: str
+
+    @functools.cached_property
+    def holds(self) -> NDArray[np.bool_]:
+        """(N,) bool: every row holds (NaN does not)."""
+        held = np.ones(self.limiting_actuator.shape, dtype=bool)
+        for margin in self.margins.values():
+            held &= margin >= 0.0
+        return held
+
+    @functools.cached_property
+    def violated(self) -> list[list[str]]:
+        """Per pose, the names of the violated rows (:data:`LOAD_ROWS` order)."""
+        broken = {name: ~(margin >= 0.0) for name, margin in self.margins.items()}
+        return [
+            [name for name in self.margins if broken[name][k]]
+            for k in range(self.limiting_actuator.shape[0])
+        ]
+
+
+def load_rows(
+    manipulator: Manipulator, case: LoadCase, rotations: ArrayLike, positions: ArrayLike
+) -> LoadRows | None:
+    """The limits ``case`` sets as margins at N poses, None when it sets none.
+
+    Parameters
+    ----------
+    manipulator, case : Manipulator, LoadCase
+        As for :func:`loads_at` (a tool-frame model, the centre of mass in its mobile frame).
+    rotations : array_like, shape (N, 3, 3)
+        R of the tool frame at each pose, base frame.
+    positions : array_like, shape (3,) or (N, 3)
+        The tool centre point, base frame, m.
+
+    Returns
+    -------
+    LoadRows or None
+    """
+    names = [
+        name
+        for name, wanted in zip(
+            LOAD_ROWS,
+            (case.force_max is not None, case.deflection_max > 0.0, case.accuracy_max > 0.0),
+            strict=True,
+        )
+        if wanted
+    ]
+    if not names:
+        return None
+    r = np.asarray(rotations, dtype=np.float64).reshape(-1, 3, 3)
+    count = r.shape[0]
+    p = np.broadcast_to(np.asarray(positions, dtype=np.float64), (count, 3))
+    margins: dict[str, NDArray[np.float64]] = {name: np.empty(count) for name in names}
+    limiting = np.zeros(count, dtype=np.int64)
+    for k in range(count):
+        loads = loads_at(manipulator, case, r[k], p[k])
+        if "actuator_force" in margins:
+            assert loads.force_margin is not None
+            margins["actuator_force"][k] = loads.force_margin
+            limiting[k] = loads.limiting_actuator
+        if "deflection" in margins:
+            assert loads.deflection_m is not None
+            margins["deflection"][k] = case.deflection_max - loads.deflection_m
+        if "accuracy" in margins:
+            assert loads.accuracy_m is not None
+            margins["accuracy"][k] = case.accuracy_max - loads.accuracy_m
+    unit = architecture_module(manipulator.architecture).FORCE_UNIT
+    return LoadRows(margins=margins, limiting_actuator=limiting, force_unit=unit)
