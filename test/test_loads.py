@@ -419,6 +419,34 @@ def test_check_counts_the_loads_limits_in_each_verdict_with_the_loads_margins(tm
     assert "--record: the log's check messages carry no loads rows" in one_error_line(err)
 
 
+@pytest.mark.parametrize(("name", "unit"), [("pus", "[N]"), ("rus", "[N·m]")])
+def test_check_gives_no_finite_force_margin_where_a_leg_has_no_solution(tmp_path, name, unit):
+    """At θ = 60° a leg of the 6-PUS and 6-RUS examples has no inverse-kinematics solution: the
+    force margin is −∞ (``null``), never a finite value, and counts as violated; at home it is
+    what ``loads`` answers, in the architecture's unit."""
+    document = yaml.safe_load((CONFIG / EXAMPLES[name]).read_text())
+    parameters = document["hexapod_workspace"]["ros__parameters"]
+    parameters["load"] = {"mass": 5.0}
+    parameters["limits"]["actuator_force_max"] = [200.0]
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(yaml.safe_dump(document))
+    code, out, _ = run_main(
+        "--config", str(path), "--json", "check", "--pose", "0", "0", "0", "--pose", "0", "60", "0"
+    )
+    assert code == 1
+    home, far = json.loads(out)["poses"]
+    _, answer, _ = run_main("--config", str(path), "--json", "loads", "--pose", "0", "0", "0")
+    assert home["reachable"] is True
+    assert home["loads"]["actuator_force"] == pytest.approx(json.loads(answer)["force_margin_n"])
+    assert set(home["loads"]) == {"actuator_force", "limiting_actuator"}
+    assert far["margins"]["ik"] < 0.0 and far["loads"]["actuator_force"] is None
+    assert far["reachable"] is False and far["violated"][-2:] == ["transmission", "actuator_force"]
+    _, text, _ = run_main("--config", str(path), "check", "--pose", "0", "0", "0")
+    names, units = text.splitlines()[2:4]
+    assert names.split()[-3:] == ["force", "limiting", "violated"]
+    assert units.split()[-2:] == [unit, "leg"]
+
+
 def test_a_centre_of_mass_in_millimetres_is_refused_with_the_unit_hint(tmp_path):
     path = loads_file(tmp_path, {"load": {"mass": 40.0, "center_of_mass": [0.0, 0.0, 200.0]}})
     code, _, err = run_main("--config", str(path), "loads", "--pose", "0", "0", "0")
