@@ -86,6 +86,7 @@ from hexapod_workspace.core import kernels
 from hexapod_workspace.core.base import params
 from hexapod_workspace.core.base.params import NODE_PARAMETERS, ROS_PARAMETERS, unknown_parameter
 from hexapod_workspace.core.evaluation.check import check
+from hexapod_workspace.core.evaluation.loads import LOAD_PARAMETERS
 from hexapod_workspace.core.kernels import planner as planner_kernels
 from hexapod_workspace.core.model.manipulator import Manipulator
 from hexapod_workspace.errors import ConfigError, InputError
@@ -420,6 +421,14 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         With no model parameter given the packaged example is the model, and the log says so."""
         names = set(self._override_names) | set(getattr(self, "_parameter_overrides", {}))
         self._specs.update(dynamic_specs(names))  # the tool table and collision.* given
+        loads = sorted(name for name in names if name in LOAD_PARAMETERS)
+        if loads:
+            msg = (
+                f"{loads[0]}: a loads parameter, read by 'hexapod-workspace loads' and "
+                "'check'; the node does not take the loads yet (leave it out of the node's "
+                "parameters)"
+            )
+            raise ConfigError(msg)
         unknown = unknown_parameter(names, (*self._specs, *NODE_PARAMETERS, *ROS_PARAMETERS))
         if unknown is not None:
             raise ConfigError(f"unknown parameter given to the node: {unknown}")

@@ -141,8 +141,14 @@ def test_invalid_overrides_refuse_to_start(ros_context, overrides, named):
             "limit: unknown section",
         ),
         ({"resolution.n_rayz": 36}, "resolution.n_rayz: unknown parameter"),
+        # a loads key is not a typo: it is read by the CLI, not yet by the node
+        (
+            {**example_model(), "load.mass": 40.0},
+            "load.mass: a loads parameter, read by 'hexapod-workspace loads' and 'check'; the "
+            "node does not take the loads yet",
+        ),
     ],
-    ids=["misspelt-key", "misspelt-section", "misspelt-setting"],
+    ids=["misspelt-key", "misspelt-section", "misspelt-setting", "loads-key"],
 )
 def test_an_unknown_parameter_stops_the_node_with_its_name(ros_context, overrides, named):
     with pytest.raises(ConfigError) as raised:
