@@ -456,9 +456,21 @@ def test_a_centre_of_mass_in_millimetres_is_refused_with_the_unit_hint(tmp_path)
     assert "it looks like millimetres" in line
 
 
-def test_loads_command_refuses_a_bad_loads_parameter_naming_the_file(tmp_path):
+@pytest.mark.parametrize(
+    "command",
+    [
+        ("loads", "--pose", "0", "0", "0"),
+        ("check", "--pose", "0", "0", "0"),
+        ("projected", "--n-phi", "8"),
+        ("torsion-range", "--direction", "0", "0"),
+    ],
+    ids=lambda command: command[0],
+)
+def test_every_command_refuses_a_bad_loads_parameter_naming_the_file(tmp_path, command):
+    """A bad loads value is bad input for every command, not only for those that read the
+    loads: it is refused (exit 2), never passed over."""
     path = loads_file(tmp_path, {"load": {"mass": -3.0}})
-    code, _, err = run_main("--config", str(path), "loads", "--pose", "0", "0", "0")
+    code, _, err = run_main("--config", str(path), *command)
     assert code == 2
     line = one_error_line(err)
     assert f"parameters file {path}: load.mass: expected one number >= 0 (kg)" in line

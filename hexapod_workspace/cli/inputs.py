@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 
 from .._resources import example_config_path
 from ..core.base import resolution
+from ..core.base.params import load_params_file
 from ..core.base.rotations import (
     ANGLE_CONVENTIONS,
     convention_to_tt,
@@ -29,8 +30,9 @@ from ..core.base.rotations import (
 from ..core.base.validation import machine_size, millimetre_reason
 from ..core.cell.frames import cell_from_params_file, require_plausible_cell, tool_model
 from ..core.evaluation.loading import load_manipulator
+from ..core.evaluation.loads import LoadCase, load_case_from_mapping, require_plausible_loads
 from ..core.model.manipulator import Manipulator
-from ..errors import HexapodWorkspaceError, InputError
+from ..errors import ConfigError, HexapodWorkspaceError, InputError
 from .tables import (
     ORIENTATION_QUANTITIES,
     Columns,
@@ -55,6 +57,7 @@ __all__ = [
     "poses_from_degrees",
     "psi_step_flag",
     "rays_flag",
+    "read_load_case",
     "read_poses_file",
     "tolerance_flag",
 ]
@@ -264,6 +267,7 @@ def configured_manipulator(
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         manipulator = load_manipulator(path, loads_read=loads_read)
+    read_load_case(path, manipulator)  # every command refuses a bad loads parameter
     cell = require_plausible_cell(manipulator, cell_from_params_file(path))
     if with_tool:
         manipulator = tool_model(manipulator, cell.tool)
@@ -279,6 +283,17 @@ def configured_manipulator(
         msg = "--position" + str(error).removeprefix("position")
         raise CliError(msg) from error
     return manipulator.with_position(position)
+
+
+def read_load_case(path: Path, platform: Manipulator) -> LoadCase:
+    """The loads of the parameters file ``path`` (centre of mass in the platform frame),
+    refused in one line naming the file, a centre of mass that fits ``platform`` only in
+    millimetres included."""
+    try:
+        return require_plausible_loads(platform, load_case_from_mapping(load_params_file(path)))
+    except ConfigError as error:
+        msg = f"parameters file {path}: {error}"
+        raise CliError(msg) from error
 
 
 def tool_position(

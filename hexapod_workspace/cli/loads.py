@@ -34,26 +34,22 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._resources import example_config_path
-from ..core.base.params import load_params_file
 from ..core.cell.frames import Tool, cell_from_params_file, require_plausible_cell, tool_model
 from ..core.evaluation.loading import load_manipulator
 from ..core.evaluation.loads import (
     LoadCase,
     Loads,
-    load_case_from_mapping,
     loads_at,
-    require_plausible_loads,
 )
 from ..core.model.architectures import module as architecture_module
 from ..core.model.manipulator import Manipulator
-from ..errors import ConfigError
 from .cam import tool_json
 from .commands import PROG
 from .inputs import (
-    CliError,
     add_angles_option,
     configured_manipulator,
     pose_flag,
+    read_load_case,
     tool_position,
 )
 
@@ -115,15 +111,9 @@ def _violated(result: Loads, deflection_max: float, accuracy_max: float) -> list
 
 
 def configured_load_case(path: Path, platform: Manipulator, tool: Tool) -> LoadCase:
-    """The loads of the parameters file ``path``, refused in one line naming the file (a centre
-    of mass that fits ``platform``, the platform-frame model, only in millimetres included),
-    with the centre of mass moved into the frame of ``tool``."""
-    try:
-        case = require_plausible_loads(platform, load_case_from_mapping(load_params_file(path)))
-    except ConfigError as error:
-        msg = f"parameters file {path}: {error}"
-        raise CliError(msg) from error
-    return case.in_tool_frame(tool.offset, tool.rotation)
+    """:func:`~hexapod_workspace.cli.inputs.read_load_case` of ``path`` (``platform``: the
+    platform-frame model) with the centre of mass moved into the frame of ``tool``."""
+    return read_load_case(path, platform).in_tool_frame(tool.offset, tool.rotation)
 
 
 def check_load_case(config: str | None) -> LoadCase | None:
