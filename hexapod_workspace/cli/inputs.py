@@ -49,6 +49,7 @@ __all__ = [
     "GivenPoses",
     "add_angles_option",
     "configured_manipulator",
+    "configured_model",
     "finite",
     "given_poses",
     "output_file",
@@ -57,7 +58,6 @@ __all__ = [
     "poses_from_degrees",
     "psi_step_flag",
     "rays_flag",
-    "read_load_case",
     "read_poses_file",
     "tolerance_flag",
 ]
@@ -253,7 +253,24 @@ def configured_manipulator(
     with_tool: bool = True,
     loads_read: bool = False,
 ) -> Manipulator:
-    """The manipulator of ``--config`` (default: the packaged example), at ``--position``.
+    """The manipulator of :func:`configured_model` (the same arguments)."""
+    manipulator, _ = configured_model(
+        config, position, err, with_tool=with_tool, loads_read=loads_read
+    )
+    return manipulator
+
+
+def configured_model(
+    config: str | Path | None,
+    position: NDArray[np.float64] | None,
+    err: IO[str],
+    *,
+    with_tool: bool = True,
+    loads_read: bool = False,
+) -> tuple[Manipulator, LoadCase]:
+    """The manipulator of ``--config`` (default: the packaged example), at ``--position``, and
+    the file's loads with the centre of mass in that model's mobile frame (every command
+    refuses a bad loads parameter, naming the file).
 
     ``loads_read``: the caller reads the loads' limits (``loads``), which the other commands
     refuse (:func:`~hexapod_workspace.core.evaluation.loading.manipulator_from_mapping`).
@@ -267,14 +284,19 @@ def configured_manipulator(
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         manipulator = load_manipulator(path, loads_read=loads_read)
-    read_load_case(path, manipulator)  # every command refuses a bad loads parameter
+    try:
+        case = require_plausible_loads(manipulator, load_case_from_mapping(load_params_file(path)))
+    except ConfigError as error:
+        msg = f"parameters file {path}: {error}"
+        raise CliError(msg) from error
     cell = require_plausible_cell(manipulator, cell_from_params_file(path))
     if with_tool:
         manipulator = tool_model(manipulator, cell.tool)
+        case = case.in_tool_frame(cell.tool.offset, cell.tool.rotation)
     for warning in caught:
         err.write(f"hexapod-workspace: warning: {warning.message}\n")
     if position is None:
-        return manipulator
+        return manipulator, case
     position = finite(position, "--position", "m")
     plausible_positions(manipulator, position, "--position")
     try:
@@ -282,18 +304,7 @@ def configured_manipulator(
     except InputError as error:
         msg = "--position" + str(error).removeprefix("position")
         raise CliError(msg) from error
-    return manipulator.with_position(position)
-
-
-def read_load_case(path: Path, platform: Manipulator) -> LoadCase:
-    """The loads of the parameters file ``path`` (centre of mass in the platform frame),
-    refused in one line naming the file, a centre of mass that fits ``platform`` only in
-    millimetres included."""
-    try:
-        return require_plausible_loads(platform, load_case_from_mapping(load_params_file(path)))
-    except ConfigError as error:
-        msg = f"parameters file {path}: {error}"
-        raise CliError(msg) from error
+    return manipulator.with_position(position), case
 
 
 def tool_position(

@@ -34,31 +34,25 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._resources import example_config_path
-from ..core.cell.frames import Tool, cell_from_params_file, require_plausible_cell, tool_model
-from ..core.evaluation.loading import load_manipulator
+from ..core.cell.frames import cell_from_params_file, require_plausible_cell, tool_model
 from ..core.evaluation.loads import (
-    LoadCase,
     Loads,
     loads_at,
 )
 from ..core.model.architectures import module as architecture_module
-from ..core.model.manipulator import Manipulator
 from .cam import tool_json
 from .commands import PROG
 from .inputs import (
     add_angles_option,
-    configured_manipulator,
+    configured_model,
     pose_flag,
-    read_load_case,
     tool_position,
 )
 
 __all__ = [
     "LOADS_DESCRIPTION",
     "LOADS_HELP",
-    "check_load_case",
     "cmd_loads",
-    "configured_load_case",
     "loads_arguments",
 ]
 
@@ -110,33 +104,13 @@ def _violated(result: Loads, deflection_max: float, accuracy_max: float) -> list
     return names
 
 
-def configured_load_case(path: Path, platform: Manipulator, tool: Tool) -> LoadCase:
-    """:func:`~hexapod_workspace.cli.inputs.read_load_case` of ``path`` (``platform``: the
-    platform-frame model) with the centre of mass moved into the frame of ``tool``."""
-    return read_load_case(path, platform).in_tool_frame(tool.offset, tool.rotation)
-
-
-def check_load_case(config: str | None) -> LoadCase | None:
-    """The loads of ``--config`` for ``check`` when it sets one of the loads' limits
-    (``limits.actuator_force_max``, ``limits.deflection_max``, ``limits.accuracy_max``),
-    centre of mass in the tool frame; None without a file or without such a limit."""
-    if not config:
-        return None
-    path = Path(config)
-    platform = load_manipulator(path, loads_read=True)
-    case = configured_load_case(path, platform, cell_from_params_file(path).tool)
-    if case.force_max is None and case.deflection_max <= 0.0 and case.accuracy_max <= 0.0:
-        return None
-    return case
-
-
 def cmd_loads(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
     """``loads``: the loads at one pose."""
     path = Path(options.config) if options.config else example_config_path()
-    platform = configured_manipulator(path, None, err, with_tool=False, loads_read=True)
+    platform, platform_case = configured_model(path, None, err, with_tool=False, loads_read=True)
     cell = require_plausible_cell(platform, cell_from_params_file(path))
     manipulator = tool_model(platform, cell.tool)
-    case = configured_load_case(path, platform, cell.tool)
+    case = platform_case.in_tool_frame(cell.tool.offset, cell.tool.rotation)
     position = tool_position(options.position, manipulator, platform)
     given = pose_flag(options.pose, options.angles)
     rotation = given.matrices()[0]

@@ -35,6 +35,7 @@ from .inputs import (
     GivenPoses,
     add_angles_option,
     configured_manipulator,
+    configured_model,
     finite,
     output_file,
     pose_flag,
@@ -201,15 +202,14 @@ def _check_run(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
         raise CliError(msg)
     record = _record_path(options)
     poses = GivenPoses(parts[-1].convention, np.concatenate([part.values for part in parts]))
-    manipulator = configured_manipulator(options.config, options.position, err, loads_read=True)
-    case = loads.check_load_case(options.config)
+    manipulator, case = configured_model(options.config, options.position, err, loads_read=True)
     return commands.check_command(
         manipulator,
         poses,
         as_json=options.json,
         record=record,
         singularity=options.singularity,
-        loads=case,
+        loads=case if case.limited_rows else None,
         out=out,
         err=err,
     )

@@ -154,6 +154,12 @@ class LoadCase:
     actuator_error: NDArray[np.float64] | None = None
     accuracy_max: float = 0.0
 
+    @property
+    def limited_rows(self) -> tuple[str, ...]:
+        """The rows of :data:`LOAD_ROWS` whose limit this case sets (empty: no loads limit)."""
+        wanted = (self.force_max is not None, self.deflection_max > 0.0, self.accuracy_max > 0.0)
+        return tuple(name for name, on in zip(LOAD_ROWS, wanted, strict=True) if on)
+
     def in_tool_frame(self, offset: ArrayLike, rotation: ArrayLike) -> LoadCase:
         """The same case with the centre of mass given in the platform frame P re-expressed in
         a tool frame C (``PC = offset``, C's axes ``rotation`` in P): ``c' = Rᵀ(c − t)``."""
@@ -572,15 +578,7 @@ def load_rows(
     -------
     LoadRows or None
     """
-    names = [
-        name
-        for name, wanted in zip(
-            LOAD_ROWS,
-            (case.force_max is not None, case.deflection_max > 0.0, case.accuracy_max > 0.0),
-            strict=True,
-        )
-        if wanted
-    ]
+    names = case.limited_rows
     if not names:
         return None
     r = np.asarray(rotations, dtype=np.float64).reshape(-1, 3, 3)
