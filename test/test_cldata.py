@@ -243,15 +243,7 @@ def test_statements_that_disagree_on_the_units_are_refused_naming_both(text, uni
         parse_cldata(text, units=units)
 
 
-# 2. NURBS: never a chord
-
-
-def test_nx_nurbs_is_refused_with_its_line():
-    with pytest.raises(InputError, match=r"line 13: NURBS/: spline moves are not modelled"):
-        _read("nx_nurbs.cls")
-    for statement in ("KNOT/0,1", "CNTRL/0,0,0"):
-        with pytest.raises(InputError, match=r"^line 2: .*spline data \(NURBS\)"):
-            parse_cldata(f"UNITS/MM\n{statement}\nGOTO/0,0,0\n")
+# 2. NURBS: modelled as the spline (test_cl_splines.py)
 
 
 # 3. MSYS: the machining coordinate system is composed with the work frame

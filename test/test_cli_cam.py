@@ -364,12 +364,42 @@ def test_cl_units_are_stated_refused_or_given_and_passed_over_statements_counted
     assert code == 2 and "--cl-units: only for CL files" in one_error_line(err)
 
 
-def test_nurbs_in_a_cl_file_exits_2_with_its_line():
-    """Issue #35 item 2: a real NX CLSF with NURBS spans is refused, not checked as chords."""
+def test_nurbs_splines_are_checked_as_certified_chords(tmp_path):
+    """Issue #35 item 2: the real NX record is checked along its spline (chords within the
+    tolerance, reported), not as one chord; the CLI's tolerance is in mm and for CL files."""
     nurbs = Path(__file__).resolve().parent / "data" / "cl" / "nx_nurbs.cls"
-    code, out, err = run_main("check-path", str(nurbs))
-    assert code == 2 and out == ""
-    assert "line 13: NURBS/: spline moves are not modelled" in one_error_line(err)
+    lines = nurbs.read_text(encoding="utf-8").splitlines()
+    first = tmp_path / "first_spline.cls"  # the header, the first spline, the closing lines
+    first.write_text("\n".join([*lines[:23], *lines[-3:]]) + "\n", encoding="utf-8")
+    # the sample's machine coordinates moved into the example's working volume
+    text = CELL.read_text(encoding="utf-8")
+    assert "origin: [0.0, 0.0, -1.40]" in text
+    config = tmp_path / "cell.yaml"
+    config.write_text(text.replace("[0.0, 0.0, -1.40]", "[0.255, -0.4595, -1.574]"), "utf-8")
+    code, out, err = run_main("--config", str(config), "check-path", str(first), "--json")
+    document = json.loads(out)
+    assert code == 0 and document["ok"], err
+    ((spline,),) = [document["cl_splines"]]
+    assert spline["line"] == 13 and spline["chords"] == 104
+    assert 0.0 < spline["deviation_max_m"] <= 1e-6
+    assert len(document["segments"]) == 1 + 104 + 1  # GOTO to GOTO, the chords, the last GOTO
+    assert [w["line"] for w in document["waypoints"]].count(13) == 104
+    code, out, _ = run_main(
+        "--config", str(config), "check-path", str(first), "--spline-tolerance-mm", "0.01"
+    )
+    assert code == 0
+    assert "NURBS: 1 spline(s) (line 13) checked as " in out and "within 0.00" in out
+    coarse = int(out.split("checked as ")[1].split()[0])
+    assert coarse < 104
+    code, _, err = run_main("check-path", str(first), "--spline-tolerance-mm", "5")
+    assert code == 2
+    assert one_error_line(err) == (
+        "hexapod-workspace: error: --spline-tolerance-mm: expected 1e-6 to 1 mm, got 5"
+    )
+    csv = tmp_path / "p.csv"
+    csv.write_text("x,y,z,i,j,k\n0,0,-1.3,0,0,1\n0.01,0,-1.3,0,0,1\n", encoding="utf-8")
+    code, _, err = run_main("check-path", str(csv), "--spline-tolerance-mm", "0.001")
+    assert code == 2 and "--spline-tolerance-mm: only for CL files" in one_error_line(err)
 
 
 def _arc_file(tmp_path, circle: bool, radius_mm: float = 350.0) -> Path:

@@ -12,16 +12,17 @@ positions and angles in that same frame (top-level ``frame`` key). The tool fram
 until a ``LOADTL/n`` selects ``tools.T<n>``; every ``LOADTL`` between moves starts a new *part*
 (the controller stops for the tool change).
 
-JSON. A path of one part has the document of a CSV path plus ``frame``, ``tool``,
-``work_frame``, ``passed_over`` (CL statements passed over: count per statement), ``cl_units``
-(``unit``, ``source``: what stated them), ``cl_frames`` (each ``MSYS``/``ORIGIN`` applied) and
-``speed``; every move (``segments[k]``) gains ``duration_s``,
-``feed_mm_min`` (or ``feed_deg_min`` for a rotation without translation), ``rapid``,
-``actuator_speed_peak`` (certified bound, actuator unit/s, the largest over the actuators),
-``speed_ok`` and ``feed_max_mm_min`` (``feed_max_deg_min`` for a rotation; ``null`` when no
-limit applies); a CL path's waypoints gain ``line``. A path with tool changes has ``ok``,
-``frame``, ``work_frame``, ``passed_over``, ``cl_units``, ``cl_frames``, ``speed`` and
-``parts``: one such document per part with ``first_waypoint``.
+JSON. A path of one part has the document of a CSV path plus ``frame``, ``tool``, ``work_frame``,
+``passed_over`` (CL statements passed over: count per statement), ``cl_units`` (``unit``,
+``source``: what stated them), ``cl_frames`` (each ``MSYS``/``ORIGIN`` applied), ``cl_splines``
+(each ``NURBS`` spline: ``line``, ``chords`` checked for it, ``deviation_max_m``, the certified
+bound of the curve's distance from them) and ``speed``; every move (``segments[k]``) gains
+``duration_s``, ``feed_mm_min`` (or ``feed_deg_min`` for a rotation without translation),
+``rapid``, ``actuator_speed_peak`` (certified bound, actuator unit/s, the largest over the
+actuators), ``speed_ok`` and ``feed_max_mm_min`` (``feed_max_deg_min`` for a rotation; ``null``
+when no limit applies); a CL path's waypoints gain ``line``. A path with tool changes has ``ok``,
+``frame``, ``work_frame``, ``passed_over``, ``cl_units``, ``cl_frames``, ``cl_splines``, ``speed``
+and ``parts``: one such document per part with ``first_waypoint``.
 
 Speeds. ``limits.actuator_speed_max`` (one or six values, actuator unit/s, 0 = unlimited). A
 move's feed is the CL file's ``FEDRAT`` (``--feed-mm-min`` before the first one, and for CSV
@@ -50,6 +51,7 @@ from ..core.base.rotations import (
     matrix_to_tt,
     tt_to_matrix,
 )
+from ..core.cell.cl_splines import DEFAULT_SPLINE_TOLERANCE
 from ..core.cell.cldata import (
     CL_SUFFIXES,
     CL_UNITS,
@@ -137,7 +139,14 @@ def is_cl_file(path: str | Path) -> bool:
 
 def cell_pipeline_applies(options: argparse.Namespace) -> bool:
     """Whether ``check-path`` needs this module (a CL file, a frame or a feed given)."""
-    flags = ("frame", "feed_mm_min", "rapid_feed_mm_min", "rotary_feed_deg_min", "cl_units")
+    flags = (
+        "frame",
+        "feed_mm_min",
+        "rapid_feed_mm_min",
+        "rotary_feed_deg_min",
+        "cl_units",
+        "spline_tolerance_mm",
+    )
     return is_cl_file(options.file) or any(getattr(options, f, None) is not None for f in flags)
 
 
@@ -179,6 +188,13 @@ def cell_arguments(sub: argparse.ArgumentParser) -> None:
         choices=tuple(CL_UNITS),
         help="units of a CL file that does not state them (no UNITS statement, no feed in "
         "MMPM or IPM); refused where the file states others",
+    )
+    sub.add_argument(
+        "--spline-tolerance-mm",
+        type=float,
+        metavar="D",
+        help="largest distance of a CL file's NURBS splines from the chords checked for them, "
+        f"mm (default {DEFAULT_SPLINE_TOLERANCE * 1e3:g}; 1e-6 to 1)",
     )
     sub.add_argument(
         "--rotary-feed-deg-min",
@@ -228,8 +244,12 @@ def _read_parts(
     """The file's parts in the base frame, and the CL program (None for CSV)."""
     work = cell.work if frame == "work" else WorkFrame()
     units = getattr(options, "cl_units", None)
+    spline = getattr(options, "spline_tolerance_mm", None)
     if is_cl_file(options.file):
-        program: CLProgram = read_cldata(options.file, tools=set(cell.tools), units=units)
+        tolerance = DEFAULT_SPLINE_TOLERANCE if spline is None else _spline_tolerance(spline)
+        program: CLProgram = read_cldata(
+            options.file, tools=set(cell.tools), units=units, spline_tolerance=tolerance
+        )
         positions = work.origin + program.positions @ work.rotation.T
         axes = vectors_to_base(program.axes, work)
         feeds = np.where(np.isnan(program.feeds), feed, program.feeds)
@@ -265,9 +285,10 @@ def _read_parts(
                 )
                 raise CliError(msg)
         return parts, program
-    if units is not None:
-        msg = f"--cl-units: only for CL files ({options.file} is read as CSV, in m)"
-        raise CliError(msg)
+    for flag, given in (("--cl-units", units), ("--spline-tolerance-mm", spline)):
+        if given is not None:
+            msg = f"{flag}: only for CL files ({options.file} is read as CSV, in m)"
+            raise CliError(msg)
     waypoints = read_path_file(options.file)
     count = len(waypoints.positions)
     feeds = np.full(count, feed)
@@ -295,6 +316,15 @@ def _read_parts(
             written=frame == "base",
         )
     return [part], None
+
+
+def _spline_tolerance(value: float) -> float:
+    """``--spline-tolerance-mm`` in m, checked."""
+    number = float(finite([value], "--spline-tolerance-mm", "mm")[0])
+    if not 1e-6 <= number <= 1.0:
+        msg = f"--spline-tolerance-mm: expected 1e-6 to 1 mm, got {number:g}"
+        raise CliError(msg)
+    return number * 1e-3
 
 
 def _part_arcs(arcs: NDArray[np.float64]) -> NDArray[np.float64] | None:
@@ -585,6 +615,10 @@ def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str])
             {"line": line, "origin": origin.tolist(), "rotation": rotation.tolist()}
             for line, origin, rotation in program.frames
         ]
+        common["cl_splines"] = [
+            {"line": line, "chords": count, "deviation_max_m": bound}
+            for line, count, bound in program.splines
+        ]
     if len(documents) == 1:
         report: dict[str, Any] = {**documents[0], **common, "ok": ok}
     else:
@@ -629,6 +663,16 @@ def _speed_text(report: dict[str, Any], out: IO[str]) -> None:
             out.write(
                 f"  CL frame from line {frame['line']}: origin ({origin}) m in the work frame\n"
             )
+    splines = report.get("cl_splines") or []
+    if splines:
+        lines = ", ".join(str(spline["line"]) for spline in splines[:8])
+        lines += ", ..." if len(splines) > 8 else ""
+        chords = sum(spline["chords"] for spline in splines)
+        bound = max(spline["deviation_max_m"] for spline in splines)
+        out.write(
+            f"  NURBS: {len(splines)} spline(s) (line {lines}) checked as {chords} chords, "
+            f"the curve within {bound * 1e3:.3g} mm of them\n"
+        )
     if report["passed_over"]:
         names = ", ".join(f"{n} x{c}" for n, c in report["passed_over"].items())
         out.write(f"  passed over (cannot change motion, frame, tool or units): {names}\n")

@@ -71,10 +71,6 @@ PASSED_OVER: dict[str, str] = {
 _REFUSED = {
     "MOVARC": "circular moves are not modelled (a chord would be checked instead of the arc; "
     "export arcs as linear GOTO moves)",
-    "NURBS": "spline moves are not modelled (a chord would be checked instead of the curve, "
-    "and its deviation is not bounded here; export splines as linear GOTO moves)",
-    "KNOT": "spline data (NURBS) is not modelled (export splines as linear GOTO moves)",
-    "CNTRL": "spline data (NURBS) is not modelled (export splines as linear GOTO moves)",
     "CYCLE": "canned cycles are not modelled (export them as GOTO moves)",
     "CUTCOM": "cutter compensation (the controller offsets the path) is not modelled; "
     "expected CUTCOM/OFF or a tool-centre path",

@@ -29,6 +29,12 @@ statement                       meaning here
                                 own, checked along the arc (``CLProgram.arcs``); a helix when
                                 the end's height along the axis differs; refused when an end
                                 is off the circle, the tool axis changes, in incremental mode
+``NURBS/``, ``KNOT/k,...``,      a spline move from the current point (NX): the clamped cubic
+``CNTRL/x,y,z``                 B-spline of :mod:`~hexapod_workspace.core.cell.cl_splines`,
+                                checked as chords certified to lie within ``spline_tolerance``
+                                of it (``CLProgram.splines``); the tool axis stays; refused
+                                when the counts do not fit, in incremental mode, after
+                                ``RAPID``, or with weights or tool axes in ``CNTRL``
 ``SET/MODE,INCR|ABSOL``         following ``GOTO`` positions are increments / absolute
 ``TLAXIS/i,j,k``                the tool axis of following 3-value ``GOTO`` statements
 ``FEDRAT/f[,MMPM|IPM|PERMIN]``  feed of the following cutting moves (also ``FEDRAT/MMPM,f``);
@@ -61,14 +67,12 @@ against ``--cl-units``) is refused naming both. A file that states no units at a
 itself has no default unit, and an inch file read as mm is a path 25.4 times smaller that may
 well pass.
 
-Refused, with the line and why: ``MOVARC`` and ``NURBS``/``KNOT``/``CNTRL`` (a curve's chord
-is not the curve, and a spline's knot vector is not stated in full by NX's CLSF: its order and
-end knots would be guessed), canned cycles, cutter compensation,
-``TRACUT`` with a matrix, ``INSERT`` (text for the controller, whose effect is unknown),
-per-revolution feeds (``MMPR``, ``IPR``, ``PERREV``), ``ORIGIN`` together with a rotated
+Refused, with the line and why: ``MOVARC`` (a curve's chord is not the curve), canned cycles,
+cutter compensation, ``TRACUT`` with a matrix, ``INSERT`` (text for the controller, whose effect is
+unknown), per-revolution feeds (``MMPR``, ``IPR``, ``PERREV``), ``ORIGIN`` together with a rotated
 ``MSYS`` (the order they compose in is not stated), ``LOAD`` of anything but a tool, ``SET`` but
-``MODE,INCR|ABSOL``, a ``GODLTA``/``GOHOME``/incremental ``GOTO`` without a known previous
-point, a 6-value ``GOTO`` in incremental mode, and every statement not listed here or in
+``MODE,INCR|ABSOL``, a ``GODLTA``/``GOHOME``/incremental ``GOTO`` without a known previous point, a
+6-value ``GOTO`` in incremental mode, and every statement not listed here or in
 :data:`PASSED_OVER`.
 
 Lines: ``$`` at the end of a line continues the statement on the next line; ``$$`` starts a
@@ -89,6 +93,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...errors import InputError
+from .cl_splines import DEFAULT_SPLINE_TOLERANCE, NXSpline, bezier_spans, chords, spline_knots
 from .cl_statements import (
     _FEED_UNITS,
     _NAMES,
@@ -153,6 +158,10 @@ class CLProgram:
     frames : tuple of (int, ndarray, ndarray)
         Each ``MSYS`` and ``ORIGIN`` applied: (line, origin in the work frame (m), rotation
         from the file's coordinates to the work frame (3, 3)).
+    splines : tuple of (int, int, float)
+        Each ``NURBS`` spline: (line, number of chords standing for it, certified bound of the
+        curve's distance from them (m)). Its chords are moves ending at waypoints whose
+        ``lines`` is the ``NURBS`` line.
     arcs : ndarray, shape (N, 7)
         The move that ends at waypoint k as an arc (``CIRCLE``): centre (work frame, m), unit
         axis (work frame) and angle φ (rad, right-handed about the axis: negative, the file's
@@ -174,6 +183,7 @@ class CLProgram:
     units_source: str = ""
     frames: tuple[tuple[int, NDArray[np.float64], NDArray[np.float64]], ...] = field(default=())
     arcs: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 7)))
+    splines: tuple[tuple[int, int, float], ...] = ()
 
     def __len__(self) -> int:
         return int(self.positions.shape[0])
@@ -222,6 +232,10 @@ class _Reader:
         # coordinates (m), radius (m)); the arcs of the moves, one row per waypoint.
         self.circle: tuple[int, str, NDArray[np.float64], NDArray[np.float64], float] | None = None
         self.arcs: list[NDArray[np.float64]] = []
+        # A NURBS record being read, the chords' tolerance (m) and each spline read.
+        self.spline: NXSpline | None = None
+        self.spline_tolerance = DEFAULT_SPLINE_TOLERANCE
+        self.splines: list[tuple[int, int, float]] = []
 
     # -- units -----------------------------------------------------------------------------
     def scale(self, line: int, shown: str) -> float:
@@ -292,7 +306,10 @@ def _unit_axis(values: NDArray[np.float64], line: int, shown: str) -> NDArray[np
 
 
 def parse_cldata(
-    text: str, tools: Collection[int] | None = None, units: str | None = None
+    text: str,
+    tools: Collection[int] | None = None,
+    units: str | None = None,
+    spline_tolerance: float = DEFAULT_SPLINE_TOLERANCE,
 ) -> CLProgram:
     """Read the text of a CL file (see the module documentation).
 
@@ -306,6 +323,9 @@ def parse_cldata(
     units : {'mm', 'inch'}, optional
         The units of a file that does not state them (``check-path --cl-units``); refused
         where the file states others before its first ``UNITS`` statement.
+    spline_tolerance : float
+        Largest distance of a ``NURBS`` spline from the chords checked for it, m (1e-9 to
+        1e-3).
 
     Returns
     -------
@@ -321,14 +341,20 @@ def parse_cldata(
     if units is not None and units not in CL_UNITS:
         msg = f"units: expected one of {', '.join(CL_UNITS)}, got {units!r}"
         raise InputError(msg)
+    if not 1e-9 <= spline_tolerance <= 1e-3:  # NaN fails too
+        msg = f"spline_tolerance: expected 1e-9 to 1e-3 m, got {spline_tolerance!r}"
+        raise InputError(msg)
     statements = _statements(text)
     unit, source = _initial_units(statements, units)
     state = _Reader(tools, unit, source)
     state.option = units
+    state.spline_tolerance = spline_tolerance
     for line, statement in statements:
         shown = _shown(statement)
         word, arguments = _split(statement, line, shown)
         _statement(state, word, arguments, line, shown)
+    if state.spline is not None:
+        _end_spline(state)
     if not state.positions:
         msg = "CL file: expected at least one GOTO (or FROM) statement, found none"
         raise InputError(msg)
@@ -353,11 +379,17 @@ def parse_cldata(
         units_source=state.unit_source,
         frames=tuple(state.frames),
         arcs=np.array(state.arcs, dtype=np.float64).reshape(-1, 7),
+        splines=tuple(state.splines),
     )
 
 
 def _statement(state: _Reader, word: str, arguments: list[str], line: int, shown: str) -> None:
     """Apply one statement to the reader's state (or refuse it)."""
+    if state.spline is not None:
+        if word in ("KNOT", "CNTRL"):
+            _spline_data(state, word, arguments, line, shown)
+            return
+        _end_spline(state)  # any other statement ends the record
     if state.circle is not None and word != "GOTO" and word not in PASSED_OVER:
         msg = (
             f"line {line}: {shown}: expected the GOTO that ends the arc of line "
@@ -366,6 +398,11 @@ def _statement(state: _Reader, word: str, arguments: list[str], line: int, shown
         raise InputError(msg)
     if word == "CIRCLE":
         _circle(state, arguments, line, shown)
+    elif word == "NURBS":
+        _start_spline(state, arguments, line, shown)
+    elif word in ("KNOT", "CNTRL"):
+        msg = f"line {line}: {shown}: expected NURBS/ before it (spline data outside a spline)"
+        raise InputError(msg)
     elif word == "GOTO" and state.circle is not None:
         _end_arc(state, arguments, line, shown)
     elif word == "GOTO":
@@ -507,6 +544,17 @@ def _statement(state: _Reader, word: str, arguments: list[str], line: int, shown
 _ARC_RELATIVE, _ARC_ABSOLUTE = 1e-5, 2e-6
 
 
+def _curve_start(state: _Reader, line: int, shown: str, statement: str, curve: str) -> None:
+    """A curve (arc, spline) starts at the current point of its part, in absolute mode."""
+    if state.incremental:
+        msg = f"line {line}: {shown}: a {statement} in incremental mode (SET/MODE,INCR) is not "
+        msg += "modelled"
+        raise InputError(msg)
+    if not state.in_part():
+        msg = f"line {line}: {shown}: expected a point of this part before the {curve}"
+        raise InputError(msg)
+
+
 def _circle(state: _Reader, arguments: list[str], line: int, shown: str) -> None:
     """``CIRCLE/xc,yc,zc,i,j,k,r[,...]``: the arc that the next GOTO ends (NX adds a
     tolerance, the tool diameter and two more values, which cannot change the arc)."""
@@ -514,12 +562,7 @@ def _circle(state: _Reader, arguments: list[str], line: int, shown: str) -> None
     if len(values) < 7:
         msg = f"line {line}: {shown}: expected CIRCLE/x,y,z,i,j,k,r (at least 7 numbers)"
         raise InputError(msg)
-    if state.incremental:
-        msg = f"line {line}: {shown}: a CIRCLE in incremental mode (SET/MODE,INCR) is not modelled"
-        raise InputError(msg)
-    if not state.in_part():
-        msg = f"line {line}: {shown}: expected a point of this part before the arc"
-        raise InputError(msg)
+    _curve_start(state, line, shown, "CIRCLE", "arc")
     scale = state.scale(line, shown)
     radius = values[6] * scale
     if not radius > 0.0:
@@ -579,6 +622,53 @@ def _end_arc(state: _Reader, arguments: list[str], line: int, shown: str) -> Non
     state.add(state.to_work(end), state.axis_work(), line, shown)
     state.arcs[-1] = np.array([*state.to_work(centre), *(state.rotation @ axis), phi])
     state.circle = None
+
+
+def _start_spline(state: _Reader, arguments: list[str], line: int, shown: str) -> None:
+    """``NURBS/``: a spline from the current point; its KNOT and CNTRL statements follow."""
+    if arguments:
+        msg = f"line {line}: {shown}: expected NURBS/ without values (NX's form), got "
+        msg += f"{len(arguments)}"
+        raise InputError(msg)
+    if state.rapid_next:
+        msg = f"line {line}: {shown}: a RAPID spline is not modelled (expected a GOTO after RAPID)"
+        raise InputError(msg)
+    _curve_start(state, line, shown, "spline", "spline")
+    start = state.to_file(state.last(line, shown))
+    state.spline = NXSpline(line, shown, start, [], [])
+
+
+def _spline_data(state: _Reader, word: str, arguments: list[str], line: int, shown: str) -> None:
+    """A ``KNOT`` (all before the first ``CNTRL``) or ``CNTRL`` statement of the record."""
+    spline = state.spline
+    assert spline is not None
+    if word == "KNOT":
+        if spline.controls:
+            msg = f"line {line}: {shown}: expected the KNOT statements before the first CNTRL"
+            raise InputError(msg)
+        if not arguments:
+            msg = f"line {line}: {shown}: expected KNOT/k,... (at least one number)"
+            raise InputError(msg)
+        spline.knots.extend(_number(a, line, shown) for a in arguments)
+        return
+    what = "CNTRL/x,y,z (3 numbers; weights and tool axes along a spline are not modelled)"
+    values = _numbers(arguments, (3,), line, shown, what)
+    spline.controls.append(values * state.scale(line, shown))
+
+
+def _end_spline(state: _Reader) -> None:
+    """The chords of the record just read (work frame), each a waypoint of the NURBS line."""
+    spline = state.spline
+    assert spline is not None
+    state.spline = None
+    knots = spline_knots(spline)
+    # a B-spline of affinely mapped control points is the mapped curve
+    controls = np.vstack([spline.start, *spline.controls])
+    work = state.origin + controls @ state.rotation.T
+    ends, bound = chords(bezier_spans(knots, work), state.spline_tolerance)
+    for end in ends:
+        state.add(end, state.axis_work(), spline.line, spline.shown)
+    state.splines.append((spline.line, int(ends.shape[0]), bound))
 
 
 def _load_tool(state: _Reader, arguments: list[str], line: int, shown: str) -> None:
@@ -680,7 +770,10 @@ def looks_like_cldata(text: str) -> bool:
 
 
 def read_cldata(
-    path: str | Path, tools: Collection[int] | None = None, units: str | None = None
+    path: str | Path,
+    tools: Collection[int] | None = None,
+    units: str | None = None,
+    spline_tolerance: float = DEFAULT_SPLINE_TOLERANCE,
 ) -> CLProgram:
     """Read a CL file from disk (see :func:`parse_cldata`).
 
@@ -700,7 +793,7 @@ def read_cldata(
         msg = f"CL file {path} is not text"
         raise InputError(msg) from error
     try:
-        return parse_cldata(text, tools, units)
+        return parse_cldata(text, tools, units, spline_tolerance)
     except InputError as error:
         msg = f"CL file {path}: {error}"
         raise InputError(msg) from error
