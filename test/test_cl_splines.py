@@ -1,6 +1,6 @@
 """NX ``NURBS`` records in CL files (issue #35 item 2): the clamped cubic from the current point,
-against a plain Cox–de Boor evaluation written here from the definition (not the reader's knot
-insertion and halving); the chords certified within the tolerance; refusals with their line.
+read as one Bézier move per span, against a plain Cox–de Boor evaluation written here from the
+definition (not the reader's knot insertion); refusals with their line.
 
 The real records are those of the public NX sample ``test/data/cl/nx_nurbs.cls`` (origin in
 ``test/data/cl/SOURCES.md``)."""
@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_beziers import casteljau
 
 from hexapod_workspace.core.cell.cldata import parse_cldata, read_cldata
 from hexapod_workspace.errors import InputError
@@ -70,26 +71,21 @@ def _cubic(knots: list[float]) -> np.ndarray:
     return np.concatenate([np.zeros(4), knots[:-1], np.ones(4)])
 
 
-def _distance_to_polyline(points: np.ndarray, vertices: np.ndarray) -> np.ndarray:
-    a, b = vertices[:-1], vertices[1:]
-    ab = b - a
-    length2 = np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300)
-    u = np.clip(np.einsum("mij,ij->mi", points[:, None, :] - a[None], ab) / length2, 0.0, 1.0)
-    nearest = a[None] + u[..., None] * ab[None]
-    return np.linalg.norm(points[:, None, :] - nearest, axis=2).min(axis=1)
-
-
-def _on_curve(knots: np.ndarray, controls: np.ndarray, point: np.ndarray) -> float:
-    """Distance of ``point`` from the curve: nearest of a grid, refined by golden section."""
-    grid = np.linspace(0.0, 1.0, 2001)
-    k = int(np.argmin(np.linalg.norm(_curve(knots, controls, grid) - point, axis=1)))
-    low, high = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
-    ratio = (np.sqrt(5.0) - 1.0) / 2.0
-    for _ in range(60):
-        a, b = high - ratio * (high - low), low + ratio * (high - low)
-        da, db = np.linalg.norm(_curve(knots, controls, np.array([a, b])) - point, axis=1)
-        low, high = (low, b) if da < db else (a, high)
-    return float(np.linalg.norm(_curve(knots, controls, np.array([low]))[0] - point))
+def _check_moves(program, line: int, knots: list[float], points: np.ndarray) -> int:
+    """Each Bézier move of the spline of ``line`` is the B-spline on its knot interval (the
+    parameter mapped affinely); returns the number of moves."""
+    rows = np.flatnonzero(program.lines == line)
+    assert rows.size and np.all(np.diff(rows) == 1)
+    t = _cubic(knots)
+    breaks = np.r_[0.0, sorted(set(knots[:-1])), 1.0]
+    assert rows.size == breaks.size - 1  # one move per span
+    s = np.linspace(0.0, 1.0, 101)
+    for k, row in enumerate(rows):
+        inner = program.beziers[row].reshape(2, 3)
+        control = np.vstack([program.positions[row - 1], inner, program.positions[row]])
+        u = breaks[k] + s * (breaks[k + 1] - breaks[k])
+        np.testing.assert_allclose(casteljau(control, s), _curve(t, points, u), atol=1e-12)
+    return int(rows.size)
 
 
 def test_every_record_of_the_nx_sample_fits_the_clamped_cubic_from_the_tool():
@@ -111,74 +107,51 @@ def test_every_record_of_the_nx_sample_fits_the_clamped_cubic_from_the_tool():
     assert min(jumps) > 0.3  # mm: the quadratic reading would start this far from the tool
 
 
-def test_the_sample_reads_as_chords_within_the_tolerance_of_each_spline():
+def test_the_sample_reads_as_one_bezier_move_per_span_of_each_spline():
     program = read_cldata(SAMPLE)
     records = _records(SAMPLE)
-    assert [line for line, _, _ in program.splines] == [line for line, *_ in records]
-    assert [count for _, count, _ in program.splines] == [104, 534, 100, 100, 48]
-    assert len(program) == 7 + sum(count for _, count, _ in program.splines)
-    largest = 0.0
-    for (line, count, bound), (_, start, knots, controls) in zip(
-        program.splines, records, strict=True
-    ):
-        assert 0.0 < bound <= 1e-6
-        rows = np.flatnonzero(program.lines == line)
-        assert rows.size == count and np.all(np.diff(rows) == 1)
-        vertices = np.vstack([program.positions[rows[0] - 1], program.positions[rows]])
+    assert [line for line, _ in program.splines] == [line for line, *_ in records]
+    assert [moves for _, moves in program.splines] == [5, 51, 4, 4, 5]
+    assert len(program) == 7 + 69
+    for (line, moves), (_, start, knots, controls) in zip(program.splines, records, strict=True):
         points = np.vstack([start, controls]) * 1e-3
-        t = _cubic(knots)
-        # the spline starts at the tool and ends at its last CNTRL point
-        np.testing.assert_allclose(vertices[0], points[0], atol=1e-15)
-        np.testing.assert_allclose(vertices[-1], points[-1], atol=1e-15)
-        samples = _curve(t, points, np.linspace(0.0, 1.0, 4001))
-        distance = _distance_to_polyline(samples, vertices)
-        assert distance.max() <= bound + 1e-12
-        largest = max(largest, float(distance.max()))
-        for vertex in vertices[1 :: max(count // 7, 1)]:
-            assert _on_curve(t, points, vertex) < 1e-9
-        # the tool axis and the feed stay those in force
-        np.testing.assert_allclose(program.axes[rows], [[0.0, 0.0, 1.0]] * count, atol=1e-15)
+        assert _check_moves(program, line, knots, points) == moves
+        rows = program.lines == line
+        # the spline ends at its last CNTRL point; the tool axis and the feed stay
+        np.testing.assert_allclose(program.positions[rows][-1], points[-1], atol=1e-15)
+        np.testing.assert_allclose(program.axes[rows], [[0.0, 0.0, 1.0]] * moves, atol=1e-15)
         np.testing.assert_allclose(program.feeds[rows], 0.25 / 60.0)
-    assert largest > 0.25e-6  # the chords are not needlessly fine: the bound is tight
-
-
-def test_a_coarser_tolerance_gives_fewer_chords_within_it():
-    coarse = read_cldata(SAMPLE, spline_tolerance=1e-5)
-    fine = read_cldata(SAMPLE)
-    for (_, few, bound), (_, many, _) in zip(coarse.splines, fine.splines, strict=True):
-        assert few < many and bound <= 1e-5
-    with pytest.raises(InputError, match=r"^spline_tolerance: expected 1e-9 to 1e-3 m, got 0.0$"):
-        parse_cldata("UNITS/MM\nGOTO/0,0,0\n", spline_tolerance=0.0)
+    curved = np.isin(program.lines, [line for line, _ in program.splines])
+    assert np.isnan(program.beziers[~curved]).all() and np.isfinite(program.beziers[curved]).all()
 
 
 SPLINE = "NURBS/\nKNOT/0.5,1\nCNTRL/1,0,0\nCNTRL/2,1,0\nCNTRL/3,1,1\nCNTRL/4,0,1\n"
 
 
 def test_a_spline_in_inches_under_a_rotated_msys_is_the_mapped_curve():
-    """B-splines are affine invariant: the reader maps the control points; the chords' ends lie
-    on the curve of the mapped points."""
+    """B-splines are affine invariant: the reader maps the control points; its Bézier moves are
+    the curve of the mapped points."""
     text = "UNITS/INCHES\nMSYS/1,2,3,0,1,0,-1,0,0\nGOTO/0,0,0\n" + SPLINE + "GOTO/4,0,2\n"
     program = parse_cldata(text)
     rotation = np.column_stack([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
     origin = np.array([1.0, 2.0, 3.0]) * 0.0254
     file_points = np.array([[0, 0, 0], [1, 0, 0], [2, 1, 0], [3, 1, 1], [4, 0, 1]]) * 0.0254
     work = origin + file_points @ rotation.T
-    ((line, count, bound),) = program.splines
-    assert line == 4 and count == len(program) - 2 and bound <= 1e-6
+    assert program.splines == ((4, 2),)
     np.testing.assert_allclose(program.positions[0], origin, atol=1e-15)
-    np.testing.assert_allclose(program.positions[-2], work[-1], atol=1e-15)
-    t = _cubic([0.5, 1.0])
-    for vertex in program.positions[1:-1:7]:
-        assert _on_curve(t, work, vertex) < 1e-9
+    assert _check_moves(program, 4, [0.5, 1.0], work) == 2
+    np.testing.assert_allclose(program.positions[2], work[-1], atol=1e-15)
     np.testing.assert_allclose(program.axes, [rotation[:, 2]] * len(program), atol=1e-15)
+    assert np.isnan(program.beziers[[0, 3]]).all()  # the first point, the GOTO after
 
 
-def test_a_triple_knot_is_a_corner_kept_as_a_chord_end():
+def test_a_triple_knot_is_a_corner_where_a_move_ends():
     text = "UNITS/MM\nGOTO/0,0,0\nNURBS/\nKNOT/0.5,0.5,0.5,1\n"
     text += "CNTRL/1,0,0\nCNTRL/2,0,0\nCNTRL/2,1,0\nCNTRL/2,2,0\nCNTRL/2,3,0\nCNTRL/2,4,0\n"
     program = parse_cldata(text)
     corner = np.array([2.0, 1.0, 0.0]) * 1e-3  # C(0.5) is the control point at the triple knot
-    assert np.min(np.linalg.norm(program.positions - corner, axis=1)) < 1e-15
+    np.testing.assert_allclose(program.positions[1], corner, atol=1e-15)  # a move ends there
+    assert program.splines == ((3, 2),)
 
 
 @pytest.mark.parametrize(

@@ -364,9 +364,9 @@ def test_cl_units_are_stated_refused_or_given_and_passed_over_statements_counted
     assert code == 2 and "--cl-units: only for CL files" in one_error_line(err)
 
 
-def test_nurbs_splines_are_checked_as_certified_chords(tmp_path):
-    """Issue #35 item 2: the real NX record is checked along its spline (chords within the
-    tolerance, reported), not as one chord; the CLI's tolerance is in mm and for CL files."""
+def test_nurbs_splines_are_checked_along_the_curve(tmp_path):
+    """Issue #35 item 2: the real NX record is checked along its spline, one Bézier move per
+    span, not as one chord; the JSON says where each move runs; --record refuses it."""
     nurbs = Path(__file__).resolve().parent / "data" / "cl" / "nx_nurbs.cls"
     lines = nurbs.read_text(encoding="utf-8").splitlines()
     first = tmp_path / "first_spline.cls"  # the header, the first spline, the closing lines
@@ -379,27 +379,26 @@ def test_nurbs_splines_are_checked_as_certified_chords(tmp_path):
     code, out, err = run_main("--config", str(config), "check-path", str(first), "--json")
     document = json.loads(out)
     assert code == 0 and document["ok"], err
-    ((spline,),) = [document["cl_splines"]]
-    assert spline["line"] == 13 and spline["chords"] == 104
-    assert 0.0 < spline["deviation_max_m"] <= 1e-6
-    assert len(document["segments"]) == 1 + 104 + 1  # GOTO to GOTO, the chords, the last GOTO
-    assert [w["line"] for w in document["waypoints"]].count(13) == 104
-    code, out, _ = run_main(
-        "--config", str(config), "check-path", str(first), "--spline-tolerance-mm", "0.01"
-    )
+    assert document["cl_splines"] == [{"line": 13, "moves": 5}]
+    segments = document["segments"]
+    assert len(segments) == 1 + 5 + 1  # GOTO to GOTO, the spline's spans, the last GOTO
+    assert [w["line"] for w in document["waypoints"]] == [9, 12, 13, 13, 13, 13, 13, 23]
+    curves = [k for k, segment in enumerate(segments) if segment["bezier"] is not None]
+    assert curves == [1, 2, 3, 4, 5]
+    # the first span's b₁ is the record's first CNTRL point (a clamped end), work frame, m
+    inner = segments[1]["bezier"]["control_points"]
+    assert inner[0] == pytest.approx([-0.2549774, 0.4662698, 0.2069401], abs=1e-9)
+    assert all(segments[k]["feed_mm_min"] == pytest.approx(250.0) for k in curves)
+    code, out, _ = run_main("--config", str(config), "check-path", str(first))
     assert code == 0
-    assert "NURBS: 1 spline(s) (line 13) checked as " in out and "within 0.00" in out
-    coarse = int(out.split("checked as ")[1].split()[0])
-    assert coarse < 104
-    code, _, err = run_main("check-path", str(first), "--spline-tolerance-mm", "5")
-    assert code == 2
-    assert one_error_line(err) == (
-        "hexapod-workspace: error: --spline-tolerance-mm: expected 1e-6 to 1 mm, got 5"
+    assert "NURBS: 1 spline(s) (line 13) as 5 cubic Bézier moves, checked along the curve" in out
+    assert "5 of them Bézier curves, checked along the curve" in out
+    record = tmp_path / "run.mcap"
+    code, _, err = run_main(
+        "--config", str(config), "check-path", str(first), "--record", str(record)
     )
-    csv = tmp_path / "p.csv"
-    csv.write_text("x,y,z,i,j,k\n0,0,-1.3,0,0,1\n0.01,0,-1.3,0,0,1\n", encoding="utf-8")
-    code, _, err = run_main("check-path", str(csv), "--spline-tolerance-mm", "0.001")
-    assert code == 2 and "--spline-tolerance-mm: only for CL files" in one_error_line(err)
+    assert code == 2 and "--record: the ~/check_path request carries waypoints, not curves " in err
+    assert "(line 13: NURBS)" in one_error_line(err)
 
 
 def _arc_file(tmp_path, circle: bool, radius_mm: float = 350.0) -> Path:
@@ -447,7 +446,7 @@ def test_a_small_arc_passes_and_record_refuses_arcs(tmp_path):
     assert code == 0 and "1 moves (tool axes, torsion planned; 1 of them arcs" in out
     code, out, err = run_main("check-path", str(small), "--record", str(tmp_path / "arc.mcap"))
     assert code == 2 and out == ""
-    assert "--record: the ~/check_path request carries waypoints, not arcs (line 5" in (
+    assert "--record: the ~/check_path request carries waypoints, not curves (line 5: CIRCLE)" in (
         one_error_line(err)
     )
     assert not (tmp_path / "arc.mcap").exists()

@@ -12,17 +12,17 @@ positions and angles in that same frame (top-level ``frame`` key). The tool fram
 until a ``LOADTL/n`` selects ``tools.T<n>``; every ``LOADTL`` between moves starts a new *part*
 (the controller stops for the tool change).
 
-JSON. A path of one part has the document of a CSV path plus ``frame``, ``tool``, ``work_frame``,
-``passed_over`` (CL statements passed over: count per statement), ``cl_units`` (``unit``,
-``source``: what stated them), ``cl_frames`` (each ``MSYS``/``ORIGIN`` applied), ``cl_splines``
-(each ``NURBS`` spline: ``line``, ``chords`` checked for it, ``deviation_max_m``, the certified
-bound of the curve's distance from them) and ``speed``; every move (``segments[k]``) gains
-``duration_s``, ``feed_mm_min`` (or ``feed_deg_min`` for a rotation without translation),
-``rapid``, ``actuator_speed_peak`` (certified bound, actuator unit/s, the largest over the
-actuators), ``speed_ok`` and ``feed_max_mm_min`` (``feed_max_deg_min`` for a rotation; ``null``
-when no limit applies); a CL path's waypoints gain ``line``. A path with tool changes has ``ok``,
-``frame``, ``work_frame``, ``passed_over``, ``cl_units``, ``cl_frames``, ``cl_splines``, ``speed``
-and ``parts``: one such document per part with ``first_waypoint``.
+JSON. A path of one part has the document of a CSV path plus ``frame``, ``tool``,
+``work_frame``, ``passed_over`` (CL statements passed over: count per statement), ``cl_units``
+(``unit``, ``source``: what stated them), ``cl_frames`` (each ``MSYS``/``ORIGIN`` applied),
+``cl_splines`` (each ``NURBS`` spline: ``line`` and ``moves``, its Bézier spans) and
+``speed``; every move (``segments[k]``) gains ``duration_s``,
+``feed_mm_min`` (or ``feed_deg_min`` for a rotation without translation), ``rapid``,
+``actuator_speed_peak`` (certified bound, actuator unit/s, the largest over the actuators),
+``speed_ok`` and ``feed_max_mm_min`` (``feed_max_deg_min`` for a rotation; ``null`` when no
+limit applies); a CL path's waypoints gain ``line``. A path with tool changes has ``ok``,
+``frame``, ``work_frame``, ``passed_over``, ``cl_units``, ``cl_frames``, ``cl_splines``,
+``speed`` and ``parts``: one such document per part with ``first_waypoint``.
 
 Speeds. ``limits.actuator_speed_max`` (one or six values, actuator unit/s, 0 = unlimited). A
 move's feed is the CL file's ``FEDRAT`` (``--feed-mm-min`` before the first one, and for CSV
@@ -51,7 +51,6 @@ from ..core.base.rotations import (
     matrix_to_tt,
     tt_to_matrix,
 )
-from ..core.cell.cl_splines import DEFAULT_SPLINE_TOLERANCE
 from ..core.cell.cldata import (
     CL_SUFFIXES,
     CL_UNITS,
@@ -139,14 +138,7 @@ def is_cl_file(path: str | Path) -> bool:
 
 def cell_pipeline_applies(options: argparse.Namespace) -> bool:
     """Whether ``check-path`` needs this module (a CL file, a frame or a feed given)."""
-    flags = (
-        "frame",
-        "feed_mm_min",
-        "rapid_feed_mm_min",
-        "rotary_feed_deg_min",
-        "cl_units",
-        "spline_tolerance_mm",
-    )
+    flags = ("frame", "feed_mm_min", "rapid_feed_mm_min", "rotary_feed_deg_min", "cl_units")
     return is_cl_file(options.file) or any(getattr(options, f, None) is not None for f in flags)
 
 
@@ -190,13 +182,6 @@ def cell_arguments(sub: argparse.ArgumentParser) -> None:
         "MMPM or IPM); refused where the file states others",
     )
     sub.add_argument(
-        "--spline-tolerance-mm",
-        type=float,
-        metavar="D",
-        help="largest distance of a CL file's NURBS splines from the chords checked for them, "
-        f"mm (default {DEFAULT_SPLINE_TOLERANCE * 1e3:g}; 1e-6 to 1)",
-    )
-    sub.add_argument(
         "--rotary-feed-deg-min",
         type=float,
         metavar="F",
@@ -230,12 +215,15 @@ class _Part:
         first: int,
         written: bool = False,
         arcs: NDArray[np.float64] | None = None,
+        beziers: NDArray[np.float64] | None = None,
     ) -> None:
         self.tool, self.positions, self.axes, self.degrees = tool, positions, axes, degrees
         self.feeds, self.rapid, self.lines, self.first = feeds, rapid, lines, first
         self.written = written  # degrees are the file's own (base frame): echoed as given
         # the part's moves (N − 1, 7) in the base frame, None when none is an arc (CIRCLE)
         self.arcs = arcs
+        # the part's Bézier moves (N − 1, 6) in the base frame, None when none is (NURBS)
+        self.beziers = beziers
 
 
 def _read_parts(
@@ -244,12 +232,8 @@ def _read_parts(
     """The file's parts in the base frame, and the CL program (None for CSV)."""
     work = cell.work if frame == "work" else WorkFrame()
     units = getattr(options, "cl_units", None)
-    spline = getattr(options, "spline_tolerance_mm", None)
     if is_cl_file(options.file):
-        tolerance = DEFAULT_SPLINE_TOLERANCE if spline is None else _spline_tolerance(spline)
-        program: CLProgram = read_cldata(
-            options.file, tools=set(cell.tools), units=units, spline_tolerance=tolerance
-        )
+        program: CLProgram = read_cldata(options.file, tools=set(cell.tools), units=units)
         positions = work.origin + program.positions @ work.rotation.T
         axes = vectors_to_base(program.axes, work)
         feeds = np.where(np.isnan(program.feeds), feed, program.feeds)
@@ -257,6 +241,8 @@ def _read_parts(
         arcs = program.arcs.copy()
         arcs[:, :3] = work.origin + program.arcs[:, :3] @ work.rotation.T
         arcs[:, 3:6] = program.arcs[:, 3:6] @ work.rotation.T
+        # Bézier moves (NURBS spans): the inner control points move as points
+        beziers = (work.origin + program.beziers.reshape(-1, 3) @ work.rotation.T).reshape(-1, 6)
         parts = []
         for start, stop in program.parts:
             number = int(program.tools[start])
@@ -274,6 +260,7 @@ def _read_parts(
                     program.lines[start:stop],
                     start,
                     arcs=_part_arcs(arcs[start + 1 : stop]),
+                    beziers=_part_arcs(beziers[start + 1 : stop]),
                 )
             )
         for k, (start, stop) in enumerate(program.parts):
@@ -285,10 +272,9 @@ def _read_parts(
                 )
                 raise CliError(msg)
         return parts, program
-    for flag, given in (("--cl-units", units), ("--spline-tolerance-mm", spline)):
-        if given is not None:
-            msg = f"{flag}: only for CL files ({options.file} is read as CSV, in m)"
-            raise CliError(msg)
+    if units is not None:
+        msg = f"--cl-units: only for CL files ({options.file} is read as CSV, in m)"
+        raise CliError(msg)
     waypoints = read_path_file(options.file)
     count = len(waypoints.positions)
     feeds = np.full(count, feed)
@@ -318,17 +304,8 @@ def _read_parts(
     return [part], None
 
 
-def _spline_tolerance(value: float) -> float:
-    """``--spline-tolerance-mm`` in m, checked."""
-    number = float(finite([value], "--spline-tolerance-mm", "mm")[0])
-    if not 1e-6 <= number <= 1.0:
-        msg = f"--spline-tolerance-mm: expected 1e-6 to 1 mm, got {number:g}"
-        raise CliError(msg)
-    return number * 1e-3
-
-
 def _part_arcs(arcs: NDArray[np.float64]) -> NDArray[np.float64] | None:
-    """A part's arcs, or None when all its moves are straight."""
+    """A part's arcs (or Bézier moves), or None when none of its moves is one."""
     return arcs if bool(np.isfinite(arcs[:, 0]).any()) else None
 
 
@@ -354,6 +331,9 @@ def _to_frame(document: dict[str, Any], work: WorkFrame) -> None:
         if arc is not None:
             arc["centre"] = position(arc["centre"])
             arc["axis"] = (np.asarray(arc["axis"]) @ r_w).tolist()
+        bezier = segment.get("bezier")
+        if bezier is not None:
+            bezier["control_points"] = [position(p) for p in bezier["control_points"]]
         if segment["position_at_violation"] is not None:
             segment["position_at_violation"] = position(segment["position_at_violation"])
             segment["first_violation_pose_deg"] = angles(segment["first_violation_pose_deg"])
@@ -408,6 +388,7 @@ def _check_part(
             interpolation=options.interpolation,
             tolerance=tolerance,
             arcs=part.arcs,
+            beziers=part.beziers,
         )
         baseline = result.baseline
     else:
@@ -419,6 +400,7 @@ def _check_part(
             interpolation=options.interpolation,
             tolerance=tolerance,
             arcs=part.arcs,
+            beziers=part.beziers,
         )
         baseline = psi_zero_baseline(model, result)
     document = path_to_json(result, baseline, part.degrees if part.written else None)
@@ -432,7 +414,12 @@ def _check_part(
         raise CliError(msg)
     rotations = tt_to_matrix(checked.waypoints.angles)
     rates = actuator_rates(
-        model, checked.waypoints.positions, rotations, speed_limits=limits, arcs=part.arcs
+        model,
+        checked.waypoints.positions,
+        rotations,
+        speed_limits=limits,
+        arcs=part.arcs,
+        beziers=part.beziers,
     )
     speeds = feed_limits(rates, feed, np.full(moves, rotary_feed), limits)
     for k, segment in enumerate(document["segments"]):
@@ -584,12 +571,14 @@ def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str])
     rapid = _positive(options.rapid_feed_mm_min, "--rapid-feed-mm-min", "mm/min") * _MM_MIN
     rotary = _positive(options.rotary_feed_deg_min, "--rotary-feed-deg-min", "deg/min") * _DEG_MIN
     parts, program = _read_parts(options, cell, frame, feed)
-    if record is not None and any(part.arcs is not None for part in parts):
-        assert program is not None  # arcs come from CL files only
-        first = int(np.flatnonzero(np.isfinite(program.arcs[:, 0]))[0])
+    if record is not None and any(p.arcs is not None or p.beziers is not None for p in parts):
+        assert program is not None  # curves come from CL files only
+        curved = np.isfinite(program.arcs[:, 0]) | np.isfinite(program.beziers[:, 0])
+        first = int(np.flatnonzero(curved)[0])
+        kind = "CIRCLE" if np.isfinite(program.arcs[first, 0]) else "NURBS"
         msg = (
-            f"--record: the ~/check_path request carries waypoints, not arcs (line "
-            f"{program.lines[first]} ends a CIRCLE); the node would check the chords"
+            f"--record: the ~/check_path request carries waypoints, not curves (line "
+            f"{program.lines[first]}: {kind}); the node would check the chords"
         )
         raise CliError(msg)
     results, documents, calls = [], [], []
@@ -615,10 +604,7 @@ def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str])
             {"line": line, "origin": origin.tolist(), "rotation": rotation.tolist()}
             for line, origin, rotation in program.frames
         ]
-        common["cl_splines"] = [
-            {"line": line, "chords": count, "deviation_max_m": bound}
-            for line, count, bound in program.splines
-        ]
+        common["cl_splines"] = [{"line": line, "moves": moves} for line, moves in program.splines]
     if len(documents) == 1:
         report: dict[str, Any] = {**documents[0], **common, "ok": ok}
     else:
@@ -667,11 +653,10 @@ def _speed_text(report: dict[str, Any], out: IO[str]) -> None:
     if splines:
         lines = ", ".join(str(spline["line"]) for spline in splines[:8])
         lines += ", ..." if len(splines) > 8 else ""
-        chords = sum(spline["chords"] for spline in splines)
-        bound = max(spline["deviation_max_m"] for spline in splines)
+        moves = sum(spline["moves"] for spline in splines)
         out.write(
-            f"  NURBS: {len(splines)} spline(s) (line {lines}) checked as {chords} chords, "
-            f"the curve within {bound * 1e3:.3g} mm of them\n"
+            f"  NURBS: {len(splines)} spline(s) (line {lines}) as {moves} cubic Bézier moves, "
+            "checked along the curve\n"
         )
     if report["passed_over"]:
         names = ", ".join(f"{n} x{c}" for n, c in report["passed_over"].items())

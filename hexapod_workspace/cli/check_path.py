@@ -251,6 +251,14 @@ def path_to_json(
                 if math.isfinite(float(row[0]))
                 else None
             )
+    if path.beziers is not None:  # NURBS spans: the inner control points (base frame, m)
+        for k, segment in enumerate(document["segments"]):
+            inner = path.beziers[k]
+            segment["bezier"] = (
+                {"control_points": [inner[:3].tolist(), inner[3:].tolist()]}
+                if math.isfinite(float(inner[0]))
+                else None
+            )
     document["psi_zero_baseline"] = {
         "waypoints_failed": baseline.failed_waypoints,
         "segments_failed": baseline.failed_segments,
@@ -315,6 +323,8 @@ def _text(result: PathCheck | TorsionPlan, document: dict[str, Any], out: IO[str
     mode = "tool axes, torsion planned" if plan is not None else "fixed orientations"
     arcs = sum(1 for segment in segments if segment.get("arc") is not None)
     mode += f"; {arcs} of them arcs, checked along the arc" if arcs else ""
+    curves = sum(1 for segment in segments if segment.get("bezier") is not None)
+    mode += f"; {curves} of them Bézier curves, checked along the curve" if curves else ""
     out.write(
         f"path: {len(waypoints)} waypoints, {len(segments)} moves ({mode}), "
         f"{document['interpolation']}, tolerance {document['tolerance_deg']:.3g} deg\n"

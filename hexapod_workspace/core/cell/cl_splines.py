@@ -1,5 +1,4 @@
-"""NX's ``NURBS`` motion in CL files: the spline it states, and chords certified to lie within a
-tolerance of it.
+"""NX's ``NURBS`` motion in CL files: the spline it states, as cubic Bézier moves.
 
 The record
 ----------
@@ -25,16 +24,14 @@ test measures it). No document stating NX's convention was found: a record
 whose counts do not fit, whose knots decrease or leave (0, 1], or whose knots repeat more than
 three times (a break in the curve) is refused with its line.
 
-The chords
-----------
+The moves
+---------
 The spline is cut into its cubic Bézier spans (Boehm's knot insertion, each interior knot raised
-to multiplicity 3), and each span is halved (de Casteljau at t = 1/2) until its two inner control
-points lie within the tolerance δ of the chord between its ends. A Bézier curve lies in the convex
-hull of its control points, and the distance to a segment is a convex function, so its largest
-value over the hull is at a vertex: **every point of the curve is within δ of its chord**, and
-the checked chords stand for the curve up to a displacement δ of the tool tip (the bound is
-reported per spline, with the number of chords). The tool axis is constant along the spline, so
-the orientation of each pose on the curve is the one checked on the chord beside it.
+to multiplicity 3): the control points then fall in groups of four sharing their ends, one group
+per span. Each span is a move of its own from one span end to the next (a waypoint at each knot),
+checked along the curve like an arc
+(:mod:`~hexapod_workspace.core.motions.interpolation`: the rate bounds of a Bézier move come
+from the convex hulls of its derivatives). The tool axis stays the one in force.
 """
 
 from __future__ import annotations
@@ -46,15 +43,10 @@ from numpy.typing import NDArray
 
 from ...errors import InputError
 
-__all__ = ["DEFAULT_SPLINE_TOLERANCE", "NXSpline", "bezier_spans", "chords", "spline_knots"]
+__all__ = ["NXSpline", "bezier_spans", "spline_knots"]
 
-#: Largest distance of a ``NURBS`` spline from the chords that stand for it, m (1 µm: a tenth
-#: of a typical CAM tolerance, below any leg's resolution).
-DEFAULT_SPLINE_TOLERANCE = 1e-6
 #: Knots are written with 7 decimals: the last one is 1 within this.
 _KNOT_ROUNDING = 1e-6
-#: Halvings of one Bézier span at most (2⁴⁰ chords: never reached for a finite curve).
-_MAX_DEPTH = 40
 
 
 @dataclass
@@ -153,64 +145,3 @@ def bezier_spans(knots: NDArray[np.float64], controls: NDArray[np.float64]) -> N
     spans = (array.shape[0] - 1) // 3
     result: NDArray[np.float64] = np.stack([array[3 * s : 3 * s + 4] for s in range(spans)])
     return result
-
-
-def _distance_to_segment(
-    points: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64]
-) -> float:
-    """Largest distance of ``points`` (shape (M, 3)) from the segment [a, b]."""
-    ab = b - a
-    length2 = float(ab @ ab)
-    if length2 > 0.0:
-        u = np.clip((points - a) @ ab / length2, 0.0, 1.0)
-        nearest = a + u[:, None] * ab
-    else:
-        nearest = np.broadcast_to(a, points.shape)
-    return float(np.max(np.linalg.norm(points - nearest, axis=1)))
-
-
-def chords(spans: NDArray[np.float64], tolerance: float) -> tuple[NDArray[np.float64], float]:
-    """Chord ends along Bézier spans, each span halved until the curve is within ``tolerance``
-    of its chords (the convex-hull bound of the module documentation).
-
-    Parameters
-    ----------
-    spans : ndarray, shape (S, 4, 3)
-        Cubic Bézier control points, m.
-    tolerance : float
-        Largest distance of the curve from its chords, m (> 0).
-
-    Returns
-    -------
-    ends : ndarray, shape (M, 3)
-        The chords' ends in order along the curve, the start of the first span excluded, m.
-    bound : float
-        The largest inner-control-point distance over the final spans (≤ tolerance): a bound of
-        the curve's distance from the chords, m.
-    """
-    ends: list[NDArray[np.float64]] = []
-    bound = 0.0
-    for span in spans:
-        stack = [(span, 0)]
-        while stack:  # depth first, second half pushed first: chords come out in order
-            piece, depth = stack.pop()
-            deviation = _distance_to_segment(piece[1:3], piece[0], piece[3])
-            if deviation <= tolerance or depth >= _MAX_DEPTH:
-                ends.append(piece[3])
-                bound = max(bound, deviation)
-                continue
-            left, right = _halves(piece)
-            stack.append((right, depth + 1))
-            stack.append((left, depth + 1))
-    return np.array(ends, dtype=np.float64).reshape(-1, 3), bound
-
-
-def _halves(piece: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """de Casteljau at t = 1/2: the control points of the two halves of a cubic Bézier."""
-    p01, p12, p23 = (piece[:-1] + piece[1:]) / 2.0
-    p012, p123 = (p01 + p12) / 2.0, (p12 + p23) / 2.0
-    middle = (p012 + p123) / 2.0
-    return (
-        np.array([piece[0], p01, p012, middle]),
-        np.array([middle, p123, p23, piece[3]]),
-    )

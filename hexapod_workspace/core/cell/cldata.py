@@ -30,11 +30,11 @@ statement                       meaning here
                                 the end's height along the axis differs; refused when an end
                                 is off the circle, the tool axis changes, in incremental mode
 ``NURBS/``, ``KNOT/k,...``,      a spline move from the current point (NX): the clamped cubic
-``CNTRL/x,y,z``                 B-spline of :mod:`~hexapod_workspace.core.cell.cl_splines`,
-                                checked as chords certified to lie within ``spline_tolerance``
-                                of it (``CLProgram.splines``); the tool axis stays; refused
-                                when the counts do not fit, in incremental mode, after
-                                ``RAPID``, or with weights or tool axes in ``CNTRL``
+``CNTRL/x,y,z``                 B-spline of :mod:`~hexapod_workspace.core.cell.cl_splines`, one
+                                Bézier move per span, checked along the curve
+                                (``CLProgram.beziers``, ``CLProgram.splines``); the tool axis
+                                stays; refused when the counts do not fit, in incremental mode,
+                                after ``RAPID``, or with weights or tool axes in ``CNTRL``
 ``SET/MODE,INCR|ABSOL``         following ``GOTO`` positions are increments / absolute
 ``TLAXIS/i,j,k``                the tool axis of following 3-value ``GOTO`` statements
 ``FEDRAT/f[,MMPM|IPM|PERMIN]``  feed of the following cutting moves (also ``FEDRAT/MMPM,f``);
@@ -93,7 +93,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...errors import InputError
-from .cl_splines import DEFAULT_SPLINE_TOLERANCE, NXSpline, bezier_spans, chords, spline_knots
+from .cl_splines import NXSpline, bezier_spans, spline_knots
 from .cl_statements import (
     _FEED_UNITS,
     _NAMES,
@@ -158,9 +158,13 @@ class CLProgram:
     frames : tuple of (int, ndarray, ndarray)
         Each ``MSYS`` and ``ORIGIN`` applied: (line, origin in the work frame (m), rotation
         from the file's coordinates to the work frame (3, 3)).
-    splines : tuple of (int, int, float)
-        Each ``NURBS`` spline: (line, number of chords standing for it, certified bound of the
-        curve's distance from them (m)). Its chords are moves ending at waypoints whose
+    beziers : ndarray, shape (N, 6)
+        The move that ends at waypoint k as a cubic Bézier curve (a span of a ``NURBS``
+        spline): its inner control points b₁, b₂ (work frame, m), as
+        :func:`~hexapod_workspace.core.motions.checks.check_path` takes them; NaN for other
+        moves and for the first waypoint of each part.
+    splines : tuple of (int, int)
+        Each ``NURBS`` spline: (line, number of Bézier moves). Its moves end at waypoints whose
         ``lines`` is the ``NURBS`` line.
     arcs : ndarray, shape (N, 7)
         The move that ends at waypoint k as an arc (``CIRCLE``): centre (work frame, m), unit
@@ -183,7 +187,8 @@ class CLProgram:
     units_source: str = ""
     frames: tuple[tuple[int, NDArray[np.float64], NDArray[np.float64]], ...] = field(default=())
     arcs: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 7)))
-    splines: tuple[tuple[int, int, float], ...] = ()
+    beziers: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 6)))
+    splines: tuple[tuple[int, int], ...] = ()
 
     def __len__(self) -> int:
         return int(self.positions.shape[0])
@@ -232,10 +237,10 @@ class _Reader:
         # coordinates (m), radius (m)); the arcs of the moves, one row per waypoint.
         self.circle: tuple[int, str, NDArray[np.float64], NDArray[np.float64], float] | None = None
         self.arcs: list[NDArray[np.float64]] = []
-        # A NURBS record being read, the chords' tolerance (m) and each spline read.
+        # A NURBS record being read, each spline read, the Bézier moves, one row per waypoint.
         self.spline: NXSpline | None = None
-        self.spline_tolerance = DEFAULT_SPLINE_TOLERANCE
-        self.splines: list[tuple[int, int, float]] = []
+        self.splines: list[tuple[int, int]] = []
+        self.beziers: list[NDArray[np.float64]] = []
 
     # -- units -----------------------------------------------------------------------------
     def scale(self, line: int, shown: str) -> float:
@@ -284,6 +289,7 @@ class _Reader:
         self.positions.append(position)
         self.axes.append(axis)
         self.arcs.append(np.full(7, np.nan))
+        self.beziers.append(np.full(6, np.nan))
         first = len(self.positions) - 1 == self.part_starts[-1]
         self.feeds.append(math.nan if first else self.feed)
         self.rapid.append(self.rapid_next and not first)
@@ -309,7 +315,6 @@ def parse_cldata(
     text: str,
     tools: Collection[int] | None = None,
     units: str | None = None,
-    spline_tolerance: float = DEFAULT_SPLINE_TOLERANCE,
 ) -> CLProgram:
     """Read the text of a CL file (see the module documentation).
 
@@ -323,9 +328,6 @@ def parse_cldata(
     units : {'mm', 'inch'}, optional
         The units of a file that does not state them (``check-path --cl-units``); refused
         where the file states others before its first ``UNITS`` statement.
-    spline_tolerance : float
-        Largest distance of a ``NURBS`` spline from the chords checked for it, m (1e-9 to
-        1e-3).
 
     Returns
     -------
@@ -341,14 +343,10 @@ def parse_cldata(
     if units is not None and units not in CL_UNITS:
         msg = f"units: expected one of {', '.join(CL_UNITS)}, got {units!r}"
         raise InputError(msg)
-    if not 1e-9 <= spline_tolerance <= 1e-3:  # NaN fails too
-        msg = f"spline_tolerance: expected 1e-9 to 1e-3 m, got {spline_tolerance!r}"
-        raise InputError(msg)
     statements = _statements(text)
     unit, source = _initial_units(statements, units)
     state = _Reader(tools, unit, source)
     state.option = units
-    state.spline_tolerance = spline_tolerance
     for line, statement in statements:
         shown = _shown(statement)
         word, arguments = _split(statement, line, shown)
@@ -379,6 +377,7 @@ def parse_cldata(
         units_source=state.unit_source,
         frames=tuple(state.frames),
         arcs=np.array(state.arcs, dtype=np.float64).reshape(-1, 7),
+        beziers=np.array(state.beziers, dtype=np.float64).reshape(-1, 6),
         splines=tuple(state.splines),
     )
 
@@ -657,7 +656,8 @@ def _spline_data(state: _Reader, word: str, arguments: list[str], line: int, sho
 
 
 def _end_spline(state: _Reader) -> None:
-    """The chords of the record just read (work frame), each a waypoint of the NURBS line."""
+    """The Bézier moves of the record just read (work frame), each ending at a waypoint of the
+    NURBS line."""
     spline = state.spline
     assert spline is not None
     state.spline = None
@@ -665,10 +665,11 @@ def _end_spline(state: _Reader) -> None:
     # a B-spline of affinely mapped control points is the mapped curve
     controls = np.vstack([spline.start, *spline.controls])
     work = state.origin + controls @ state.rotation.T
-    ends, bound = chords(bezier_spans(knots, work), state.spline_tolerance)
-    for end in ends:
-        state.add(end, state.axis_work(), spline.line, spline.shown)
-    state.splines.append((spline.line, int(ends.shape[0]), bound))
+    spans = bezier_spans(knots, work)
+    for span in spans:
+        state.add(span[3], state.axis_work(), spline.line, spline.shown)
+        state.beziers[-1] = span[1:3].reshape(6)
+    state.splines.append((spline.line, int(spans.shape[0])))
 
 
 def _load_tool(state: _Reader, arguments: list[str], line: int, shown: str) -> None:
@@ -773,7 +774,6 @@ def read_cldata(
     path: str | Path,
     tools: Collection[int] | None = None,
     units: str | None = None,
-    spline_tolerance: float = DEFAULT_SPLINE_TOLERANCE,
 ) -> CLProgram:
     """Read a CL file from disk (see :func:`parse_cldata`).
 
@@ -793,7 +793,7 @@ def read_cldata(
         msg = f"CL file {path} is not text"
         raise InputError(msg) from error
     try:
-        return parse_cldata(text, tools, units, spline_tolerance)
+        return parse_cldata(text, tools, units)
     except InputError as error:
         msg = f"CL file {path}: {error}"
         raise InputError(msg) from error

@@ -39,6 +39,7 @@ def psi_zero_baseline(manipulator: Manipulator, path: PathCheck) -> PathCheck:
         interpolation=path.interpolation,
         tolerance=path.tolerance,
         arcs=path.arcs,
+        beziers=path.beziers,
     )
 
 

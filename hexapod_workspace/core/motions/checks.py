@@ -35,7 +35,7 @@ from .certificate import (
 from .interpolation import (
     _Moves,
     _orientations,
-    _validate_arcs,
+    _validate_curves,
     _validate_interpolation,
     _validate_positions,
     _validate_tolerance,
@@ -112,6 +112,7 @@ def check_path(
     tolerance: float = DEFAULT_PATH_TOLERANCE,
     max_sample_angle: float = DEFAULT_MAX_SAMPLE_ANGLE,
     arcs: ArrayLike | None = None,
+    beziers: ArrayLike | None = None,
 ) -> PathCheck:
     """Check a path of N waypoints and the N − 1 moves between them, certified.
 
@@ -138,6 +139,10 @@ def check_path(
         Moves that are arcs (CAM's ``CIRCLE``): per move, centre (m, base frame), axis and
         angle φ (rad, right-handed about the axis); a row of NaN for a straight move
         (:mod:`~hexapod_workspace.core.motions.interpolation`). None: every move is straight.
+    beziers : array_like, shape (N − 1, 6), optional
+        Moves that are cubic Bézier curves (CAM's NURBS spans): per move, the inner control
+        points b₁, b₂ (m, base frame; the ends are the waypoints); a row of NaN for another
+        move (:mod:`~hexapod_workspace.core.motions.interpolation`). None: none is.
 
     Returns
     -------
@@ -158,7 +163,7 @@ def check_path(
     if not (math.isfinite(max_sample_angle) and max_sample_angle >= tolerance):
         msg = f"max_sample_angle: expected a finite value >= tolerance, got {max_sample_angle!r}"
         raise ResolutionError(msg)
-    circles = _validate_arcs(arcs, positions)
+    circles = _validate_curves(arcs, beziers, positions)
     certifier = _Certifier(manipulator)
     waypoints, found = _waypoint_checks(certifier, positions, matrices)
     moves = _Moves(
@@ -187,7 +192,8 @@ def check_path(
         interpolation=interpolation,
         tolerance=tolerance,
         elapsed=time.perf_counter() - started,
-        arcs=None if circles is None else np.array(arcs, dtype=np.float64),
+        arcs=None if arcs is None else np.array(arcs, dtype=np.float64),
+        beziers=None if beziers is None else np.array(beziers, dtype=np.float64),
     )
 
 

@@ -30,6 +30,20 @@ so ``|p'| ≤ √(Δh² + Δρ² + max(ρ₀, ρ₁)²φ²)``: the arc's "transl
 ``√(Δh² + Δρ² + min(ρ₀, ρ₁)²φ²)`` (a duration at a feed is taken from this lower bound, so
 actuator speeds are never under-stated).
 
+A move may also be a **cubic Bézier curve** (what CAM writes as NURBS, cut into its spans):
+given two inner control points b₁, b₂ between the ends b₀ = p₀, b₃ = p₁,
+
+    p(s) = (1 − s)³b₀ + 3s(1 − s)²b₁ + 3s²(1 − s)b₂ + s³b₃,
+    p'(s) = 3[(1 − s)²d₀ + 2s(1 − s)d₁ + s²d₂],   d_k = b_{k+1} − b_k,
+    p''(s) = 6[(1 − s)e₀ + s·e₁],                  e_k = d_{k+1} − d_k.
+
+p' and p'' are Bézier curves of the d_k and e_k, so they lie in their convex hulls, and a norm
+is convex: ``|p'| ≤ 3·max_k |d_k|`` and ``|p''| ≤ 6·max(|e₀|, |e₁|)``: the spline's
+"translation" in the rate bounds and its curvature term. A polyline through points of a curve
+is never longer than the curve, so the length through 33 points of it is a lower bound (a
+duration at a feed is taken from it, as for arcs). The orientation follows the interpolation
+as for a straight move.
+
 The rate bounds (angular rate Ω, joint speed V) are derived in
 :mod:`hexapod_workspace.core.motions.certificate`.
 """
@@ -37,6 +51,7 @@ The rate bounds (angular rate Ω, joint speed V) are derived in
 from __future__ import annotations
 
 import math
+from typing import Self
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -55,6 +70,9 @@ from ..base.rotations import (
 
 __all__ = ["ARC_TOLERANCE", "INTERPOLATIONS", "ROTATION_TOLERANCE"]
 
+#: Points of a Bézier move whose polyline gives the lower bound of its length.
+_LENGTH_POINTS = 33
+
 #: Interpolations between waypoints (see the module documentation).
 INTERPOLATIONS = ("slerp", "tilt-torsion")
 #: Deviation from a rotation matrix accepted in inputs (|RᵀR − I| and |det R − 1|).
@@ -63,7 +81,24 @@ ROTATION_TOLERANCE = 1e-6
 ARC_TOLERANCE = 1e-6
 
 
-class _Arcs:
+class _CurveKind:
+    """One kind of curved move over a batch: arrays with one row per move (``mask``: the moves
+    of this kind; ``speed``, ``length``, ``accel``: the bounds of the module documentation)."""
+
+    mask: NDArray[np.bool_]
+    speed: NDArray[np.float64]
+    length: NDArray[np.float64]
+    accel: NDArray[np.float64]
+
+    def take(self, moves: NDArray[np.int64]) -> Self:
+        """The moves ``moves`` (a new batch of the same kind, in that order)."""
+        taken = object.__new__(type(self))
+        for name, value in vars(self).items():
+            setattr(taken, name, value[moves])
+        return taken
+
+
+class _Arcs(_CurveKind):
     """The arc moves of a batch of K moves (module documentation); straight moves have NaN
     rows and are left to :class:`_Moves`.
 
@@ -106,13 +141,6 @@ class _Arcs:
         self.speed = np.sqrt(base + (largest * self.phi) ** 2)
         self.length = np.sqrt(base + (smallest * self.phi) ** 2)
         self.accel = 2.0 * np.abs(self.drho * self.phi) + largest * self.phi**2
-
-    def take(self, moves: NDArray[np.int64]) -> _Arcs:
-        """The arcs of moves ``moves`` (a new batch in that order)."""
-        taken = object.__new__(_Arcs)
-        for name, value in vars(self).items():
-            setattr(taken, name, value[moves])
-        return taken
 
     def _turned(
         self, moves: NDArray[np.int64], s: NDArray[np.float64]
@@ -187,6 +215,153 @@ def _validate_arcs(arcs: ArrayLike | None, positions: NDArray[np.float64]) -> _A
             )
             raise InputError(msg)
     return result if result.mask.any() else None
+
+
+class _Beziers(_CurveKind):
+    """The cubic Bézier moves of a batch of K moves (module documentation); other moves have
+    NaN rows.
+
+    Parameters
+    ----------
+    positions0, positions1 : ndarray, shape (K, 3)
+        The moves' ends b₀, b₃, m.
+    inner : ndarray, shape (K, 6)
+        Per move: the inner control points b₁, b₂ (m); a row of NaN for another move.
+    """
+
+    def __init__(
+        self,
+        positions0: NDArray[np.float64],
+        positions1: NDArray[np.float64],
+        inner: NDArray[np.float64],
+    ) -> None:
+        self.mask = np.isfinite(inner[:, 0])
+        # other moves get the straight line's control points: harmless, never used
+        straight = np.concatenate(
+            [
+                positions0 + (positions1 - positions0) / 3.0,
+                positions0 + 2.0 * (positions1 - positions0) / 3.0,
+            ],
+            axis=1,
+        )
+        rows = np.where(self.mask[:, None], inner, straight)
+        self.control = np.stack([positions0, rows[:, :3], rows[:, 3:], positions1], axis=1)
+        d = np.diff(self.control, axis=1)  # (K, 3, 3)
+        e = np.diff(d, axis=1)  # (K, 2, 3)
+        #: Bound of |p'(s)| (m per unit s), the lower bound of the length (m), bound of |p''|.
+        self.speed = 3.0 * np.linalg.norm(d, axis=2).max(axis=1)
+        self.accel = 6.0 * np.linalg.norm(e, axis=2).max(axis=1)
+        grid = np.linspace(0.0, 1.0, _LENGTH_POINTS, dtype=np.float64)
+        points = np.einsum("sk,nkj->nsj", _bernstein(grid), self.control)
+        self.length = np.linalg.norm(np.diff(points, axis=1), axis=2).sum(axis=1)
+
+    def positions(self, moves: NDArray[np.int64], s: NDArray[np.float64]) -> NDArray[np.float64]:
+        """p(s) (n, 3) of Bézier moves ``moves`` (n,) at ``s`` (n,), m."""
+        result: NDArray[np.float64] = np.einsum("nk,nkj->nj", _bernstein(s), self.control[moves])
+        return result
+
+    def velocities(self, moves: NDArray[np.int64], s: NDArray[np.float64]) -> NDArray[np.float64]:
+        """p'(s) (n, 3), m per unit s."""
+        d = np.diff(self.control[moves], axis=1)
+        weights = np.column_stack([(1.0 - s) ** 2, 2.0 * s * (1.0 - s), s**2]) * 3.0
+        result: NDArray[np.float64] = np.einsum("nk,nkj->nj", weights, d)
+        return result
+
+
+def _bernstein(s: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The cubic Bernstein polynomials at ``s`` (n,): shape (n, 4)."""
+    t = 1.0 - s
+    return np.column_stack([t**3, 3.0 * s * t**2, 3.0 * s**2 * t, s**3])
+
+
+class _Curves:
+    """The curved moves of a batch (arcs, Bézier moves or both), as one: per move its kind's
+    position, velocity and bounds; straight moves are left to :class:`_Moves`."""
+
+    def __init__(self, arcs: _Arcs | None, beziers: _Beziers | None) -> None:
+        self.kinds: list[_Arcs | _Beziers] = [k for k in (arcs, beziers) if k is not None]
+        assert self.kinds
+        self.mask: NDArray[np.bool_] = np.logical_or.reduce([k.mask for k in self.kinds])
+        #: Per move: bound of |p'(s)|, lower bound of the length, bound of |p''| (its kind's).
+        self.speed = self._merged([k.speed for k in self.kinds])
+        self.length = self._merged([k.length for k in self.kinds])
+        self.accel = self._merged([k.accel for k in self.kinds])
+
+    def _merged(self, values: list[NDArray[np.float64]]) -> NDArray[np.float64]:
+        merged = np.zeros(self.mask.shape)
+        for kind, value in zip(self.kinds, values, strict=True):
+            merged = np.where(kind.mask, value, merged)
+        return merged
+
+    def take(self, moves: NDArray[np.int64]) -> _Curves:
+        """The moves ``moves`` (a new batch in that order)."""
+        taken = object.__new__(_Curves)
+        taken.kinds = [kind.take(moves) for kind in self.kinds]
+        taken.mask = self.mask[moves]
+        taken.speed, taken.length = self.speed[moves], self.length[moves]
+        taken.accel = self.accel[moves]
+        return taken
+
+    def _each(
+        self, method: str, moves: NDArray[np.int64], s: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        result = np.zeros((moves.shape[0], 3))
+        for kind in self.kinds:
+            mine = kind.mask[moves]
+            if mine.any():
+                result[mine] = getattr(kind, method)(moves[mine], s[mine])
+        return result
+
+    def positions(self, moves: NDArray[np.int64], s: NDArray[np.float64]) -> NDArray[np.float64]:
+        """p(s) (n, 3) of curved moves ``moves`` (n,) at ``s`` (n,), m."""
+        return self._each("positions", moves, s)
+
+    def velocities(self, moves: NDArray[np.int64], s: NDArray[np.float64]) -> NDArray[np.float64]:
+        """p'(s) (n, 3), m per unit s."""
+        return self._each("velocities", moves, s)
+
+
+def _validate_beziers(beziers: ArrayLike | None, positions: NDArray[np.float64]) -> _Beziers | None:
+    """``beziers`` (N − 1, 6) of a path of N waypoints as :class:`_Beziers`, or None (none).
+
+    Refused (InputError naming the move): a wrong shape, a row neither all finite nor all NaN,
+    a control point beyond 1e6 m.
+    """
+    if beziers is None:
+        return None
+    count = positions.shape[0] - 1
+    inner = np.asarray(beziers, dtype=np.float64)
+    if inner.shape != (count, 6):
+        msg = f"beziers: expected shape ({count}, 6) (one row per move), got {inner.shape}"
+        raise InputError(msg)
+    finite = np.asarray(np.isfinite(inner).all(axis=1), dtype=np.bool_)
+    size = np.abs(np.where(finite[:, None], inner, 0.0)).max(axis=1)
+    bad = np.flatnonzero(~(finite | np.isnan(inner).all(axis=1)) | (finite & (size > 1e6)))
+    if bad.size:
+        msg = (
+            f"beziers: move {bad[0] + 1}: expected 6 finite numbers within 1e6 m (the inner "
+            "control points) or 6 NaN (another move)"
+        )
+        raise InputError(msg)
+    result = _Beziers(positions[:-1], positions[1:], inner)
+    return result if result.mask.any() else None
+
+
+def _validate_curves(
+    arcs: ArrayLike | None, beziers: ArrayLike | None, positions: NDArray[np.float64]
+) -> _Curves | None:
+    """The curved moves of a path: :func:`_validate_arcs` and :func:`_validate_beziers`, a move
+    given as both refused; None when every move is straight."""
+    circles = _validate_arcs(arcs, positions)
+    curves = _validate_beziers(beziers, positions)
+    if circles is not None and curves is not None:
+        both = np.flatnonzero(circles.mask & curves.mask)
+        if both.size:
+            msg = f"beziers: move {both[0] + 1} is an arc too (expected one curve per move)"
+            raise InputError(msg)
+    if circles is None and curves is None:
+        return None
+    return _Curves(circles, curves)
 
 
 def _validate_positions(positions: ArrayLike, minimum: int = 2) -> NDArray[np.float64]:
@@ -297,9 +472,9 @@ class _Moves:
         max_i |b_i|, m.
     quaternions : (ndarray, ndarray), optional
         The ends' unit quaternions (K, 4), when the caller has them.
-    arcs : _Arcs, optional
-        Which moves are arcs (their positions follow the arc, their ``translation`` is the
-        bound of |dp/ds|); None: every move is straight.
+    arcs : _Curves, optional
+        Which moves are curves, arcs or Bézier (their positions follow the curve, their
+        ``translation`` is the bound of |dp/ds|); None: every move is straight.
     """
 
     def __init__(
@@ -311,12 +486,12 @@ class _Moves:
         interpolation: str,
         rho: float,
         quaternions: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
-        arcs: _Arcs | None = None,
+        arcs: _Curves | None = None,
     ) -> None:
         self.p0 = positions0
         self.dp = positions1 - positions0
         self.arcs = arcs
-        #: |Δp| of a straight move, the bound of |dp/ds| of an arc (module documentation), m.
+        #: |Δp| of a straight move, the bound of |dp/ds| of a curve (module documentation), m.
         self.translation = np.linalg.norm(self.dp, axis=1)
         if arcs is not None:
             self.translation = np.where(arcs.mask, arcs.speed, self.translation)

@@ -59,10 +59,10 @@ from .certificate import (
 )
 from .checks import check_path
 from .interpolation import (
-    _Arcs,
+    _Curves,
     _Moves,
     _unit_rows,
-    _validate_arcs,
+    _validate_curves,
     _validate_interpolation,
     _validate_positions,
     _validate_tolerance,
@@ -86,6 +86,7 @@ def plan_torsion(
     tolerance: float = DEFAULT_PATH_TOLERANCE,
     margin_resolution: float = DEFAULT_MARGIN_RESOLUTION,
     arcs: ArrayLike | None = None,
+    beziers: ArrayLike | None = None,
 ) -> TorsionPlan:
     """Choose the torsion at every waypoint of a toolpath for an axisymmetric tool.
 
@@ -113,6 +114,9 @@ def plan_torsion(
     arcs : array_like, shape (N − 1, 7), optional
         Moves that are arcs, as :func:`~hexapod_workspace.core.motions.checks.check_path` takes
         them.
+    beziers : array_like, shape (N − 1, 6), optional
+        Moves that are cubic Bézier curves, as
+        :func:`~hexapod_workspace.core.motions.checks.check_path` takes them.
 
     Returns
     -------
@@ -137,7 +141,7 @@ def plan_torsion(
             msg = f"max_dpsi: expected a finite value >= 0 rad or None, got {max_dpsi!r}"
             raise InputError(msg)
     directions = approach_to_tilt(axes)  # (N, 2)
-    circles = _validate_arcs(arcs, positions)
+    circles = _validate_curves(arcs, beziers, positions)
     baseline = check_path(
         manipulator,
         positions,
@@ -145,6 +149,7 @@ def plan_torsion(
         interpolation=interpolation,
         tolerance=tolerance,
         arcs=arcs,
+        beziers=beziers,
     )
     margin_resolution = float(margin_resolution)
     if not (math.isfinite(margin_resolution) and 1e-6 <= margin_resolution <= 0.1):
@@ -171,6 +176,7 @@ def plan_torsion(
             interpolation=interpolation,
             tolerance=tolerance,
             arcs=arcs,
+            beziers=beziers,
         )
     return TorsionPlan(
         ok=psi is not None,
@@ -240,7 +246,7 @@ class _Planner:
         interpolation: str,
         tolerance: float,
         resolution: float,
-        arcs: _Arcs | None = None,
+        arcs: _Curves | None = None,
     ) -> None:
         self.certifier = _Certifier(manipulator)
         self.arcs = arcs

@@ -162,6 +162,9 @@ class PathCheck:
     arcs : ndarray, shape (N − 1, 7), or None
         The moves that are arcs, as :func:`check_path` took them (NaN rows: straight moves);
         None when every move is straight.
+    beziers : ndarray, shape (N − 1, 6), or None
+        The moves that are cubic Bézier curves, as :func:`check_path` took them (their inner
+        control points; NaN rows: other moves); None when none is.
     """
 
     waypoints: WaypointChecks
@@ -170,6 +173,7 @@ class PathCheck:
     tolerance: float
     elapsed: float
     arcs: NDArray[np.float64] | None = field(default=None, repr=False)
+    beziers: NDArray[np.float64] | None = field(default=None, repr=False)
 
     @property
     def ok(self) -> bool:

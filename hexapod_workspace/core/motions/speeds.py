@@ -101,7 +101,7 @@ from ..base.rotations import (
 )
 from ..model import architectures
 from ..model.manipulator import Manipulator
-from .interpolation import _Arcs, _validate_arcs
+from .interpolation import _Curves, _validate_curves
 
 __all__ = [
     "ACTUATOR_MODELS",
@@ -353,7 +353,7 @@ class _SlerpMoves:
         positions1: NDArray[np.float64],
         rotations0: NDArray[np.float64],
         rotations1: NDArray[np.float64],
-        arcs: _Arcs | None = None,
+        arcs: _Curves | None = None,
     ) -> None:
         self.joints = manipulator.platform_joints
         self.p0 = positions0
@@ -372,9 +372,9 @@ class _SlerpMoves:
         travel = self.translation  # the bound of |dp/ds|
         curvature = np.zeros_like(travel)  # the bound of |d²p/ds²|
         if arcs is not None:
-            # Arcs (path_interpolation): |p'| ≤ arcs.speed, |p''| ≤ arcs.accel, so
+            # Curves (interpolation): |p'| ≤ arcs.speed, |p''| ≤ arcs.accel, so
             # V_i = |p'| + Ω|b_i| and A_i = |p''| + Ω²|b_i| (|dv_i/ds| ≤ |p''| + |w × (w × Rb_i)|);
-            # the length for a duration is the arc's lower bound.
+            # the length for a duration is the curve's lower bound.
             travel = np.where(arcs.mask, arcs.speed, travel)
             curvature = np.where(arcs.mask, arcs.accel, 0.0)
             self.translation = np.where(arcs.mask, arcs.length, self.translation)
@@ -425,6 +425,7 @@ def actuator_rates(
     architecture: str | None = None,
     relative: float = DEFAULT_RELATIVE,
     arcs: ArrayLike | None = None,
+    beziers: ArrayLike | None = None,
 ) -> MoveRates:
     """Certified peak actuator rates (per unit s) of the N − 1 slerp moves of a path.
 
@@ -446,6 +447,10 @@ def actuator_rates(
     arcs : array_like, shape (N − 1, 7), optional
         Moves that are arcs, as :func:`~hexapod_workspace.core.motions.checks.check_path` takes
         them; their ``translation`` is then a lower bound of the arc's length.
+    beziers : array_like, shape (N − 1, 6), optional
+        Moves that are cubic Bézier curves, as
+        :func:`~hexapod_workspace.core.motions.checks.check_path` takes them (``translation``:
+        a lower bound of the length).
 
     Returns
     -------
@@ -478,7 +483,9 @@ def actuator_rates(
     model = ACTUATOR_MODELS[name]
     limits = np.zeros(6) if speed_limits is None else np.broadcast_to(speed_limits, (6,))
     weights = _weights(np.asarray(limits, dtype=np.float64))
-    moves = _SlerpMoves(manipulator, p[:-1], p[1:], r[:-1], r[1:], _validate_arcs(arcs, p))
+    moves = _SlerpMoves(
+        manipulator, p[:-1], p[1:], r[:-1], r[1:], _validate_curves(arcs, beziers, p)
+    )
     count = p.shape[0] - 1
     bound = np.zeros((count, 6))
     sampled = np.zeros((count, 6))
