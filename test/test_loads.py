@@ -442,9 +442,10 @@ def test_check_gives_no_finite_force_margin_where_a_leg_has_no_solution(tmp_path
     assert far["margins"]["ik"] < 0.0 and far["loads"]["actuator_force"] is None
     assert far["reachable"] is False and far["violated"][-2:] == ["transmission", "actuator_force"]
     _, text, _ = run_main("--config", str(path), "check", "--pose", "0", "0", "0")
-    names, units = text.splitlines()[2:4]
-    assert names.split()[-3:] == ["force", "limiting", "violated"]
-    assert units.split()[-2:] == [unit, "leg"]
+    names, units, row = text.splitlines()[2:5]
+    assert names.split()[-4:] == ["force", "limiting", "force", "violated"]
+    assert units.split()[-3:] == [unit, "leg", "actuator"]
+    assert row.split()[-2] == str(home["loads"]["limiting_actuator"])  # the JSON's actuator
 
 
 def test_a_centre_of_mass_in_millimetres_is_refused_with_the_unit_hint(tmp_path):

@@ -195,7 +195,8 @@ def check_table(
     loads: LoadRows | None = None,
 ) -> None:
     """Write a readable table: angles in degrees, margins (distance to each limit) in mm and
-    degrees, the limiting leg and the violated constraints.
+    degrees, the limiting leg and the violated constraints (and, with a force limit, the actuator
+    that limits the force margin).
 
     Parameters are those of :func:`check_json`, and the model the result is of (the unit of a
     row can depend on it: the ``actuator`` stroke in mm for slides, deg for cranks). Poses given
@@ -236,12 +237,16 @@ def check_table(
         given_units = "".join(f"{'[deg]' if angular else '[1]':>9} " for _ in keys)
         given_format = ("%9.3f " if angular else "%9.6f ") * len(keys)
         given_columns = np.asarray(values).T.tolist()
+    by_actuator = loads is not None and "actuator_force" in loads.margins
+    force_name, force_unit = (f"  {'force':>8}", f"  {'actuator':>8}") if by_actuator else ("", "")
     header = (
         f"{' ' * len(given_names)}"
         f"{'':>9} {'':>9} {'':>9}  {'':<9}  {'margin to each limit (>= 0 holds, < 0 violated)'}",
         f"{given_names}{'phi':>9} {'theta':>9} {'psi':>9}  {'reachable':<9}  {names}  "
-        f"{'limiting':>8}  violated" + ("  closest pair" if result.collision_pairs else ""),
-        f"{given_units}{'[deg]':>9} {'[deg]':>9} {'[deg]':>9}  {'':<9}  {units}  {'leg':>8}",
+        f"{'limiting':>8}{force_name}  violated"
+        + ("  closest pair" if result.collision_pairs else ""),
+        f"{given_units}{'[deg]':>9} {'[deg]':>9} {'[deg]':>9}  {'':<9}  {units}  {'leg':>8}"
+        f"{force_unit}",
     )
     out.write("".join(line.rstrip() + "\n" for line in header))
     degrees = np.asarray(degrees)
@@ -267,10 +272,12 @@ def check_table(
             )
         ),
         result.limiting_leg.tolist(),
+        *([loads.limiting_actuator.tolist()] if loads is not None and by_actuator else []),
         [",".join(v) or "-" for v in violated],
     ]
     count = len(columns_shown)
-    template = angle_format + "  %-9s  " + " ".join(["%11.3f"] * count) + "  %8d  %s"
+    template = angle_format + "  %-9s  " + " ".join(["%11.3f"] * count) + "  %8d"
+    template += "  %8d  %s" if by_actuator else "  %s"
     if result.collision_pairs:
         template += "  %s"
         columns.append(result.collision_pair)
