@@ -366,7 +366,7 @@ def test_cl_units_are_stated_refused_or_given_and_passed_over_statements_counted
 
 def test_nurbs_splines_are_checked_along_the_curve(tmp_path):
     """Issue #35 item 2: the real NX record is checked along its spline, one Bézier move per
-    span, not as one chord; the JSON says where each move runs; --record refuses it."""
+    span, not as one chord; the JSON says where each move runs; --record carries the curves."""
     nurbs = Path(__file__).resolve().parent / "data" / "cl" / "nx_nurbs.cls"
     lines = nurbs.read_text(encoding="utf-8").splitlines()
     first = tmp_path / "first_spline.cls"  # the header, the first spline, the closing lines
@@ -393,12 +393,23 @@ def test_nurbs_splines_are_checked_along_the_curve(tmp_path):
     assert code == 0
     assert "NURBS: 1 spline(s) (line 13) as 5 cubic Bézier moves, checked along the curve" in out
     assert "5 of them Bézier curves, checked along the curve" in out
+    # --record: the ~/check_path request carries the Bézier moves (base frame), read back
+    from recording_support import read_with_rosbags
+
     record = tmp_path / "run.mcap"
     code, _, err = run_main(
         "--config", str(config), "check-path", str(first), "--record", str(record)
     )
-    assert code == 2 and "--record: the ~/check_path request carries waypoints, not curves " in err
-    assert "(line 13: NURBS)" in one_error_line(err)
+    assert code == 0 and "recorded the path check (1 call(s))" in err
+    messages = read_with_rosbags(record)
+    (request,) = [m for topic, _, m in messages if topic.endswith("/check_path/request")]
+    (response,) = [m for topic, _, m in messages if topic.endswith("/check_path/response")]
+    rows = np.asarray(request.beziers).reshape(-1, 6)
+    assert np.isfinite(rows[:, 0]).tolist() == [k in curves for k in range(len(segments))]
+    assert len(request.arcs) == 0
+    origin = np.array([0.255, -0.4595, -1.574])  # the work frame's: no rotation
+    np.testing.assert_allclose(rows[1, :3], np.array(inner[0]) + origin, atol=1e-12)
+    assert [s.ok for s in response.segments] == [s["ok"] for s in segments]
 
 
 def _arc_file(tmp_path, circle: bool, radius_mm: float = 350.0) -> Path:
@@ -437,7 +448,7 @@ def test_a_circle_is_checked_and_timed_along_the_arc(tmp_path):
     assert chord["segments"][0]["duration_s"] == pytest.approx(0.7 / (0.6 / 60.0))
 
 
-def test_a_small_arc_passes_and_record_refuses_arcs(tmp_path):
+def test_a_small_arc_passes_and_is_recorded_as_an_arc(tmp_path):
     small = _arc_file(tmp_path, circle=True, radius_mm=150.0)
     code, out, err = run_main("check-path", str(small), "--json")
     assert code == 0, err
@@ -445,11 +456,13 @@ def test_a_small_arc_passes_and_record_refuses_arcs(tmp_path):
     code, out, err = run_main("check-path", str(small))
     assert code == 0 and "1 moves (tool axes, torsion planned; 1 of them arcs" in out
     code, out, err = run_main("check-path", str(small), "--record", str(tmp_path / "arc.mcap"))
-    assert code == 2 and out == ""
-    assert "--record: the ~/check_path request carries waypoints, not curves (line 5: CIRCLE)" in (
-        one_error_line(err)
-    )
-    assert not (tmp_path / "arc.mcap").exists()
+    assert code == 0 and "recorded the path check (1 call(s))" in err
+    from recording_support import read_with_mcap_ros2
+
+    messages = read_with_mcap_ros2(tmp_path / "arc.mcap")
+    (request,) = [m for topic, _, m in messages if topic.endswith("/check_path/request")]
+    arcs = np.asarray(request.arcs).reshape(-1, 7)
+    assert arcs.shape == (1, 7) and np.all(np.isfinite(arcs)) and len(request.beziers) == 0
 
 
 def test_the_real_nx_pocket_with_circles_is_read_and_checked():

@@ -468,8 +468,8 @@ def _part_call(
     feed: NDArray[np.float64],
 ) -> tuple[dict[str, Any], dict[str, Any]]:
     """One part as the ``~/check_path`` call the node would answer the same way: poses in the
-    base frame, the part's feeds (mm/min) and rapid flags, the speeds and frames in the
-    response."""
+    base frame, the part's feeds (mm/min), rapid flags and curved moves (arcs, Bézier), the
+    speeds and frames in the response."""
     from ..logs import paths as path_fields
     from ..logs.cell import cell_frames_fields, segment_speed_fields, slow_moves_clause
 
@@ -500,6 +500,9 @@ def _part_call(
         rapid=[bool(r) for r in part.rapid[1:]],
         rapid_feed_mm_min=0.0 if math.isnan(rapid_feed) else rapid_feed / _MM_MIN,
         rotary_feed_deg_min=0.0 if math.isnan(rotary_feed) else rotary_feed / _DEG_MIN,
+        # the curved moves (CIRCLE, NURBS spans), base frame, flattened one row per move
+        arcs=[] if part.arcs is None else part.arcs.ravel().tolist(),
+        beziers=[] if part.beziers is None else part.beziers.ravel().tolist(),
     )
     response = path_fields.check_path_response_fields(
         result, pairs=model.leg_diameter > 0.0, baseline=baseline
@@ -571,16 +574,6 @@ def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str])
     rapid = _positive(options.rapid_feed_mm_min, "--rapid-feed-mm-min", "mm/min") * _MM_MIN
     rotary = _positive(options.rotary_feed_deg_min, "--rotary-feed-deg-min", "deg/min") * _DEG_MIN
     parts, program = _read_parts(options, cell, frame, feed)
-    if record is not None and any(p.arcs is not None or p.beziers is not None for p in parts):
-        assert program is not None  # curves come from CL files only
-        curved = np.isfinite(program.arcs[:, 0]) | np.isfinite(program.beziers[:, 0])
-        first = int(np.flatnonzero(curved)[0])
-        kind = "CIRCLE" if np.isfinite(program.arcs[first, 0]) else "NURBS"
-        msg = (
-            f"--record: the ~/check_path request carries waypoints, not curves (line "
-            f"{program.lines[first]}: {kind}); the node would check the chords"
-        )
-        raise CliError(msg)
     results, documents, calls = [], [], []
     for part in parts:
         result, document, call = _check_part(platform, part, cell, options, (rapid, rotary))

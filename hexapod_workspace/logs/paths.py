@@ -107,6 +107,8 @@ def check_path_request_fields(
         "rapid_feed_mm_min": 0.0,
         "durations_s": [],
         "rotary_feed_deg_min": 0.0,
+        "arcs": [],
+        "beziers": [],
     }
 
 

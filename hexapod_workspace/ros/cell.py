@@ -149,6 +149,28 @@ def poses_to_base(
     return moved, matrix_to_quaternion(rotations)
 
 
+def curves_to_base(
+    state: State,
+    frame_id: str,
+    arcs: NDArray[np.float64] | None,
+    beziers: NDArray[np.float64] | None,
+) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None]:
+    """A request's curved moves, ``arcs`` (K, 7: centre, axis, angle) and ``beziers`` (K, 6:
+    two control points), given in ``frame_id``, in the base frame: points move as points, the
+    arcs' axes turn as vectors, angles stay; NaN rows stay NaN."""
+    if not in_work_frame(state, frame_id):
+        return arcs, beziers
+    assert state.cell is not None
+    work = state.cell.work
+    if arcs is not None:
+        arcs = arcs.copy()
+        arcs[:, :3] = work.origin + arcs[:, :3] @ work.rotation.T
+        arcs[:, 3:6] = arcs[:, 3:6] @ work.rotation.T
+    if beziers is not None:
+        beziers = (work.origin + beziers.reshape(-1, 3) @ work.rotation.T).reshape(-1, 6)
+    return arcs, beziers
+
+
 _frames_cache: dict[tuple[int, str], tuple[State, Any]] = {}
 
 
@@ -230,9 +252,15 @@ def validate_speed_request(request: Any, interpolation: str) -> None:
         raise InputError(msg)
 
 
-def path_speeds(state: State, request: Any, result: PathCheck | TorsionPlan) -> dict[str, Any]:
+def path_speeds(
+    state: State,
+    request: Any,
+    result: PathCheck | TorsionPlan,
+    curves: tuple[NDArray[np.float64] | None, NDArray[np.float64] | None] = (None, None),
+) -> dict[str, Any]:
     """``speeds`` and ``actuator_speed_max`` of a ``CheckPath`` response (request validated by
-    :func:`validate_speed_request`).
+    :func:`validate_speed_request`); ``curves``: the moves' arcs and Bézier curves in the base
+    frame, as checked.
 
     A move's feed: ``rapid_feed_mm_min`` when ``rapid[k]``, else ``feeds_mm_min[k]``; a move
     without translation runs at ``rotary_feed_deg_min``. With ``durations_s`` each move's feed is
@@ -245,7 +273,15 @@ def path_speeds(state: State, request: Any, result: PathCheck | TorsionPlan) -> 
     waypoints = checked.waypoints
     count = len(waypoints) - 1
     rotations = tt_to_matrix(waypoints.angles)
-    rates = actuator_rates(state.manipulator, waypoints.positions, rotations, speed_limits=limits)
+    arcs, beziers = curves
+    rates = actuator_rates(
+        state.manipulator,
+        waypoints.positions,
+        rotations,
+        speed_limits=limits,
+        arcs=arcs,
+        beziers=beziers,
+    )
     rapid: NDArray[Any] = np.zeros(count, dtype=bool)
     if len(request.rapid):
         rapid = np.asarray(list(request.rapid), dtype=bool)

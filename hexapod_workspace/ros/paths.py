@@ -166,10 +166,13 @@ def check_path_response_fields(
         interpolation = INTERPOLATIONS[request.interpolation]
         tolerance = _option(request.tolerance, "tolerance", DEFAULT_PATH_TOLERANCE)
         positions, quaternions = pose_arrays(request.poses)
+        arcs = _curve_rows(request.arcs, len(positions), 7, "arcs")
+        beziers = _curve_rows(request.beziers, len(positions), 6, "beziers")
         if state is not None:
             positions, quaternions = cell.poses_to_base(
                 state, request.header.frame_id, positions, quaternions
             )
+            arcs, beziers = cell.curves_to_base(state, request.header.frame_id, arcs, beziers)
             if speeds:
                 cell.validate_speed_request(request, interpolation)
         if request.free_torsion:
@@ -192,6 +195,8 @@ def check_path_response_fields(
                 max_dpsi=max_dpsi,
                 interpolation=interpolation,
                 tolerance=tolerance,
+                arcs=arcs,
+                beziers=beziers,
             )
         else:
             result = check_path(
@@ -200,6 +205,8 @@ def check_path_response_fields(
                 quaternions=quaternions,
                 interpolation=interpolation,
                 tolerance=tolerance,
+                arcs=arcs,
+                beziers=beziers,
             )
         if state is not None and state.settings.report_singularity:
             result = report_singularity(manipulator, result)
@@ -210,7 +217,7 @@ def check_path_response_fields(
         )
         if speeds:
             assert state is not None
-            speed_fields = cell.path_speeds(state, request, result)
+            speed_fields = cell.path_speeds(state, request, result, (arcs, beziers))
             fields["message"] += speed_fields.pop("message_suffix", "")
             fields.update(speed_fields)
     except HexapodWorkspaceError as error:
@@ -218,6 +225,22 @@ def check_path_response_fields(
     if state is not None:
         fields["frames"] = cell.cell_frames_fields(state.cell, request.header.frame_id)
     return fields
+
+
+def _curve_rows(values: Any, count: int, width: int, name: str) -> NDArray[np.float64] | None:
+    """A request's flattened per-move curve rows as (count − 1, width), or None when empty
+    (every move straight); the core validates the rows (naming the move)."""
+    array = np.asarray(list(values), dtype=np.float64)
+    if array.size == 0:
+        return None
+    moves = max(count - 1, 0)
+    if array.size != moves * width:
+        msg = (
+            f"{name}: expected none or {width} values per move ({moves} moves: "
+            f"{moves * width}), got {array.size}"
+        )
+        raise InputError(msg)
+    return array.reshape(moves, width)
 
 
 def _option(value: float, name: str, default: float) -> float:

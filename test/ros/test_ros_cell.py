@@ -456,6 +456,69 @@ def test_check_path_reports_actuator_speeds_and_feed_max(client, platform):
     assert response.success and len(response.speeds) == 0
 
 
+# ------------------------------------------------------------------ curved moves
+def test_check_path_takes_arcs_and_bezier_moves_in_the_work_frame(client, platform):
+    """A CIRCLE move and a Bézier move given in the work frame are checked along their curves:
+    the node's answer is the core's on the base-frame curves, mapped here with a plain 4x4
+    transform (points as points, the arc's axis as a vector)."""
+    rotation = tt(0.0, 0.0, 0.0)
+    ends = [[0.03, 0.0, -0.25], [-0.03, 0.0, -0.25], [0.03, 0.01, -0.26]]
+    path = [homogeneous(rotation, end) for end in ends]
+    arc = [0.0, 0.0, -0.25, 0.0, 0.0, 1.0, math.pi]  # half a turn about the part's z
+    inner = [0.0, 0.04, -0.25, 0.02, 0.05, -0.26]  # the Bézier move's b1, b2
+    nan7, nan6 = [math.nan] * 7, [math.nan] * 6
+    feeds = [600.0, 900.0]
+    request = CheckPath.Request(
+        poses=[ros_pose(t) for t in path],
+        arcs=[*arc, *nan7],
+        beziers=[*nan6, *inner],
+        feeds_mm_min=feeds,
+    )
+    request.header.frame_id = "part"
+    response = client.call(CheckPath, f"{NODE}/check_path", request)
+    assert response.success, response.message
+    t_ow = homogeneous(tt(*WORK_ANGLES), WORK_ORIGIN)
+
+    def point(p):
+        return (t_ow @ np.r_[p, 1.0])[:3]
+
+    base = [base_of(t) for t in path]
+    arcs = np.array([[*point(arc[:3]), *(t_ow[:3, :3] @ arc[3:6]), arc[6]], nan7])
+    beziers = np.array([nan6, [*point(inner[:3]), *point(inner[3:])]])
+    model = tool_model(platform, cell_tool())
+    positions = np.array([t[:3, 3] for t in base])
+    rotations = np.array([t[:3, :3] for t in base])
+    truth = check_path(model, positions, rotations=rotations, arcs=arcs, beziers=beziers)
+    straight = check_path(model, positions, rotations=rotations)
+    assert [s.ok for s in response.segments] == truth.segments.ok.tolist()
+    for segment, bound in zip(
+        response.segments, truth.segments.min_relative_margin_bound, strict=True
+    ):
+        assert segment.min_relative_margin_bound == pytest.approx(bound, rel=1e-9)
+    # the curves are not the chords: their certified margins differ
+    assert not np.allclose(
+        truth.segments.min_relative_margin_bound, straight.segments.min_relative_margin_bound
+    )
+    rates = actuator_rates(
+        model, positions, rotations, speed_limits=[SPEED_MAX] * 6, arcs=arcs, beziers=beziers
+    )
+    used = np.array(feeds) * 1e-3 / 60.0
+    speeds = feed_limits(rates, used, np.full(2, math.nan), [SPEED_MAX] * 6)
+    for k, speed in enumerate(response.speeds):
+        assert speed.actuator_speed_peak == pytest.approx(speeds.speed_peak[k], rel=1e-12)
+        assert speed.duration_s == pytest.approx(speeds.duration[k], rel=1e-12)
+    assert response.speeds[0].duration_s == pytest.approx(
+        math.pi * 0.03 / (600.0 * 1e-3 / 60.0), rel=1e-12
+    )
+    # rows of the wrong length are refused with the field
+    for bad, word in (
+        (CheckPath.Request(poses=request.poses, arcs=arc), "arcs: expected none or 7 values"),
+        (CheckPath.Request(poses=request.poses, beziers=inner), "beziers: expected none or 6"),
+    ):
+        answer = client.call(CheckPath, f"{NODE}/check_path", bad)
+        assert not answer.success and word in answer.message, answer.message
+
+
 # ------------------------------------------------------------------ ~/axis_limits
 def test_axis_limits_follow_the_current_pose(ros_client, client, platform):
     limits = ros_client.collect(AxisLimits, f"{NODE}/axis_limits", transient_local=True)
