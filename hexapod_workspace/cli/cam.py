@@ -259,8 +259,8 @@ def _read_parts(
                     program.rapid[start:stop],
                     program.lines[start:stop],
                     start,
-                    arcs=_part_arcs(arcs[start + 1 : stop]),
-                    beziers=_part_arcs(beziers[start + 1 : stop]),
+                    arcs=_part_curves(arcs[start + 1 : stop]),
+                    beziers=_part_curves(beziers[start + 1 : stop]),
                 )
             )
         for k, (start, stop) in enumerate(program.parts):
@@ -304,9 +304,9 @@ def _read_parts(
     return [part], None
 
 
-def _part_arcs(arcs: NDArray[np.float64]) -> NDArray[np.float64] | None:
-    """A part's arcs (or Bézier moves), or None when none of its moves is one."""
-    return arcs if bool(np.isfinite(arcs[:, 0]).any()) else None
+def _part_curves(rows: NDArray[np.float64]) -> NDArray[np.float64] | None:
+    """A part's curve rows (arcs or Bézier moves), or None when none of its moves is one."""
+    return rows if bool(np.isfinite(rows[:, 0]).any()) else None
 
 
 def _to_frame(document: dict[str, Any], work: WorkFrame) -> None:

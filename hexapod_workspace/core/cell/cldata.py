@@ -312,9 +312,7 @@ def _unit_axis(values: NDArray[np.float64], line: int, shown: str) -> NDArray[np
 
 
 def parse_cldata(
-    text: str,
-    tools: Collection[int] | None = None,
-    units: str | None = None,
+    text: str, tools: Collection[int] | None = None, units: str | None = None
 ) -> CLProgram:
     """Read the text of a CL file (see the module documentation).
 
@@ -771,9 +769,7 @@ def looks_like_cldata(text: str) -> bool:
 
 
 def read_cldata(
-    path: str | Path,
-    tools: Collection[int] | None = None,
-    units: str | None = None,
+    path: str | Path, tools: Collection[int] | None = None, units: str | None = None
 ) -> CLProgram:
     """Read a CL file from disk (see :func:`parse_cldata`).
 

@@ -192,9 +192,17 @@ def check_path(
         interpolation=interpolation,
         tolerance=tolerance,
         elapsed=time.perf_counter() - started,
-        arcs=None if arcs is None else np.array(arcs, dtype=np.float64),
-        beziers=None if beziers is None else np.array(beziers, dtype=np.float64),
+        arcs=_some_rows(arcs),
+        beziers=_some_rows(beziers),
     )
+
+
+def _some_rows(rows: ArrayLike | None) -> NDArray[np.float64] | None:
+    """Validated curve rows as given, or None when none is a curve (all NaN, or not given)."""
+    if rows is None:
+        return None
+    array = np.array(rows, dtype=np.float64)
+    return array if bool(np.isfinite(array[:, 0]).any()) else None
 
 
 def _segment_checks(certifier: _Certifier, moves: _Moves, raw: _MoveCheck) -> SegmentChecks:
