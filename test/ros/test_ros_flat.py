@@ -160,25 +160,36 @@ def test_flat_calls_are_recorded_and_read_back(ros_client, tmp_path, model):
     service = f"{name}/check_poses_flat"
     with running_node(tmp_path, extra_args=args) as node:
         answer = ros_client.call(CheckPosesFlat, service, flat_request(angles))
+        # a refused request without poses is recorded too, and reads back (its empty float64[]
+        # comes first in the message: see CheckPosesFlatRequest.msg)
+        empty = ros_client.call(CheckPosesFlat, service, CheckPosesFlat.Request())
         ros_client.drop_client(service)
         assert node.stop() == 0, node.output()
     assert answer.success, answer.message
+    assert not empty.success and "at least one pose" in empty.message
     # the node (a child of this process, which set NUMBA_CACHE_DIR for the source tree) loads
     # the kernels the install space was built with, from the install space's cache
     assert f"(compiled-code cache: {INSTALL}/" in node.output(), node.output()
     (log,) = (tmp_path / "logs").glob("*.mcap")
     request_topic, response_topic = logs.service_topics(service)
-    decoded = {topic: (msgtype, m) for topic, msgtype, m in read_with_rosbags_documented(log)}
+    everything = read_with_rosbags_documented(log)
+    requests = [m for topic, _, m in everything if topic == request_topic]
+    assert [len(r.angles) for r in requests] == [angles.size, 0]
+    np.testing.assert_array_equal(requests[0].angles, angles.reshape(-1))
+    # the first answer (the dict keeps each topic's first message)
+    decoded: dict[str, tuple[str, object]] = {}
+    for topic, msgtype, m in everything:
+        decoded.setdefault(topic, (msgtype, m))
     assert decoded[request_topic][0] == "hexapod_workspace_msgs/msg/CheckPosesFlatRequest"
-    np.testing.assert_array_equal(decoded[request_topic][1].angles, angles.reshape(-1))
     msgtype, response = decoded[response_topic]
     assert msgtype == "hexapod_workspace_msgs/msg/CheckPosesFlatResponse"
     assert list(response.constraint_names) == list(CONSTRAINT_NAMES)
     np.testing.assert_array_equal(response.margins, np.asarray(answer.margins))
     np.testing.assert_array_equal(response.reachable, np.asarray(answer.reachable))
     foxglove = read_with_foxglove(log, tmp_path)
-    assert foxglove[response_topic]["count"] == 1
+    assert foxglove[response_topic]["count"] == 2 and foxglove[request_topic]["count"] == 2
     summary, _ = summarize_log(log)
-    (call,) = [c for c in summary.checks if c.topic.startswith(service)]
+    call, refused = [c for c in summary.checks if c.topic.startswith(service)]
     np.testing.assert_array_equal(call.angles, angles)
+    assert len(refused.angles) == 0
     assert call.n_reachable == int(np.count_nonzero(check(model, angles, model.position).reachable))
