@@ -7,6 +7,10 @@ the certified path check of the same moves, measured in one run.
   packaged example's working volume, against :func:`hexapod_workspace.check_path` of the same
   moves (the reachability certificate a CL file gets anyway). Prints ms per 1000 moves for both,
   the ratio, and the samples the speed bound needed per move.
+* **curved moves**: the same moves as cubic Bézier curves (inner control points a third and two
+  thirds along each move, pushed 20 mm sideways: what a NURBS span of a CL file becomes), checked
+  and speed-bounded along the curve, against the straight moves: ms per 1000 moves and the
+  ratios.
 * **axis limits**: :func:`hexapod_workspace.axis_limits` (12 certified reaches) at a few poses,
   ms per call.
 
@@ -72,6 +76,26 @@ def main() -> None:
         f"  samples per move: {rates.evaluations / options.moves:.1f}; "
         f"certified / sampled peak per move: median {np.median(tightness):.4f}, "
         f"max {tightness.max():.4f}"
+    )
+    # the same moves as Bézier curves bulging 20 mm sideways (perpendicular to the move, in z)
+    delta = np.diff(positions, axis=0)
+    side = np.cross(delta, [0.0, 0.0, 1.0])
+    side *= 0.02 / np.maximum(np.linalg.norm(side, axis=1, keepdims=True), 1e-12)
+    inner = np.hstack([positions[:-1] + delta / 3 + side, positions[:-1] + 2 * delta / 3 + side])
+    curve_path_s = _best(
+        lambda: check_path(manipulator, positions, rotations=rotations, beziers=inner),
+        options.repeat,
+    )
+    curve_speed_s = _best(
+        lambda: actuator_rates(
+            manipulator, positions, rotations, speed_limits=limits, beziers=inner
+        ),
+        options.repeat,
+    )
+    print(
+        f"  Bézier moves: check_path {curve_path_s * per_thousand * 1e3:8.1f} ms per 1000 moves "
+        f"({curve_path_s / path_s:.2f}x the straight moves), actuator speed bound "
+        f"{curve_speed_s * per_thousand * 1e3:8.1f} ms ({curve_speed_s / speed_s:.2f}x)"
     )
     poses = [(np.eye(3), np.array([0.0, 0.0, -1.2])), (tt_to_matrix([0.5, 0.3, 0.1]), positions[5])]
     axis_s = min(
