@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 import pytest
+from path_support import assert_curve_found_leaving
 
 from hexapod_workspace import InputError, check_path, plan_torsion
 from hexapod_workspace.core.base.rotations import tt_to_matrix
@@ -77,14 +78,7 @@ def test_an_arc_is_checked_along_the_arc_not_its_chord(example, direction):
     arc = check_path(example, positions, angles=angles, arcs=circle)
     s = np.linspace(0.0, 1.0, 20001)
     points = arc_points(positions[0], positions[1], CENTRE, [0, 1, 0], circle[0, 6], s)
-    dense = pose_margins(example, np.repeat(np.eye(3)[None], s.size, axis=0), points).reachable
-    assert dense[0] and dense[-1]
-    assert chord.segments.ok[0]  # the straight move stays inside
-    assert not dense.all() and not arc.segments.ok[0]  # the arc leaves, and is found to
-    first = s[np.argmax(~dense)]
-    assert abs(arc.segments.first_violation_s[0] - first) < 1e-3
-    where = arc.segments.violation_positions[0]
-    assert not pose_margins(example, np.eye(3)[None], where).reachable[0]
+    where = assert_curve_found_leaving(example, chord, arc, s, points)
     np.testing.assert_allclose(np.linalg.norm((where - CENTRE)[[0, 2]]), 0.35, atol=1e-12)
     assert arc.arcs is not None
 

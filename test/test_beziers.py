@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from path_support import assert_curve_found_leaving
 
 from hexapod_workspace import InputError, check_path, plan_torsion
 from hexapod_workspace.core.base.rotations import tt_to_matrix
@@ -69,15 +70,7 @@ def test_a_bezier_move_is_checked_along_the_curve_not_its_chord(example, directi
     chord = check_path(example, positions, angles=angles)
     curve = check_path(example, positions, angles=angles, beziers=inner)
     s = np.linspace(0.0, 1.0, 20001)
-    points = casteljau(control, s)
-    dense = pose_margins(example, np.repeat(np.eye(3)[None], s.size, axis=0), points).reachable
-    assert dense[0] and dense[-1]
-    assert chord.segments.ok[0]  # the straight move stays inside
-    assert not dense.all() and not curve.segments.ok[0]  # the curve leaves, and is found to
-    first = s[np.argmax(~dense)]
-    assert abs(curve.segments.first_violation_s[0] - first) < 1e-3
-    where = curve.segments.violation_positions[0]
-    assert not pose_margins(example, np.eye(3)[None], where).reachable[0]
+    where = assert_curve_found_leaving(example, chord, curve, s, casteljau(control, s))
     s_found = curve.segments.first_violation_s[0]
     np.testing.assert_allclose(where, casteljau(control, [s_found])[0], atol=1e-12)
     assert curve.beziers is not None
