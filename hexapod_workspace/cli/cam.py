@@ -63,6 +63,7 @@ from ..core.cell.frames import (
     Tool,
     WorkFrame,
     cell_from_params_file,
+    curves_to_base,
     tool_model,
     vectors_to_base,
     work_to_base,
@@ -237,12 +238,9 @@ def _read_parts(
         positions = work.origin + program.positions @ work.rotation.T
         axes = vectors_to_base(program.axes, work)
         feeds = np.where(np.isnan(program.feeds), feed, program.feeds)
-        # arcs (CIRCLE) in the base frame: the centre moves as a point, the axis as a vector
-        arcs = program.arcs.copy()
-        arcs[:, :3] = work.origin + program.arcs[:, :3] @ work.rotation.T
-        arcs[:, 3:6] = program.arcs[:, 3:6] @ work.rotation.T
-        # Bézier moves (NURBS spans): the inner control points move as points
-        beziers = (work.origin + program.beziers.reshape(-1, 3) @ work.rotation.T).reshape(-1, 6)
+        # the curved moves (CIRCLE, NURBS spans) in the base frame
+        arcs, beziers = curves_to_base(program.arcs, program.beziers, work)
+        assert arcs is not None and beziers is not None
         parts = []
         for start, stop in program.parts:
             number = int(program.tools[start])

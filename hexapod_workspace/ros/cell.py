@@ -60,6 +60,7 @@ from hexapod_workspace.core.base.rotations import (
     quaternion_to_matrix,
     tt_to_matrix,
 )
+from hexapod_workspace.core.cell.frames import curves_to_base as work_curves_to_base
 from hexapod_workspace.core.cell.frames import work_to_base
 from hexapod_workspace.core.cell.reach import axis_limits
 from hexapod_workspace.core.motions import PathCheck, TorsionPlan, reported_parts
@@ -155,20 +156,12 @@ def curves_to_base(
     arcs: NDArray[np.float64] | None,
     beziers: NDArray[np.float64] | None,
 ) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None]:
-    """A request's curved moves, ``arcs`` (K, 7: centre, axis, angle) and ``beziers`` (K, 6:
-    two control points), given in ``frame_id``, in the base frame: points move as points, the
-    arcs' axes turn as vectors, angles stay; NaN rows stay NaN."""
+    """A request's curved moves, ``arcs`` (K, 7) and ``beziers`` (K, 6), given in ``frame_id``,
+    in the base frame (:func:`~hexapod_workspace.core.cell.frames.curves_to_base`)."""
     if not in_work_frame(state, frame_id):
         return arcs, beziers
     assert state.cell is not None
-    work = state.cell.work
-    if arcs is not None:
-        arcs = arcs.copy()
-        arcs[:, :3] = work.origin + arcs[:, :3] @ work.rotation.T
-        arcs[:, 3:6] = arcs[:, 3:6] @ work.rotation.T
-    if beziers is not None:
-        beziers = (work.origin + beziers.reshape(-1, 3) @ work.rotation.T).reshape(-1, 6)
-    return arcs, beziers
+    return work_curves_to_base(arcs, beziers, state.cell.work)
 
 
 _frames_cache: dict[tuple[int, str], tuple[State, Any]] = {}
@@ -252,15 +245,9 @@ def validate_speed_request(request: Any, interpolation: str) -> None:
         raise InputError(msg)
 
 
-def path_speeds(
-    state: State,
-    request: Any,
-    result: PathCheck | TorsionPlan,
-    curves: tuple[NDArray[np.float64] | None, NDArray[np.float64] | None] = (None, None),
-) -> dict[str, Any]:
+def path_speeds(state: State, request: Any, result: PathCheck | TorsionPlan) -> dict[str, Any]:
     """``speeds`` and ``actuator_speed_max`` of a ``CheckPath`` response (request validated by
-    :func:`validate_speed_request`); ``curves``: the moves' arcs and Bézier curves in the base
-    frame, as checked.
+    :func:`validate_speed_request`), along the moves as checked (their arcs and Bézier curves).
 
     A move's feed: ``rapid_feed_mm_min`` when ``rapid[k]``, else ``feeds_mm_min[k]``; a move
     without translation runs at ``rotary_feed_deg_min``. With ``durations_s`` each move's feed is
@@ -273,14 +260,13 @@ def path_speeds(
     waypoints = checked.waypoints
     count = len(waypoints) - 1
     rotations = tt_to_matrix(waypoints.angles)
-    arcs, beziers = curves
     rates = actuator_rates(
         state.manipulator,
         waypoints.positions,
         rotations,
         speed_limits=limits,
-        arcs=arcs,
-        beziers=beziers,
+        arcs=checked.arcs,
+        beziers=checked.beziers,
     )
     rapid: NDArray[Any] = np.zeros(count, dtype=bool)
     if len(request.rapid):

@@ -217,7 +217,7 @@ def check_path_response_fields(
         )
         if speeds:
             assert state is not None
-            speed_fields = cell.path_speeds(state, request, result, (arcs, beziers))
+            speed_fields = cell.path_speeds(state, request, result)
             fields["message"] += speed_fields.pop("message_suffix", "")
             fields.update(speed_fields)
     except HexapodWorkspaceError as error:

@@ -661,8 +661,7 @@ def _end_spline(state: _Reader) -> None:
     state.spline = None
     knots = spline_knots(spline)
     # a B-spline of affinely mapped control points is the mapped curve
-    controls = np.vstack([spline.start, *spline.controls])
-    work = state.origin + controls @ state.rotation.T
+    work = np.array([state.to_work(point) for point in [spline.start, *spline.controls]])
     spans = bezier_spans(knots, work)
     for span in spans:
         state.add(span[3], state.axis_work(), spline.line, spline.shown)

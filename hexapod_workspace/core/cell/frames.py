@@ -70,6 +70,7 @@ __all__ = [
     "cell_from_mapping",
     "cell_from_params_file",
     "cell_unit_reason",
+    "curves_to_base",
     "platform_pose",
     "require_plausible_cell",
     "tool_model",
@@ -420,6 +421,21 @@ def vectors_to_base(vectors: ArrayLike, work: WorkFrame) -> NDArray[np.float64]:
     array = np.asarray(vectors, dtype=np.float64)
     rotated: NDArray[np.float64] = array @ work.rotation.T
     return rotated
+
+
+def curves_to_base(
+    arcs: NDArray[np.float64] | None, beziers: NDArray[np.float64] | None, work: WorkFrame
+) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None]:
+    """Curved moves from W to the base frame, one row per move: ``arcs`` (K, 7: the centre moves
+    as a point, the axis turns as a vector, the angle stays) and ``beziers`` (K, 6: two inner
+    control points, as points). None stays None, NaN rows stay NaN."""
+    if arcs is not None:
+        arcs = arcs.copy()
+        arcs[:, :3] = work.origin + arcs[:, :3] @ work.rotation.T
+        arcs[:, 3:6] = vectors_to_base(arcs[:, 3:6], work)
+    if beziers is not None:
+        beziers = (work.origin + beziers.reshape(-1, 3) @ work.rotation.T).reshape(-1, 6)
+    return arcs, beziers
 
 
 def cell_unit_reason(manipulator: Manipulator, cell: CellFrames) -> str | None:

@@ -236,15 +236,7 @@ class _Beziers(_CurveKind):
         inner: NDArray[np.float64],
     ) -> None:
         self.mask = np.isfinite(inner[:, 0])
-        # other moves get the straight line's control points: harmless, never used
-        straight = np.concatenate(
-            [
-                positions0 + (positions1 - positions0) / 3.0,
-                positions0 + 2.0 * (positions1 - positions0) / 3.0,
-            ],
-            axis=1,
-        )
-        rows = np.where(self.mask[:, None], inner, straight)
+        rows = np.where(self.mask[:, None], inner, 0.0)  # other moves: never used
         self.control = np.stack([positions0, rows[:, :3], rows[:, 3:], positions1], axis=1)
         d = np.diff(self.control, axis=1)  # (K, 3, 3)
         e = np.diff(d, axis=1)  # (K, 2, 3)
