@@ -37,3 +37,30 @@ def assert_curve_found_leaving(manipulator, chord, curved, s, points) -> np.ndar
     where = curved.segments.violation_positions[0]
     assert not pose_margins(manipulator, np.eye(3)[None], where).reachable[0]
     return where
+
+
+def assert_rates_bound_the_finite_differences(manipulator, rates, rotation, s, points) -> None:
+    """The certified peak leg rates of one move (``rates``: MoveRates of a 6-UPS model) against
+    finite differences of plain-numpy leg lengths |p + R·b − a| along ``points`` (n, 3) sampled
+    at ``s``, orientation ``rotation`` (3, 3): never below them, within 2 % of the largest."""
+    joints = (rotation @ manipulator.platform_joints.T).T
+    lengths = np.linalg.norm(points[:, None, :] + joints - manipulator.base_joints, axis=2)
+    dense_peak = (np.abs(np.diff(lengths, axis=0)) / s[1]).max(axis=0)
+    assert np.all(rates.peak_bound[0] >= dense_peak * (1 - 1e-6))
+    # tight to 1 % of the largest actuator's (the refinement's target, module speeds)
+    assert np.max(rates.peak_bound[0]) <= np.max(dense_peak) * 1.02
+
+
+def assert_curve_bounds(kind, points, s) -> float:
+    """One curved move of ``kind`` (``_Arcs`` or ``_Beziers``, move 0) sampled at ``s``, its
+    positions ``points`` (n, 3) already checked against the definition: the velocity agrees
+    with central differences of them, and |p'|, |p''| stay within the kind's bounds; the length
+    bound is at most the polyline's. Returns that polyline's length (m)."""
+    velocity = kind.velocities(np.zeros(len(s), dtype=np.int64), s)
+    np.testing.assert_allclose(velocity[1:-1], (points[2:] - points[:-2]) / (2 * s[1]), atol=1e-6)
+    assert np.linalg.norm(velocity, axis=1).max() <= kind.speed[0] + 1e-15
+    length = float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1)))
+    assert kind.length[0] <= length + 1e-12
+    accel = np.linalg.norm(np.diff(velocity, axis=0), axis=1) / s[1]
+    assert accel.max() <= kind.accel[0] * (1 + 1e-6)
+    return length

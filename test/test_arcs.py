@@ -11,7 +11,11 @@ import math
 
 import numpy as np
 import pytest
-from path_support import assert_curve_found_leaving
+from path_support import (
+    assert_curve_bounds,
+    assert_curve_found_leaving,
+    assert_rates_bound_the_finite_differences,
+)
 
 from hexapod_workspace import InputError, check_path, plan_torsion
 from hexapod_workspace.core.base.rotations import tt_to_matrix
@@ -51,14 +55,7 @@ def test_the_arc_motion_and_its_bounds():
         points, arc_points(p0, p1, CENTRE, [0, 0, 1], -math.pi / 2, s), rtol=0, atol=1e-14
     )
     np.testing.assert_allclose(points[[0, -1]], [p0, p1], atol=1e-15)
-    velocity = arcs.velocities(moves, s)
-    np.testing.assert_allclose(velocity[1:-1], (points[2:] - points[:-2]) / (2 * s[1]), atol=1e-6)
-    speed = np.linalg.norm(velocity, axis=1)
-    assert speed.max() <= arcs.speed[0] + 1e-15
-    length = float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1)))
-    assert arcs.length[0] <= length + 1e-12
-    accel = np.linalg.norm(np.diff(velocity, axis=0), axis=1) / s[1]
-    assert accel.max() <= arcs.accel[0] * (1 + 1e-6)
+    assert_curve_bounds(arcs, points, s)
 
 
 def _vertical_arc(direction: float):
@@ -125,13 +122,7 @@ def test_actuator_rates_along_an_arc_bound_the_finite_differences(example):
     chord = actuator_rates(example, np.array([p0, p1]), rotations)
     s = np.linspace(0.0, 1.0, 200001)
     points = arc_points(p0, p1, CENTRE, [0, 0, 1], math.pi, s)
-    legs = points[:, None, :] + (rotations[0] @ example.platform_joints.T).T - example.base_joints
-    lengths = np.linalg.norm(legs, axis=2)
-    rates = np.abs(np.diff(lengths, axis=0)) / s[1]
-    dense_peak = rates.max(axis=0)
-    assert np.all(arc.peak_bound[0] >= dense_peak * (1 - 1e-6))
-    # tight to 1 % of the largest actuator's (the refinement's target, module speeds)
-    assert np.max(arc.peak_bound[0]) <= np.max(dense_peak) * 1.02
+    assert_rates_bound_the_finite_differences(example, arc, rotations[0], s, points)
     assert arc.translation[0] == pytest.approx(0.15 * math.pi)  # the half circle's length
     assert chord.translation[0] == pytest.approx(0.3)
     assert np.max(arc.peak_bound) > 1.2 * np.max(chord.peak_bound)

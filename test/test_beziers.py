@@ -10,7 +10,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from path_support import assert_curve_found_leaving
+from path_support import (
+    assert_curve_bounds,
+    assert_curve_found_leaving,
+    assert_rates_bound_the_finite_differences,
+)
 
 from hexapod_workspace import InputError, check_path, plan_torsion
 from hexapod_workspace.core.base.rotations import tt_to_matrix
@@ -43,15 +47,8 @@ def test_the_bezier_motion_and_its_bounds():
     points = curves.positions(moves, s)
     np.testing.assert_allclose(points, casteljau(control, s), rtol=0, atol=1e-14)
     np.testing.assert_allclose(points[[0, -1]], control[[0, 3]], atol=1e-15)
-    velocity = curves.velocities(moves, s)
-    np.testing.assert_allclose(velocity[1:-1], (points[2:] - points[:-2]) / (2 * s[1]), atol=1e-6)
-    speed = np.linalg.norm(velocity, axis=1)
-    assert speed.max() <= curves.speed[0] + 1e-15
-    length = float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1)))
-    assert curves.length[0] <= length + 1e-12
+    length = assert_curve_bounds(curves, points, s)
     assert curves.length[0] >= 0.99 * length  # the 33-point polyline is close
-    accel = np.linalg.norm(np.diff(velocity, axis=0), axis=1) / s[1]
-    assert accel.max() <= curves.accel[0] * (1 + 1e-6)
 
 
 def _bulge(direction: float) -> np.ndarray:
@@ -105,13 +102,7 @@ def test_actuator_rates_along_a_bezier_move_bound_the_finite_differences(example
     chord = actuator_rates(example, positions, rotations)
     s = np.linspace(0.0, 1.0, 200001)
     points = casteljau(control, s)
-    legs = points[:, None, :] + (rotations[0] @ example.platform_joints.T).T - example.base_joints
-    lengths = np.linalg.norm(legs, axis=2)
-    rates = np.abs(np.diff(lengths, axis=0)) / s[1]
-    dense_peak = rates.max(axis=0)
-    assert np.all(curve.peak_bound[0] >= dense_peak * (1 - 1e-6))
-    # tight to 1 % of the largest actuator's (the refinement's target, module speeds)
-    assert np.max(curve.peak_bound[0]) <= np.max(dense_peak) * 1.02
+    assert_rates_bound_the_finite_differences(example, curve, rotations[0], s, points)
     length = float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1)))
     assert length * 0.99 <= curve.translation[0] <= length  # a lower bound of the length
     assert chord.translation[0] == pytest.approx(0.3)
