@@ -699,7 +699,9 @@ CHECK_PATH_DESCRIPTION = (
     "bounds, so no violation wider than the tolerance is missed. Positions come from FILE. "
     "FILE may also be an APT cutter-location file (CLDATA: .cl, .cls, .apt, .ncl, or a file "
     "with GOTO/ lines): GOTO, FEDRAT, RAPID, UNITS, MULTAX, LOADTL (tool table tools.T<n>), "
-    "in the work frame (work.*); with feeds, every move gets its certified peak actuator "
+    "MSYS, CIRCLE arcs and NX's NURBS splines (checked along the curve) and the other "
+    "statements of docs/cell.md, each modelled or refused with its line, in the work frame "
+    "(work.*); with feeds, every move gets its certified peak actuator "
     "speed against limits.actuator_speed_max and the largest feed within it."
 )
 
