@@ -53,26 +53,15 @@ def rodrigues(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
     )
 
 
-def dense_lengths(model: Manipulator, p0, p1, r0, r1) -> np.ndarray:
-    """Leg lengths (DENSE, 6) along the slerp move, from the formulas."""
-    s = np.linspace(0.0, 1.0, DENSE)
-    axis, angle = log_axis_angle(r1 @ r0.T)
-    rotations = rodrigues(axis, s * angle) @ r0
-    positions = p0 + s[:, None] * (p1 - p0)
-    points = positions[:, None, :] + np.einsum("nij,kj->nki", rotations, model.platform_joints)
-    return np.linalg.norm(points - model.base_joints[None], axis=2)
-
-
-def dense_coordinates(model: Manipulator, p0, p1, r0, r1) -> np.ndarray:
-    """Actuated coordinates (DENSE, 6) along the slerp move, from the formulas."""
-    if model.architecture == "ups":
-        return dense_lengths(model, p0, p1, r0, r1)
-    s = np.linspace(0.0, 1.0, DENSE)
+def coordinates_at(model: Manipulator, p0, p1, r0, r1, s: np.ndarray) -> np.ndarray:
+    """Actuated coordinates (len(s), 6) at ``s`` along the slerp move, from the formulas."""
     axis, angle = log_axis_angle(r1 @ r0.T)
     rotations = rodrigues(axis, s * angle) @ r0
     positions = p0 + s[:, None] * (p1 - p0)
     points = positions[:, None, :] + np.einsum("nij,kj->nki", rotations, model.platform_joints)
     d = points - model.base_joints[None]
+    if model.architecture == "ups":
+        return np.linalg.norm(d, axis=2)
     length, branch = model.leg_lengths, model.branch
     if model.architecture == "pus":
         u = model.rail_directions
@@ -88,6 +77,11 @@ def dense_coordinates(model: Manipulator, p0, p1, r0, r1) -> np.ndarray:
     ratio = c / np.hypot(a, b)
     assert np.all(np.abs(ratio) < 1.0)
     return np.unwrap(np.arctan2(b, a) + branch * np.arccos(ratio), axis=0)
+
+
+def dense_coordinates(model: Manipulator, p0, p1, r0, r1) -> np.ndarray:
+    """Actuated coordinates (DENSE, 6) along the slerp move, from the formulas."""
+    return coordinates_at(model, p0, p1, r0, r1, np.linspace(0.0, 1.0, DENSE))
 
 
 def dense_rate_peaks(model: Manipulator, positions, rotations) -> np.ndarray:

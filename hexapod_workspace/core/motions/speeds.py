@@ -88,6 +88,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -343,7 +344,7 @@ class MoveRates:
     evaluations: int
 
 
-class _SlerpMoves:
+class SlerpMoves:
     """Poses and joint velocities along slerp moves: R(s) = Rot(s·Ω·u)·R₀ (u in base frame)."""
 
     def __init__(
@@ -380,6 +381,10 @@ class _SlerpMoves:
             self.translation = np.where(arcs.mask, arcs.length, self.translation)
         self.speed = travel[:, None] + self.omega[:, None] * radius  # V_i (M, 6)
         self.accel = curvature[:, None] + self.omega[:, None] ** 2 * radius  # A_i (M, 6)
+        # J_i ≥ |d²v_i/ds²| = |w × (w × (w × Rb_i))| on a straight move; curves: NaN (unknown)
+        self.jerk = self.omega[:, None] ** 3 * radius
+        if arcs is not None:
+            self.jerk = np.where(arcs.mask[:, None], np.nan, self.jerk)
 
     def motion(self, moves: NDArray[np.int64], s: NDArray[np.float64]) -> LegMotion:
         """Leg quantities of moves ``moves`` (n,) at parameters ``s`` (n,)."""
@@ -407,6 +412,24 @@ class _SlerpMoves:
         velocities = linear[:, None, :] + np.cross(w[:, None, :], arms)
         return LegMotion(position[:, None, :] + arms, velocities)
 
+    def joint_accelerations(
+        self, moves: NDArray[np.int64], s: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """dv_i/ds = w × (w × R(s)·b_i) (n, 6, 3) on straight moves; NaN on curved ones."""
+        angle = s * self.omega[moves]
+        u = self.axis[moves]
+        w = self.omega[moves][:, None] * u
+        r0b = np.einsum("nij,kj->nki", self.r0[moves], self.joints)
+        # R(s)·b = Rodrigues about u of R₀·b
+        c, sn = np.cos(angle)[:, None, None], np.sin(angle)[:, None, None]
+        along = np.einsum("nj,nkj->nk", u, r0b)[:, :, None] * u[:, None, :]
+        arms = c * r0b + sn * np.cross(u[:, None, :], r0b) + (1.0 - c) * along
+        wn = np.broadcast_to(w[:, None, :], arms.shape)
+        accelerations: NDArray[np.float64] = np.cross(wn, np.cross(wn, arms))
+        if self.arcs is not None:
+            accelerations[self.arcs.mask[moves]] = np.nan
+        return accelerations
+
 
 def _weights(limits: NDArray[np.float64]) -> NDArray[np.float64]:
     """Per-actuator weights for the tightness test: 1/vmax (unlimited: 1/largest limit)."""
@@ -414,6 +437,150 @@ def _weights(limits: NDArray[np.float64]) -> NDArray[np.float64]:
     if not np.any(limited):
         return np.ones(6)
     return np.where(limited, 1.0 / np.where(limited, limits, 1.0), 1.0 / float(limits.max()))
+
+
+@dataclass(frozen=True)
+class Intervals:
+    """The final intervals of a refinement: on each, certified bounds of |g_i| and |dg_i/ds|.
+
+    Attributes
+    ----------
+    move : ndarray, shape (m,), int
+        Move of each interval.
+    a, b : ndarray, shape (m,)
+        Its ends, in the move's s ∈ [0, 1].
+    g_a, g_b : ndarray, shape (m, 6)
+        |g_i| = |dq_i/ds| at the ends (actuator unit per unit s).
+    upper : ndarray, shape (m, 6)
+        Certified bound of |g_i| on [a, b]: ``(|g(a)| + |g(b)| + K·w)/2`` (module
+        documentation); +inf where no floor could be found.
+    rate : ndarray, shape (m, 6)
+        K_i, the certified bound of |dg_i/ds| on [a, b] (0 for a move that does not move, +inf
+        where no floor could be found).
+    floor : ndarray, shape (m, 6)
+        The floor K_i was computed with (ℓ_f or τ_f; not positive or NaN: none).
+    sampled : ndarray, shape (M, 6)
+        Largest |g_i| evaluated per move.
+    evaluations : int
+        Samples evaluated.
+    """
+
+    move: NDArray[np.int64]
+    a: NDArray[np.float64]
+    b: NDArray[np.float64]
+    g_a: NDArray[np.float64]
+    g_b: NDArray[np.float64]
+    upper: NDArray[np.float64]
+    rate: NDArray[np.float64]
+    floor: NDArray[np.float64]
+    sampled: NDArray[np.float64]
+    evaluations: int
+
+
+def interval_nodes(
+    move: NDArray[np.int64], a: NDArray[np.float64], b: NDArray[np.float64]
+) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.int64]]:
+    """Every node of intervals (move, a, b) (sorted, tiling each move) once: (move, s) of the
+    interval starts, then of each move's end; and the node at each interval's end (the next
+    interval's start, or its move's end node)."""
+    last = np.r_[move[1:] != move[:-1], True]
+    node_move = np.concatenate([move, move[last]])
+    node_s = np.concatenate([a, b[last]])
+    end_node = np.arange(1, move.size + 1)
+    end_node[last] = move.size + np.arange(int(last.sum()))
+    return node_move, node_s, end_node
+
+
+def certified_intervals(
+    manipulator: Manipulator,
+    model: ActuatorModel,
+    moves: SlerpMoves,
+    count: int,
+    weights: NDArray[np.float64],
+    relative: float,
+    max_intervals: int,
+    *,
+    local: bool,
+    start: tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.float64]] | None = None,
+) -> Intervals:
+    """Bisect the moves' intervals until their bounds of |g_i| are tight (module documentation).
+
+    ``local=False`` (peak speeds): an interval is loose when its bound exceeds the move's largest
+    sampled rate by more than ``relative`` (weighted by ``weights``, 1/vmax). ``local=True``
+    (schedules, :mod:`~hexapod_workspace.core.motions.schedule`): when it exceeds the larger of
+    its own two end values by more than ``relative`` of that value plus ``relative`` of the
+    move's weighted peak (an actuator much slower than the move's fastest one does not bind).
+    Past :data:`MAX_ROUNDS` rounds, or ``max_intervals`` intervals, the bounds stay certified,
+    only looser. ``start``: the first intervals (move, a, b), sorted by move then s and tiling
+    each move's [0, 1] (default :data:`INITIAL_INTERVALS` equal ones per move).
+    """
+    if start is None:
+        grid = np.linspace(0.0, 1.0, INITIAL_INTERVALS + 1)
+        index = np.repeat(np.arange(count), grid.size)
+        s = np.tile(grid, count)
+        g, at = model.evaluate(manipulator, moves.motion(index, s))
+        g = np.abs(g).reshape(count, grid.size, 6)
+        at = at.reshape(count, grid.size, 6)
+        evaluations = index.size
+        sampled = np.max(g, axis=1)
+        move = np.repeat(np.arange(count), INITIAL_INTERVALS)
+        a = np.tile(grid[:-1], count)
+        b = np.tile(grid[1:], count)
+        g_a: NDArray[np.float64] = g[:, :-1].reshape(-1, 6)
+        g_b: NDArray[np.float64] = g[:, 1:].reshape(-1, 6)
+        f_a: NDArray[np.float64] = at[:, :-1].reshape(-1, 6)
+        f_b: NDArray[np.float64] = at[:, 1:].reshape(-1, 6)
+    else:
+        move, a, b = start
+        node_move, node_s, end_node = interval_nodes(move, a, b)
+        g_n, f_n = model.evaluate(manipulator, moves.motion(node_move, node_s))
+        g_n = np.abs(g_n)
+        evaluations = node_s.size
+        sampled = np.zeros((count, 6))
+        np.maximum.at(sampled, node_move, g_n)
+        g_a, f_a = g_n[: move.size], f_n[: move.size]
+        g_b, f_b = g_n[end_node], f_n[end_node]
+    done: list[tuple[NDArray[Any], ...]] = []
+    for round_ in range(MAX_ROUNDS + 1):
+        width = (b - a)[:, None]
+        speed, accel = moves.speed[move], moves.accel[move]
+        floor = model.interval_floor(manipulator, f_a, f_b, speed, width)
+        positive = floor > 0.0
+        rate = model.rate_bound(manipulator, speed, accel, np.where(positive, floor, 1.0))
+        # a move that does not move has zero rates everywhere (V = A = 0)
+        rate = np.where(speed == 0.0, 0.0, np.where(positive, rate, np.inf))
+        upper = np.where(speed == 0.0, 0.0, 0.5 * (g_a + g_b + rate * width))
+        # a floor of 1e-9 of the joint speed keeps a move whose rates are all ~0 from
+        # splitting for ever
+        scale = np.max(sampled * weights, axis=1) + 1e-9 * np.max(moves.speed * weights, axis=1)
+        if local:
+            ends = np.maximum(g_a, g_b) * weights
+            slack = relative * (ends + scale[move][:, None])
+            loose = np.any(upper * weights > ends + slack, axis=1)
+        else:
+            target = (1.0 + relative) * scale
+            loose = np.any(upper * weights > target[move][:, None], axis=1)
+        if round_ == MAX_ROUNDS or not np.any(loose) or 2 * a.size > max_intervals:
+            done.append((move, a, b, g_a, g_b, upper, rate, floor))
+            break
+        keep = ~loose
+        done.append(tuple(x[keep] for x in (move, a, b, g_a, g_b, upper, rate, floor)))
+        mid = 0.5 * (a[loose] + b[loose])
+        split = move[loose]
+        g_m, f_m = model.evaluate(manipulator, moves.motion(split, mid))
+        g_m = np.abs(g_m)
+        evaluations += mid.size
+        np.maximum.at(sampled, split, g_m)
+        move = np.concatenate([split, split])
+        a = np.concatenate([a[loose], mid])
+        b = np.concatenate([mid, b[loose]])
+        g_a, g_b = np.concatenate([g_a[loose], g_m]), np.concatenate([g_m, g_b[loose]])
+        f_a = np.concatenate([f_a[loose], f_m])
+        f_b = np.concatenate([f_m, f_b[loose]])
+    parts = [np.concatenate(column) for column in zip(*done, strict=True)]
+    order = np.lexsort((parts[1], parts[0]))  # by move, then by s
+    m, a, b, g_a, g_b, upper, rate, floor = (x[order] for x in parts)
+    return Intervals(m, a, b, g_a, g_b, upper, rate, floor, sampled, evaluations)
 
 
 def actuator_rates(
@@ -483,7 +650,7 @@ def actuator_rates(
     model = ACTUATOR_MODELS[name]
     limits = np.zeros(6) if speed_limits is None else np.broadcast_to(speed_limits, (6,))
     weights = _weights(np.asarray(limits, dtype=np.float64))
-    moves = _SlerpMoves(
+    moves = SlerpMoves(
         manipulator, p[:-1], p[1:], r[:-1], r[1:], _validate_curves(arcs, beziers, p)
     )
     count = p.shape[0] - 1
@@ -492,55 +659,11 @@ def actuator_rates(
     if count == 0:
         return MoveRates(bound, sampled, moves.translation, moves.omega, 0)
 
-    # Samples on the initial grid, then intervals (move, a, b) with their end values.
-    grid = np.linspace(0.0, 1.0, INITIAL_INTERVALS + 1)
-    index = np.repeat(np.arange(count), grid.size)
-    s = np.tile(grid, count)
-    g, at = model.evaluate(manipulator, moves.motion(index, s))
-    g = np.abs(g).reshape(count, grid.size, 6)
-    at = at.reshape(count, grid.size, 6)
-    evaluations = index.size
-    np.maximum.reduce(g, axis=1, out=sampled)
-    move = np.repeat(np.arange(count), INITIAL_INTERVALS)
-    a = np.tile(grid[:-1], count)
-    b = np.tile(grid[1:], count)
-    g_a: NDArray[np.float64] = g[:, :-1].reshape(-1, 6)
-    g_b: NDArray[np.float64] = g[:, 1:].reshape(-1, 6)
-    f_a: NDArray[np.float64] = at[:, :-1].reshape(-1, 6)
-    f_b: NDArray[np.float64] = at[:, 1:].reshape(-1, 6)
-    for round_ in range(MAX_ROUNDS + 1):
-        width = (b - a)[:, None]
-        speed, accel = moves.speed[move], moves.accel[move]
-        floor = model.interval_floor(manipulator, f_a, f_b, speed, width)
-        positive = floor > 0.0
-        rate = model.rate_bound(manipulator, speed, accel, np.where(positive, floor, 1.0))
-        # a move that does not move has zero rates everywhere (V = A = 0)
-        rate = np.where(positive | (speed == 0.0), rate, np.inf)
-        upper = np.where(speed == 0.0, 0.0, 0.5 * (g_a + g_b + rate * width))
-        # loose: above the sampled peak by more than `relative` (a floor of 1e-9 of the joint
-        # speed keeps a move whose rates are all ~0 from splitting for ever)
-        target = (1.0 + relative) * np.max(sampled * weights, axis=1) + 1e-9 * np.max(
-            moves.speed * weights, axis=1
-        )
-        loose = np.any(upper * weights > target[move][:, None], axis=1)
-        if round_ == MAX_ROUNDS or not np.any(loose) or 2 * a.size > MAX_INTERVALS:
-            np.maximum.at(bound, move, upper)
-            break
-        keep = ~loose
-        np.maximum.at(bound, move[keep], upper[keep])
-        mid = 0.5 * (a[loose] + b[loose])
-        split = move[loose]
-        g_m, f_m = model.evaluate(manipulator, moves.motion(split, mid))
-        g_m = np.abs(g_m)
-        evaluations += mid.size
-        np.maximum.at(sampled, split, g_m)
-        move = np.concatenate([split, split])
-        a = np.concatenate([a[loose], mid])
-        b = np.concatenate([mid, b[loose]])
-        g_a, g_b = np.concatenate([g_a[loose], g_m]), np.concatenate([g_m, g_b[loose]])
-        f_a = np.concatenate([f_a[loose], f_m])
-        f_b = np.concatenate([f_m, f_b[loose]])
-    return MoveRates(bound, sampled, moves.translation, moves.omega, evaluations)
+    final = certified_intervals(
+        manipulator, model, moves, count, weights, relative, MAX_INTERVALS, local=False
+    )
+    np.maximum.at(bound, final.move, final.upper)
+    return MoveRates(bound, final.sampled, moves.translation, moves.omega, final.evaluations)
 
 
 @dataclass(frozen=True)

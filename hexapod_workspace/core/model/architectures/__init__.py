@@ -8,6 +8,8 @@ One interface per architecture (a module each, in numpy; the compiled margins of
   has no solution; q is NaN there);
 * ``base_ends(manipulator, q)``: the base-side end A_i(q_i) of every leg (the leg segment runs
   from there to B_i);
+* ``base_end_derivatives(manipulator, q)``: dA_i/dq and d²A_i/dq² (the schedule's second-order
+  bounds, :mod:`hexapod_workspace.core.motions.schedule`);
 * ``transmission(manipulator, directions, q)``: τ_i, the factor by which the actuator's motion
   reaches the leg line (``n_i·dB_i = τ_i·(speed of the base-side end)``), whose inverse bounds
   the actuator's rate;
@@ -63,6 +65,12 @@ class Architecture(Protocol):
 
     def base_ends(self, manipulator: Manipulator, q: NDArray[np.float64]) -> NDArray[np.float64]:
         """The base-side ends A_i(q_i)."""
+        ...
+
+    def base_end_derivatives(
+        self, manipulator: Manipulator, q: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """dA_i/dq and d²A_i/dq²."""
         ...
 
     def transmission(

@@ -30,6 +30,7 @@ __all__ = [
     "TURNING_BASE",
     "actuator_lever",
     "base_axes",
+    "base_end_derivatives",
     "base_ends",
     "inverse_kinematics",
     "transmission",
@@ -66,6 +67,14 @@ def inverse_kinematics(
 def base_ends(manipulator: Manipulator, q: NDArray[np.float64]) -> NDArray[np.float64]:
     """The slide joints A_i(q) = A0_i + q·u_i, (..., 6, 3), m."""
     return manipulator.base_joints + np.asarray(q)[..., None] * _rails(manipulator)
+
+
+def base_end_derivatives(
+    manipulator: Manipulator, q: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """dA_i/dq = u_i (unitless) and d²A_i/dq² = 0, each (..., 6, 3): the slide is straight."""
+    rails = np.broadcast_to(_rails(manipulator), (*np.shape(q), 3)).copy()
+    return rails, np.zeros_like(rails)
 
 
 def transmission(

@@ -36,6 +36,7 @@ __all__ = [
     "TURNING_BASE",
     "actuator_lever",
     "base_axes",
+    "base_end_derivatives",
     "base_ends",
     "inverse_kinematics",
     "rotate_about",
@@ -88,6 +89,19 @@ def base_ends(manipulator: Manipulator, q: NDArray[np.float64]) -> NDArray[np.fl
         np.cos(q)[..., None] * e + np.sin(q)[..., None] * f
     )
     return ends
+
+
+def base_end_derivatives(
+    manipulator: Manipulator, q: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """dC_i/dq = r_i·(cos q·f_i − sin q·e_i) and d²C_i/dq² = −(C_i − A0_i), each (..., 6, 3), m
+    per rad and per rad²; |d³C/dq³| = |dC/dq| = r_i."""
+    _, e, f, r = _crank(manipulator)
+    q = np.asarray(q)
+    c, s = np.cos(q)[..., None], np.sin(q)[..., None]
+    first: NDArray[np.float64] = r[:, None] * (c * f - s * e)
+    second: NDArray[np.float64] = -r[:, None] * (c * e + s * f)
+    return first, second
 
 
 def transmission(

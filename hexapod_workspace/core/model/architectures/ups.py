@@ -17,6 +17,7 @@ __all__ = [
     "TURNING_BASE",
     "actuator_lever",
     "base_axes",
+    "base_end_derivatives",
     "base_ends",
     "inverse_kinematics",
     "transmission",
@@ -40,6 +41,14 @@ def inverse_kinematics(
 def base_ends(manipulator: Manipulator, q: NDArray[np.float64]) -> NDArray[np.float64]:
     """The fixed base joints, broadcast to (..., 6, 3), m."""
     return np.broadcast_to(manipulator.base_joints, (*np.shape(q), 3)).copy()
+
+
+def base_end_derivatives(
+    manipulator: Manipulator, q: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """dA_i/dq and d²A_i/dq²: zero (the base joints do not move with the leg length)."""
+    zeros = np.zeros((*np.shape(q), 3))
+    return zeros, zeros.copy()
 
 
 def transmission(

@@ -1,0 +1,734 @@
+"""The fastest feed schedule along a path that is certified to run: actuator speeds and
+accelerations, the tool centre point's feed, rest at both ends.
+
+**The problem.** Along a path of M moves (the moves :func:`~hexapod_workspace.core.motions.checks.
+check_path` checks: position linear, or an arc, or a cubic Bézier curve, orientation by slerp),
+s = k + u on move k with u ∈ [0, 1] its own parameter, find the time law s(t) that minimises the
+total time subject to, for every actuator i and every s,
+
+    |q̇_i| ≤ v_i,     |q̈_i| ≤ a_i,     |ṗ| ≤ f_k (the move's feed ceiling),
+
+and ṡ = 0 at both ends (and where the path must stop). With g_i = dq_i/du (:mod:`.speeds`),
+``q̇_i = g_i·ṡ`` and ``q̈_i = g_i'·ṡ² + g_i·s̈``. In ``x = ṡ²`` (a function of s) the time is
+``∫ ds/√x`` and ``s̈ = x'/2``.
+
+**The grid and its certified coefficients.** Each move is cut into intervals by the bisection
+of :func:`~hexapod_workspace.core.motions.speeds.certified_intervals` (``local=True``: until the
+bound of every |g_i| over an interval is within ``relative`` of the larger of its end values).
+On an interval I = [a, b] of width w it gives two certified bounds, valid for every s in I:
+G_i ≥ |g_i(s)| and K_i ≥ |g_i'(s)| (derived in :mod:`.speeds`). The tool centre point's speed
+per unit s is bounded the same way: ``P = |Δp|`` on a straight move; on a curve
+``P = min(P₁, (|p'(a)| + |p'(b)| + P₂·w)/2)`` with P₁, P₂ the curve's bounds of |p'| and |p''|
+(:mod:`.interpolation`); a rotation without translation takes ``P = Ω`` against the rotary feed.
+
+**The schedule's form.** On every interval s̈ = u is constant, so x is linear in s:
+``x(s) = x_a + 2u·(s − a)``, and ``max_I x = max(x_a, x_b)``. Then, on the whole interval,
+
+    |q̇_i| ≤ G_i·√max(x_a, x_b),       |q̈_i| ≤ K_i·max(x_a, x_b) + G_i·|u|,
+    |ṗ| ≤ P·√max(x_a, x_b),
+
+so the schedule holds every limit everywhere (not only at grid points) when, at both ends,
+
+    x ≤ X_I := min_i((v_i/G_i)², a_i/K_i) and (f/P)²,    |u| ≤ U_I(x) := min_i (a_i − K_i x)/G_i.
+
+**Second order.** The bound K of :mod:`.speeds` is a move-wide worst case: it does not shrink
+with the interval, and ``K·x`` would slow every fast stretch down. On straight moves (where
+``v_i' = w × (w × R b_i)`` and ``|v_i''| ≤ J_i := Ω³·|b_i|``) each interval therefore takes
+``K_loc = min(K, (|g'(a)| + |g'(b)| + K2·w)/2)`` (the argument of the certified peak, one
+order up), with g' evaluated exactly at the nodes and K2 ≥ |g''| on the interval. Then G is
+re-derived from K_loc (``G = (|g(a)| + |g(b)| + K_loc·w)/2``, valid for any bound of |g'|).
+
+* 6-UPS: ``g' = (|v|² − g²)/ℓ + n·v'``; differentiating, with ``ℓ' = g``, ``|n'| ≤ V/ℓ``,
+  ``|g| ≤ V`` and ``|g'| ≤ K``: ``|g''| ≤ (3VA + 2VK)/ℓ_f + V³/ℓ_f² + J =: K2``.
+* 6-PUS and 6-RUS (ρ, τ_f, L, N as in :mod:`.speeds`; A' = dA/dq, A'' and A''' of norm r for
+  a crank, 0 for a slide; ``h = ρτ = n·A'``): ``h·g' = E := L|n'|² + n·v' − g²·n·A''`` with
+  ``n' = (v − A'g)/L``. Differentiating, ``n'' = (v' − A''g² − A'g')/L``,
+  ``h' = n'·A' + g·n·A''`` and ``E' = 2L·n'·n'' + n'·v' + n·v'' − 2gg'·n·A'' −
+  g²(n'·A'' + g·n·A''')``, so ``g'' = (E' − h'g')/h`` and, with ``|g| ≤ Ĝ := V/(ρτ_f)``,
+  ``|n'| ≤ N``, ``|n''| ≤ (A + rĜ² + ρK)/L``, ``|h'| ≤ ρN + rĜ``:
+  ``|g''| ≤ (2LN|n''| + NA + J + 2ĜKr + Ĝ²(Nr + rĜ) + |h'|K)/(ρτ_f) =: K2``.
+
+Curved moves (arcs, Bézier spans) keep K (their third derivative is not bounded here).
+
+**The passes.** U_I decreases in x, which makes the classic two-pass construction both optimal
+on this grid and feasible. Forward from rest, each node takes the largest x the interval allows
+from the one before: accelerating (x_b > x_a, so max x = x_b), ``x_b ≤ x_a + 2w·(a_i − K_i x_b)
+/G_i``, i.e. ``x_b ≤ (G_i x_a + 2w a_i)/(G_i + 2w K_i)`` for every i, and ``x_b ≤ X``. Backward
+from rest the same with a and b swapped. The schedule is ``x = min(forward, backward)``. On
+every interval it is feasible: where both ends come from one pass, that pass's step holds (a
+capped, decelerating forward step is a backward step, since the backward pass is capped by the
+same X); where the forward pass gives x_a and the backward one x_b, ``x_b − x_a`` lies between
+the backward step's and the forward step's, each within U at larger x, hence within U at the
+schedule's x (U decreasing); the other mixed case is symmetric. Each node's x is the largest any
+schedule of this form can have (by induction along each pass), so the time is the least on the
+grid; as the grid is refined the bounds G, K close on g, g' and the time approaches the true
+optimum from above (``test/test_schedule.py`` compares it with toppra's).
+
+**Waypoints.** Across a waypoint q̇ = g·ṡ stays continuous when the rates of the two moves are
+parallel, ``g_left = c·g_right`` with c > 0 (the moves may be of different lengths): the
+schedule then runs through with ``x_right = c²·x_left`` (ṡ jumps, q̇ does not; the bounds of q̈
+hold on each side). Where the 6-vectors are not parallel (within ``corner``, an angle) q̇ would
+jump, which no finite acceleration allows: the schedule stops there (x = 0 on both sides). It
+also stops where the caller asks (``stops``: tool changes, ``RAPID`` boundaries). A move that
+does not move (repeated waypoint) takes no time and is passed over for the continuity test.
+
+**Time and witnesses.** An interval with x linear lasts ``2w/(√x_a + √x_b)``. Every node records
+what fixed its x (rest, the feed, an actuator's speed or acceleration), and every move reports its
+certified peak feed and actuator speeds and accelerations (the bounds above at the schedule's
+x and u). A move where some actuator has no inverse-kinematics solution, or a transmission of 0,
+on the move is refused with the move named, as is a move no limit bounds.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ...errors import InputError
+from ..model import architectures
+from ..model.manipulator import Manipulator
+from .interpolation import _validate_curves
+from .speeds import (
+    ACTUATOR_MODELS,
+    Intervals,
+    SlerpMoves,
+    _weights,
+    certified_intervals,
+    interval_nodes,
+)
+
+__all__ = [
+    "DEFAULT_CORNER",
+    "DEFAULT_SCHEDULE_RELATIVE",
+    "LIMIT_KINDS",
+    "PathSchedule",
+    "schedule_path",
+]
+
+#: Tightness of each interval's bound of |g_i| against its end values (module documentation).
+DEFAULT_SCHEDULE_RELATIVE = 0.002
+#: Largest angle between the actuator-rate 6-vectors of two moves that still runs through their
+#: waypoint, rad (below it the jump of q̇ is at most this share of |q̇|).
+DEFAULT_CORNER = 1e-6
+#: Largest number of intervals (memory and time bound; past it the bounds are only looser).
+MAX_SCHEDULE_INTERVALS = 400_000
+#: Rounds of refinement where the schedule ramps.
+REFINE_ROUNDS = 16
+#: What fixes a node's speed: ``rest`` (a stop), ``feed``, ``velocity`` or ``acceleration``.
+LIMIT_KINDS = ("rest", "feed", "velocity", "acceleration")
+_REST, _FEED, _VELOCITY, _ACCELERATION = range(4)
+
+
+@dataclass(frozen=True)
+class PathSchedule:
+    """A certified time-optimal schedule of a path of M moves.
+
+    Attributes
+    ----------
+    s : ndarray, shape (n,)
+        Grid nodes, s = k + u on move k; at a waypoint the end of one move and the start of
+        the next are two nodes with the same s.
+    sdot : ndarray, shape (n,)
+        ṡ at the nodes, 1/s (s̈ is constant between two nodes of one move, so ṡ² is linear).
+    node_move : ndarray, shape (n,), int
+        Move of each node.
+    time : ndarray, shape (n,)
+        t at the nodes, s.
+    limit_kind : ndarray, shape (n,), int
+        Index in :data:`LIMIT_KINDS` of what fixed the node's speed.
+    limit_actuator : ndarray, shape (n,), int
+        The limiting actuator (0-based), −1 for rest and feed.
+    t_start, t_end : ndarray, shape (M,)
+        Each move's start and end time, s.
+    feed_peak : ndarray, shape (M,)
+        Certified bound of the tool centre point's speed over the move, m/s (rad/s for a
+        rotation without translation).
+    speed_peak : ndarray, shape (M, 6)
+        Certified bound of |q̇_i| over the move (actuator unit/s).
+    accel_peak : ndarray, shape (M, 6)
+        Certified bound of |q̈_i| over the move (actuator unit/s²).
+    stops : ndarray, shape (M + 1,), bool
+        The waypoints where the schedule is at rest.
+    rotary : ndarray, shape (M,), bool
+        Moves without translation (their feed is a rotation rate).
+    length : ndarray, shape (M,)
+        Each move's length (m; a lower bound on a curve) or rotation (rad, rotary moves).
+    intervals : int
+        Grid intervals.
+    """
+
+    s: NDArray[np.float64]
+    sdot: NDArray[np.float64]
+    node_move: NDArray[np.int64]
+    time: NDArray[np.float64]
+    limit_kind: NDArray[np.int64]
+    limit_actuator: NDArray[np.int64]
+    t_start: NDArray[np.float64]
+    t_end: NDArray[np.float64]
+    feed_peak: NDArray[np.float64]
+    speed_peak: NDArray[np.float64]
+    accel_peak: NDArray[np.float64]
+    stops: NDArray[np.bool_]
+    rotary: NDArray[np.bool_]
+    length: NDArray[np.float64]
+    intervals: int
+
+    @property
+    def duration(self) -> float:
+        """Total time, s."""
+        return float(self.time[-1]) if self.time.size else 0.0
+
+
+def _limits(values: ArrayLike, name: str, unit: str) -> NDArray[np.float64]:
+    """One or six limits >= 0 (0 = unlimited) as six, unlimited as +inf."""
+    array = np.asarray(values, dtype=np.float64).reshape(-1)
+    if array.size not in (1, 6) or not np.all(np.isfinite(array)) or np.any(array < 0.0):
+        msg = f"{name}: expected 1 or 6 finite values >= 0 ({unit}, 0 = unlimited), got {array}"
+        raise InputError(msg)
+    six = np.broadcast_to(array, (6,))
+    return np.where(six > 0.0, six, np.inf)
+
+
+def _ceilings(values: ArrayLike | None, count: int, name: str) -> NDArray[np.float64]:
+    """Per-move ceilings > 0 (inf: none)."""
+    if values is None:
+        return np.full(count, np.inf)
+    array = np.broadcast_to(np.asarray(values, dtype=np.float64), (count,))
+    if np.any(np.isnan(array)) or np.any(array <= 0.0):
+        msg = f"{name}: expected values > 0 per move (inf: no ceiling)"
+        raise InputError(msg)
+    return np.asarray(array, dtype=np.float64)
+
+
+def _tcp_bounds(
+    moves: SlerpMoves, move: NDArray[np.int64], a: NDArray[np.float64], b: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """P per interval: a certified bound of |p'(s)| on [a, b] (module documentation)."""
+    bound: NDArray[np.float64] = np.linalg.norm(moves.dp[move], axis=1)
+    curves = moves.arcs
+    if curves is not None:
+        on = curves.mask[move]
+        if on.any():
+            m = move[on]
+            ends = np.linalg.norm(curves.velocities(m, a[on]), axis=1) + np.linalg.norm(
+                curves.velocities(m, b[on]), axis=1
+            )
+            local = 0.5 * (ends + curves.accel[m] * (b[on] - a[on]))
+            bound[on] = np.minimum(curves.speed[m], local)
+    return bound
+
+
+def _junctions(
+    manipulator: Manipulator,
+    moves: SlerpMoves,
+    active: NDArray[np.int64],
+    stops: NDArray[np.bool_],
+    corner: float,
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """Between consecutive active moves: c² (x_right = c²·x_left) and whether to stop."""
+    model = ACTUATOR_MODELS[manipulator.architecture]
+    n = active.size
+    if n < 2:
+        return np.zeros(0), np.zeros(0, dtype=bool)
+    left, right = active[:-1], active[1:]  # the moves' numbers in the path
+    mine = np.arange(n)  # and in ``moves`` (the active moves only)
+    g_left, _ = model.evaluate(manipulator, moves.motion(mine[:-1], np.ones(n - 1)))
+    g_right, _ = model.evaluate(manipulator, moves.motion(mine[1:], np.zeros(n - 1)))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        scale = np.einsum("ij,ij->i", g_left, g_right) / np.einsum("ij,ij->i", g_right, g_right)
+        residual = np.linalg.norm(g_left - scale[:, None] * g_right, axis=1)
+        parallel = (scale > 0.0) & (residual <= math.sin(corner) * np.linalg.norm(g_left, axis=1))
+    # the waypoint between left and right: any stop requested at it or at a still move between
+    asked = np.array(
+        [bool(stops[lo + 1 : hi + 1].any()) for lo, hi in zip(left, right, strict=True)]
+    )
+    stop = ~parallel | asked | ~np.isfinite(scale)
+    return np.where(stop, 0.0, scale**2), stop
+
+
+def schedule_path(
+    manipulator: Manipulator,
+    positions: ArrayLike,
+    rotations: ArrayLike,
+    *,
+    speed_limits: ArrayLike,
+    accel_limits: ArrayLike,
+    feeds: ArrayLike | None = None,
+    rotary_feeds: ArrayLike | None = None,
+    stops: ArrayLike | None = None,
+    arcs: ArrayLike | None = None,
+    beziers: ArrayLike | None = None,
+    relative: float = DEFAULT_SCHEDULE_RELATIVE,
+    corner: float = DEFAULT_CORNER,
+) -> PathSchedule:
+    """The fastest certified schedule of the N − 1 slerp moves of a path (module documentation).
+
+    Parameters
+    ----------
+    manipulator : Manipulator
+        In the frame whose poses are given (a tool model for tool-centre-point poses).
+    positions : array_like, shape (N, 3)
+        Tool centre point, base frame, m.
+    rotations : array_like, shape (N, 3, 3)
+        Orientations, base frame.
+    speed_limits : array_like, shape (6,) or (1,)
+        v_i, actuator unit/s (0 = unlimited).
+    accel_limits : array_like, shape (6,) or (1,)
+        a_i, actuator unit/s² (0 = unlimited).
+    feeds : array_like, shape (N − 1,), optional
+        Tool-centre-point speed ceiling per move, m/s (inf: none); default none.
+    rotary_feeds : array_like, shape (N − 1,), optional
+        Rotation-rate ceiling of moves without translation, rad/s (inf: none).
+    stops : array_like, shape (N,), bool, optional
+        Waypoints where the schedule must be at rest (the ends always are).
+    arcs, beziers : array_like, optional
+        Curved moves, as :func:`~hexapod_workspace.core.motions.checks.check_path` takes them.
+    relative : float
+        Tightness of the grid's bounds, in (0, 0.5).
+    corner : float
+        Largest angle between two moves' rate vectors that runs through their waypoint, rad,
+        in [0, 0.1].
+
+    Returns
+    -------
+    PathSchedule
+
+    Raises
+    ------
+    InputError
+        Bad shapes or values (naming the parameter); a move where an actuator has no
+        inverse-kinematics solution or a transmission of 0, or whose speed no limit bounds
+        (naming the move, 1-based).
+    """
+    p = np.asarray(positions, dtype=np.float64)
+    r = np.asarray(rotations, dtype=np.float64)
+    if p.ndim != 2 or p.shape[1] != 3 or r.shape != (p.shape[0], 3, 3) or p.shape[0] < 2:
+        msg = (
+            "poses: expected positions (N, 3) and rotations (N, 3, 3), N >= 2, "
+            f"got {p.shape}, {r.shape}"
+        )
+        raise InputError(msg)
+    if not (np.all(np.isfinite(p)) and np.all(np.isfinite(r))):
+        msg = "poses: expected finite positions and rotations"
+        raise InputError(msg)
+    if not 0.0 < relative < 0.5:
+        msg = f"relative: expected a value in (0, 0.5), got {relative!r}"
+        raise InputError(msg)
+    if not 0.0 <= corner <= 0.1:
+        msg = f"corner: expected an angle in [0, 0.1] rad, got {corner!r}"
+        raise InputError(msg)
+    name = manipulator.architecture
+    if name not in ACTUATOR_MODELS:
+        msg = f"architecture: expected one of {', '.join(ACTUATOR_MODELS)}, got {name!r}"
+        raise InputError(msg)
+    count = p.shape[0] - 1
+    vmax = _limits(speed_limits, "speed_limits", "actuator unit/s")
+    amax = _limits(accel_limits, "accel_limits", "actuator unit/s²")
+    feed = _ceilings(feeds, count, "feeds")
+    rotary_feed = _ceilings(rotary_feeds, count, "rotary_feeds")
+    stop_at = np.zeros(count + 1, dtype=bool)
+    if stops is not None:
+        asked = np.asarray(stops, dtype=bool)
+        if asked.shape != (count + 1,):
+            msg = f"stops: expected one flag per waypoint ({count + 1}), got shape {asked.shape}"
+            raise InputError(msg)
+        stop_at |= asked
+    stop_at[0] = stop_at[-1] = True
+    moves = SlerpMoves(
+        manipulator, p[:-1], p[1:], r[:-1], r[1:], _validate_curves(arcs, beziers, p)
+    )
+    rotary = moves.translation == 0.0
+    length = np.where(rotary, moves.omega, moves.translation)
+    still = length == 0.0
+    active = np.flatnonzero(~still)
+    model = ACTUATOR_MODELS[name]
+    weights = _weights(np.where(np.isfinite(vmax), vmax, 0.0))
+
+    if active.size == 0:
+        return _still_schedule(count, stop_at, rotary, length)
+    sub = SlerpMoves(
+        manipulator,
+        p[:-1][active],
+        p[1:][active],
+        r[:-1][active],
+        r[1:][active],
+        None if moves.arcs is None else moves.arcs.take(active),
+    )
+    grid = certified_intervals(
+        manipulator, model, sub, active.size, weights, relative, MAX_SCHEDULE_INTERVALS, local=True
+    )
+    given = (vmax, amax, feed, rotary_feed, rotary, length, stop_at)
+    schedule, ramp = _solve(manipulator, sub, grid, active, given, corner)
+    # Refine where the schedule ramps (leaves or nears rest, or is acceleration-bound): the grid
+    # is what limits the time there; stop when a round gains less than relative/4.
+    for _ in range(REFINE_ROUNDS):
+        if not ramp.any() or grid.move.size + int(ramp.sum()) > MAX_SCHEDULE_INTERVALS:
+            break
+        mid = 0.5 * (grid.a[ramp] + grid.b[ramp])
+        move = np.concatenate([grid.move, grid.move[ramp]])
+        a = np.concatenate([grid.a, mid])
+        b = np.concatenate([np.where(ramp, 0.5 * (grid.a + grid.b), grid.b), grid.b[ramp]])
+        order = np.lexsort((a, move))
+        finer = certified_intervals(
+            manipulator,
+            model,
+            sub,
+            active.size,
+            weights,
+            relative,
+            MAX_SCHEDULE_INTERVALS,
+            local=True,
+            start=(move[order], a[order], b[order]),
+        )
+        candidate, candidate_ramp = _solve(manipulator, sub, finer, active, given, corner)
+        gain = schedule.duration - candidate.duration
+        if gain < 0.0:
+            break
+        schedule, ramp, grid = candidate, candidate_ramp, finer
+        if gain <= 0.25 * relative * schedule.duration:
+            break
+    return schedule
+
+
+def _solve(
+    manipulator: Manipulator,
+    sub: SlerpMoves,
+    grid: Intervals,
+    active: NDArray[np.int64],
+    given: tuple[NDArray[Any], ...],
+    corner: float,
+) -> tuple[PathSchedule, NDArray[np.bool_]]:
+    """The schedule on one grid (module documentation), and its ramp intervals (an end at rest
+    or below its cap)."""
+    vmax, amax, feed, rotary_feed, rotary, length, stop_at = given
+    count = feed.size
+
+    move, a, b = grid.move, grid.a, grid.b
+    width = b - a
+    big_k, big_g = _local_rates(manipulator, sub, grid)
+    bad = np.flatnonzero(~np.all(np.isfinite(big_g) & np.isfinite(big_k), axis=1))
+    if bad.size:
+        k = int(active[move[bad[0]]])
+        which_leg = int(
+            np.flatnonzero(~np.isfinite(big_g[bad[0]]) | ~np.isfinite(big_k[bad[0]]))[0]
+        )
+        msg = (
+            f"move {k + 1}: actuator {which_leg + 1} has no inverse-kinematics solution or a "
+            "transmission of 0 on it (no speed can be scheduled; see the ik and transmission "
+            "constraints)"
+        )
+        raise InputError(msg)
+
+    # the caps X_I per interval, and what sets them
+    with np.errstate(divide="ignore", invalid="ignore"):
+        speed_cap = np.where(big_g > 0.0, (vmax / big_g) ** 2, np.inf)
+        accel_cap = np.where(big_k > 0.0, amax / big_k, np.inf)
+    tcp = np.where(rotary[active][move], sub.omega[move], _tcp_bounds(sub, move, a, b))
+    ceiling = np.where(rotary[active][move], rotary_feed[active][move], feed[active][move])
+    with np.errstate(divide="ignore"):
+        feed_cap = np.where(tcp > 0.0, (ceiling / tcp) ** 2, np.inf)
+    candidates = np.column_stack([feed_cap, speed_cap, accel_cap])  # (m, 13)
+    which = np.argmin(candidates, axis=1)
+    cap = candidates[np.arange(which.size), which]
+    unbounded = np.flatnonzero(~np.isfinite(cap))
+    if unbounded.size:
+        k = int(active[move[unbounded[0]]])
+        msg = (
+            f"move {k + 1}: no limit bounds its speed (give it a feed, or set "
+            "limits.actuator_speed_max or limits.actuator_accel_max)"
+        )
+        raise InputError(msg)
+    cap_kind = np.where(which == 0, _FEED, np.where(which <= 6, _VELOCITY, _ACCELERATION))
+    cap_actuator = np.where(which == 0, -1, (which - 1) % 6)
+
+    # per-interval step coefficients: x_next <= lam_i·x + mu_i (module documentation)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        den = big_g + 2.0 * width[:, None] * big_k
+        lam = np.where(den > 0.0, big_g / den, 1.0)
+        mu = np.where(den > 0.0, 2.0 * width[:, None] * amax / den, np.inf)
+    lam = np.where(np.isfinite(amax), lam, 1.0)
+    mu = np.where(np.isfinite(amax), mu, np.inf)
+
+    first = np.flatnonzero(np.r_[True, move[1:] != move[:-1]])  # first interval of each move
+    factor, junction_stop = _junctions(manipulator, sub, active, stop_at, corner)
+    nodes_per_move = np.diff(np.r_[first, move.size]) + 1
+    total = int(nodes_per_move.sum())
+    node_start = np.r_[0, np.cumsum(nodes_per_move)[:-1]]
+    # node caps: a node inside a move takes both neighbouring intervals' caps
+    node_cap = np.empty(total)
+    node_kind = np.empty(total, dtype=np.int64)
+    node_act = np.empty(total, dtype=np.int64)
+    interval_node = np.empty(move.size, dtype=np.int64)  # node at each interval's start
+    for j, (start, n) in enumerate(zip(first, nodes_per_move - 1, strict=True)):
+        lo = node_start[j]
+        interval_node[start : start + n] = np.arange(lo, lo + n)
+        left = np.r_[cap[start : start + n], np.inf]
+        right = np.r_[np.inf, cap[start : start + n]]
+        use_left = left <= right
+        node_cap[lo : lo + n + 1] = np.minimum(left, right)
+        idx = np.r_[np.arange(start, start + n), start + n - 1]
+        idx_right = np.r_[start, np.arange(start, start + n)]
+        chosen = np.where(use_left, idx, idx_right)
+        node_kind[lo : lo + n + 1] = cap_kind[chosen]
+        node_act[lo : lo + n + 1] = cap_actuator[chosen]
+    rest = np.zeros(total, dtype=bool)
+    rest[0] = rest[-1] = True
+    ends = node_start + nodes_per_move - 1
+    rest[ends[:-1][junction_stop]] = True
+    rest[node_start[1:][junction_stop]] = True
+    node_cap[rest] = 0.0
+
+    forward, f_act = _pass(node_cap, lam, mu, interval_node, ends, node_start, factor, 1)
+    backward, b_act = _pass(node_cap, lam, mu, interval_node, ends, node_start, factor, -1)
+    x = np.minimum(forward, backward)
+    kind = np.where(
+        rest,
+        _REST,
+        np.where(x >= node_cap, node_kind, _ACCELERATION),
+    )
+    actuator = np.where(
+        rest, -1, np.where(x >= node_cap, node_act, np.where(forward <= backward, f_act, b_act))
+    )
+
+    # time and the certified peaks per move
+    x_a, x_b = x[interval_node], x[interval_node + 1]
+    root_a, root_b = np.sqrt(x_a), np.sqrt(x_b)
+    with np.errstate(divide="ignore"):
+        dt = np.where(width > 0.0, 2.0 * width / (root_a + root_b), 0.0)
+    if not np.all(np.isfinite(dt)):
+        worst = int(active[move[np.flatnonzero(~np.isfinite(dt))[0]]])
+        msg = f"move {worst + 1}: the schedule cannot leave rest on it (a limit of 0 speed)"
+        raise InputError(msg)
+    high = np.maximum(x_a, x_b)
+    u = np.where(width > 0.0, (x_b - x_a) / (2.0 * width), 0.0)
+    interval_speed = big_g * np.sqrt(high)[:, None]
+    interval_accel = big_k * high[:, None] + big_g * np.abs(u)[:, None]
+    interval_feed = tcp * np.sqrt(high)
+    time = np.empty(total)
+    s = np.empty(total)
+    node_move = np.empty(total, dtype=np.int64)
+    clock = 0.0
+    t_start = np.zeros(count)
+    t_end = np.zeros(count)
+    feed_peak = np.zeros(count)
+    speed_peak = np.zeros((count, 6))
+    accel_peak = np.zeros((count, 6))
+    previous = -1
+    for j, k in enumerate(active):
+        start, n, lo = first[j], nodes_per_move[j] - 1, node_start[j]
+        t_start[previous + 1 : k + 1] = clock  # still moves before k take no time
+        t_end[previous + 1 : k] = clock
+        times = clock + np.r_[0.0, np.cumsum(dt[start : start + n])]
+        time[lo : lo + n + 1] = times
+        s[lo : lo + n + 1] = k + np.r_[a[start : start + n], 1.0]
+        node_move[lo : lo + n + 1] = k
+        clock = float(times[-1])
+        t_end[k] = clock
+        feed_peak[k] = float(np.max(interval_feed[start : start + n]))
+        speed_peak[k] = np.max(interval_speed[start : start + n], axis=0)
+        accel_peak[k] = np.max(interval_accel[start : start + n], axis=0)
+        previous = k
+    t_start[previous + 1 :] = clock
+    t_end[previous + 1 :] = clock
+    sdot = np.sqrt(x)
+    stops_out = stop_at.copy()
+    for j in range(active.size - 1):
+        if junction_stop[j]:
+            stops_out[active[j] + 1 : active[j + 1] + 1] = True
+    at_cap = x >= node_cap
+    ramp = ~(at_cap[interval_node] & at_cap[interval_node + 1]) | rest[interval_node]
+    ramp |= rest[interval_node + 1]
+    return PathSchedule(
+        s=s,
+        sdot=sdot,
+        node_move=node_move,
+        time=time,
+        limit_kind=kind,
+        limit_actuator=actuator,
+        t_start=t_start,
+        t_end=t_end,
+        feed_peak=feed_peak,
+        speed_peak=speed_peak,
+        accel_peak=accel_peak,
+        stops=stops_out,
+        rotary=rotary,
+        length=length,
+        intervals=int(move.size),
+    ), ramp
+
+
+def _rate_derivatives(
+    manipulator: Manipulator, sub: SlerpMoves, moves: NDArray[np.int64], s: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """g_i' = d²q_i/ds² (n, 6) at (moves, s) (module documentation; NaN on curved moves)."""
+    motion = sub.motion(moves, s)
+    v, dv = motion.joint_velocities, sub.joint_accelerations(moves, s)
+    arch = architectures.module(manipulator.architecture)
+    if not arch.MOVING_BASE:  # g' = (|v|² − g²)/ℓ + n·v'
+        d = motion.platform - manipulator.base_joints
+        length = np.linalg.norm(d, axis=2)
+        n = d / length[..., None]
+        g = np.sum(n * v, axis=2)
+        result: NDArray[np.float64] = (np.sum(v * v, axis=2) - g * g) / length + np.sum(
+            n * dv, axis=2
+        )
+        return result
+    q, _ = arch.inverse_kinematics(manipulator, motion.platform)
+    q = np.where(np.isfinite(q), q, 0.0)  # unsolved legs are refused by G = inf
+    d = motion.platform - arch.base_ends(manipulator, q)
+    length = np.linalg.norm(d, axis=2)
+    n = d / length[..., None]
+    first, second = arch.base_end_derivatives(manipulator, q)
+    h = np.sum(n * first, axis=2)  # ρ·τ
+    with np.errstate(divide="ignore", invalid="ignore"):
+        g = np.sum(n * v, axis=2) / h
+        dn = (v - first * g[..., None]) / length[..., None]
+        # ρτ·g' = L|n'|² + n·v' − g²·n·A″
+        derivative: NDArray[np.float64] = (
+            length * np.sum(dn * dn, axis=2)
+            + np.sum(n * dv, axis=2)
+            - g * g * np.sum(n * second, axis=2)
+        ) / h
+    return derivative
+
+
+def _third_bound(
+    manipulator: Manipulator,
+    speed: NDArray[np.float64],
+    accel: NDArray[np.float64],
+    jerk: NDArray[np.float64],
+    floor: NDArray[np.float64],
+    rate: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """K2_i ≥ |g_i″| on an interval where |v| ≤ V, |v′| ≤ A, |v″| ≤ J, the floor holds and
+    |g′| ≤ K (module documentation, "Second order")."""
+    arch = architectures.module(manipulator.architecture)
+    v, a, j, k = speed, accel, jerk, rate
+    if not arch.MOVING_BASE:
+        bound: NDArray[np.float64] = (3.0 * v * a + 2.0 * v * k) / floor + v**3 / floor**2 + j
+        return bound
+    length = manipulator.leg_lengths
+    assert length is not None
+    rho = arch.actuator_lever(manipulator)
+    turning = rho if arch.TURNING_BASE else np.zeros(6)  # |A″| = |A‴| = r for a crank
+    g = v / (rho * floor)  # |g|
+    n1 = v * (1.0 + 1.0 / floor) / length  # |n′|
+    n2 = (a + turning * g * g + rho * k) / length  # |n″|
+    h1 = rho * n1 + g * turning  # |(ρτ)′|
+    e1 = 2.0 * length * n1 * n2 + n1 * a + j + 2.0 * g * k * turning
+    e1 = e1 + g * g * (n1 * turning + turning * g)
+    bound = (e1 + h1 * k) / (rho * floor)
+    return bound
+
+
+def _local_rates(
+    manipulator: Manipulator, sub: SlerpMoves, grid: Intervals
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Tighter certified bounds of |g_i′| and |g_i| per interval: the second-order bound
+    ``(|g′(a)| + |g′(b)| + K2·w)/2`` where it is smaller than K (straight moves), and G from
+    it (module documentation, "Second order")."""
+    move, a, b = grid.move, grid.a, grid.b
+    node_move, node_s, end_node = interval_nodes(move, a, b)
+    derivative = np.abs(_rate_derivatives(manipulator, sub, node_move, node_s))
+    width = (b - a)[:, None]
+    positive = grid.floor > 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k2 = _third_bound(
+            manipulator,
+            sub.speed[move],
+            sub.accel[move],
+            sub.jerk[move],
+            np.where(positive, grid.floor, 1.0),
+            np.where(np.isfinite(grid.rate), grid.rate, 0.0),
+        )
+        local = 0.5 * (derivative[: move.size] + derivative[end_node] + k2 * width)
+    usable = positive & np.isfinite(local) & np.isfinite(grid.rate)
+    rate = np.where(usable, np.minimum(grid.rate, local), grid.rate)
+    upper = np.minimum(grid.upper, 0.5 * (grid.g_a + grid.g_b + rate * width))
+    return rate, upper
+
+
+def _pass(
+    cap: NDArray[np.float64],
+    lam: NDArray[np.float64],
+    mu: NDArray[np.float64],
+    interval_node: NDArray[np.int64],
+    ends: NDArray[np.int64],
+    starts: NDArray[np.int64],
+    factor: NDArray[np.float64],
+    direction: int,
+) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """One pass (1: forward, −1: backward): each node's largest x from its predecessor, capped;
+    also the actuator whose acceleration bounds the step (−1: the cap or a junction)."""
+    total = cap.size
+    x = np.empty(total)
+    act = np.full(total, -1, dtype=np.int64)
+    # predecessor of each node in this direction: an interval (its index) or a junction
+    step_interval = np.full(total, -1, dtype=np.int64)
+    junction_of = np.full(total, -1, dtype=np.int64)
+    if direction > 0:
+        step_interval[interval_node + 1] = np.arange(interval_node.size)
+        junction_of[starts[1:]] = np.arange(starts.size - 1)
+        order = range(total)
+    else:
+        step_interval[interval_node] = np.arange(interval_node.size)
+        junction_of[ends[:-1]] = np.arange(ends.size - 1)
+        order = range(total - 1, -1, -1)
+    lam_rows, mu_rows = lam.tolist(), mu.tolist()
+    caps = cap.tolist()
+    values = [0.0] * total
+    acts = [-1] * total
+    previous, previous_act = 0.0, -1
+    for node in order:
+        interval = int(step_interval[node])
+        if interval >= 0:
+            best, who = caps[node], -1
+            for i, (l_i, m_i) in enumerate(zip(lam_rows[interval], mu_rows[interval], strict=True)):
+                reach = l_i * previous + m_i
+                if reach < best:
+                    best, who = reach, i
+        else:
+            junction = int(junction_of[node])
+            if junction < 0:  # the first node of the pass
+                best, who = caps[node], -1
+            else:
+                scale = float(factor[junction])
+                reach = (
+                    previous * scale
+                    if direction > 0
+                    else (previous / scale if scale > 0.0 else 0.0)
+                )
+                best, who = (reach, previous_act) if reach < caps[node] else (caps[node], -1)
+        values[node], acts[node] = best, who
+        previous, previous_act = best, who
+    x[:] = values
+    act[:] = acts
+    return x, act
+
+
+def _still_schedule(
+    count: int, stops: NDArray[np.bool_], rotary: NDArray[np.bool_], length: NDArray[np.float64]
+) -> PathSchedule:
+    """A path none of whose moves moves: no time, no grid."""
+    zeros = np.zeros(count)
+    return PathSchedule(
+        s=np.zeros(0),
+        sdot=np.zeros(0),
+        node_move=np.zeros(0, dtype=np.int64),
+        time=np.zeros(0),
+        limit_kind=np.zeros(0, dtype=np.int64),
+        limit_actuator=np.zeros(0, dtype=np.int64),
+        t_start=zeros,
+        t_end=zeros.copy(),
+        feed_peak=zeros.copy(),
+        speed_peak=np.zeros((count, 6)),
+        accel_peak=np.zeros((count, 6)),
+        stops=stops,
+        rotary=rotary,
+        length=length,
+        intervals=0,
+    )
