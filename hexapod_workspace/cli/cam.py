@@ -99,7 +99,9 @@ from .inputs import (
 )
 
 __all__ = [
+    "DEG_MIN",
     "FRAMES",
+    "MM_MIN",
     "SPEED_COVERAGE",
     "cell_arguments",
     "cell_pipeline_applies",
@@ -107,6 +109,7 @@ __all__ = [
     "cmd_check_cell_path",
     "cmd_check_path_any",
     "is_cl_file",
+    "read_cell_inputs",
     "tool_json",
     "work_json",
 ]
@@ -118,8 +121,8 @@ SPEED_COVERAGE = (
     "actuator speeds along the programmed moves, each at its constant feed (certified bound); "
     "corner blending and accelerations are the controller's"
 )
-_MM_MIN = 1e-3 / 60.0  # m/s per mm/min
-_DEG_MIN = math.radians(1.0) / 60.0  # rad/s per deg/min
+#: m/s per mm/min, and rad/s per deg/min.
+MM_MIN, DEG_MIN = 1e-3 / 60.0, math.radians(1.0) / 60.0
 
 
 def is_cl_file(path: str | Path) -> bool:
@@ -424,7 +427,7 @@ def _check_part(
         known = bool(np.isfinite(speeds.duration[k]))
         rotary = bool(speeds.rotary[k])
         feed_max = float(speeds.feed_max[k])
-        per_minute = feed_max / (_DEG_MIN if rotary else _MM_MIN)
+        per_minute = feed_max / (DEG_MIN if rotary else MM_MIN)
         segment.update(
             rapid=bool(part.rapid[k + 1]),
             duration_s=float(speeds.duration[k]) if known else None,
@@ -433,10 +436,10 @@ def _check_part(
             feed_max_mm_min=None if rotary or math.isnan(feed_max) else _finite(per_minute),
         )
         if rotary:
-            segment["feed_deg_min"] = rotary_feed / _DEG_MIN if known else None
+            segment["feed_deg_min"] = rotary_feed / DEG_MIN if known else None
             segment["feed_max_deg_min"] = None if math.isnan(feed_max) else _finite(per_minute)
         else:
-            segment["feed_mm_min"] = float(feed[k]) / _MM_MIN if known else None
+            segment["feed_mm_min"] = float(feed[k]) / MM_MIN if known else None
         if not known:
             segment["speed_note"] = "no feed for this move: no duration, no speed verdict"
         elif not math.isfinite(float(speeds.speed_peak[k])):
@@ -494,10 +497,10 @@ def _part_call(
     )
     request.update(
         header={"stamp": {"sec": 0, "nanosec": 0}, "frame_id": model.frame_id},
-        feeds_mm_min=(part.feeds[1:] / _MM_MIN).tolist(),
+        feeds_mm_min=(part.feeds[1:] / MM_MIN).tolist(),
         rapid=[bool(r) for r in part.rapid[1:]],
-        rapid_feed_mm_min=0.0 if math.isnan(rapid_feed) else rapid_feed / _MM_MIN,
-        rotary_feed_deg_min=0.0 if math.isnan(rotary_feed) else rotary_feed / _DEG_MIN,
+        rapid_feed_mm_min=0.0 if math.isnan(rapid_feed) else rapid_feed / MM_MIN,
+        rotary_feed_deg_min=0.0 if math.isnan(rotary_feed) else rotary_feed / DEG_MIN,
         # the curved moves (CIRCLE, NURBS spans), base frame, flattened one row per move
         arcs=[] if part.arcs is None else part.arcs.ravel().tolist(),
         beziers=[] if part.beziers is None else part.beziers.ravel().tolist(),
@@ -552,6 +555,23 @@ def _speed_summary(
     }
 
 
+def read_cell_inputs(
+    options: argparse.Namespace, err: IO[str]
+) -> tuple[Manipulator, CellFrames, str, tuple[float, float], list[_Part], CLProgram | None]:
+    """What ``check-path`` and ``schedule`` read: the platform frame's model (each part's tool
+    model is built from it), the cell, the frame of the file, the rapid and rotary feeds (m/s,
+    rad/s; NaN: not given) and the file's parts (with ``--feed-mm-min`` where no feed is
+    programmed) and CL program."""
+    platform = configured_manipulator(options.config, None, err, with_tool=False)
+    cell = cell_from_params_file(options.config or example_config_path())
+    frame = options.frame or ("work" if is_cl_file(options.file) else "base")
+    feed = _positive(options.feed_mm_min, "--feed-mm-min", "mm/min") * MM_MIN
+    rapid = _positive(options.rapid_feed_mm_min, "--rapid-feed-mm-min", "mm/min") * MM_MIN
+    rotary = _positive(options.rotary_feed_deg_min, "--rotary-feed-deg-min", "deg/min") * DEG_MIN
+    parts, program = _read_parts(options, cell, frame, feed)
+    return platform, cell, frame, (rapid, rotary), parts, program
+
+
 def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
     """``check-path`` for CL files, frames and feeds (see the module documentation)."""
     record = (
@@ -564,14 +584,7 @@ def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str])
         if options.plot is None
         else output_file(options.plot, "--plot", force=options.force, suffixes=PLOT_FORMATS)
     )
-    # the platform frame's model: each part's tool model is built from it
-    platform = configured_manipulator(options.config, None, err, with_tool=False)
-    cell = cell_from_params_file(options.config or example_config_path())
-    frame = options.frame or ("work" if is_cl_file(options.file) else "base")
-    feed = _positive(options.feed_mm_min, "--feed-mm-min", "mm/min") * _MM_MIN
-    rapid = _positive(options.rapid_feed_mm_min, "--rapid-feed-mm-min", "mm/min") * _MM_MIN
-    rotary = _positive(options.rotary_feed_deg_min, "--rotary-feed-deg-min", "deg/min") * _DEG_MIN
-    parts, program = _read_parts(options, cell, frame, feed)
+    platform, cell, frame, (rapid, rotary), parts, program = read_cell_inputs(options, err)
     results, documents, calls = [], [], []
     for part in parts:
         result, document, call = _check_part(platform, part, cell, options, (rapid, rotary))
@@ -583,7 +596,7 @@ def cmd_check_cell_path(options: argparse.Namespace, out: IO[str], err: IO[str])
     unit = ACTUATOR_MODELS[platform.architecture].unit
     speed = _speed_summary(documents, cell.actuator_speed_max, unit)
     ok = all(d["ok"] for d in documents) and not speed["moves_to_slow_down"]
-    common = {
+    common: dict[str, Any] = {
         "frame": frame,
         "work_frame": work_json(cell.work),
         "passed_over": {} if program is None else {n: c for n, _, c in program.passed_over},

@@ -28,7 +28,7 @@ from .. import __version__
 from ..core import kernels
 from ..core.base import resolution
 from ..errors import HexapodWorkspaceError
-from . import atlas, cam, check_path, commands, linuxcnc, loads, reach, scene
+from . import atlas, cam, check_path, commands, linuxcnc, loads, reach, scene, schedule
 from .inputs import (
     PLOT_FORMATS,
     CliError,
@@ -455,6 +455,14 @@ for _command in (
         check_path.CHECK_PATH_DESCRIPTION,
         cam.check_path_any_arguments,
         _check_path_run,
+        uses=("config", "json"),
+    ),
+    Command(
+        "schedule",
+        schedule.SCHEDULE_HELP,
+        schedule.SCHEDULE_DESCRIPTION,
+        schedule.schedule_arguments,
+        schedule.cmd_schedule,
         uses=("config", "json"),
     ),
     Command(

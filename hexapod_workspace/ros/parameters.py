@@ -359,6 +359,10 @@ CELL_DESCRIPTIONS = {
         "Largest actuator speed, actuator unit/s (m/s for legs), 1 value or 6; 0 = unlimited "
         "(~/check_path's speed verdicts)."
     ),
+    "limits.actuator_accel_max": (
+        "Largest actuator acceleration, actuator unit/s² (m/s² for legs), 1 value or 6; "
+        "0 = unlimited (the schedule command's limit; validated with the cell)."
+    ),
 }
 #: The tool table's parameter names (declared from the parameters given at start, or when a
 #: client sets a new one).

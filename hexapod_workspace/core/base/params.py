@@ -63,6 +63,7 @@ CELL_PARAMETERS = (
     "work.frame_id",
     "tools.",
     "limits.actuator_speed_max",
+    "limits.actuator_accel_max",
 )
 #: Parameters of the collision scene (``collision.clearance``, ``collision.platform.*``,
 #: ``collision.tool.*``, ``collision.obstacles.*``), read by

@@ -88,6 +88,7 @@ CELL_DEFAULTS: dict[str, Any] = {
     "work.orientation": [0.0, 0.0, 0.0],
     "work.frame_id": "work",
     "limits.actuator_speed_max": [0.0],
+    "limits.actuator_accel_max": [0.0],
 }
 _TOOL_KEY = re.compile(r"^tools\.T([1-9][0-9]*)\.(offset|orientation)$")
 
@@ -186,12 +187,16 @@ class CellFrames:
         The tool table (``tools.T<n>.*``), by number.
     actuator_speed_max : ndarray, shape (6,)
         Largest actuator speed per actuator (m/s for 6-UPS legs); 0 = unlimited.
+    actuator_accel_max : ndarray, shape (6,)
+        Largest actuator acceleration per actuator (m/s² for legs and slides, rad/s² for
+        cranks); 0 = unlimited (the ``schedule`` command's limit).
     """
 
     tool: Tool
     work: WorkFrame
     tools: dict[int, Tool]
     actuator_speed_max: NDArray[np.float64]
+    actuator_accel_max: NDArray[np.float64] = field(default_factory=lambda: frozen(np.zeros(6)))
 
     def select(self, number: int) -> Tool:
         """Tool ``number`` of the table.
@@ -269,15 +274,23 @@ def cell_from_mapping(parameters: Mapping[str, Any]) -> CellFrames:
             number,
         )
     tool = _selected(tool, tools, values["tool.number"])
-    name = "limits.actuator_speed_max"
-    speeds = numbers(name, values[name])
-    if speeds.size not in (1, 6):
-        msg = f"{name}: expected 1 or 6 numbers, got {speeds.size}"
+    speeds, accels = (
+        _actuator_limits(name, values[name])
+        for name in ("limits.actuator_speed_max", "limits.actuator_accel_max")
+    )
+    return CellFrames(tool, work, tools, speeds, accels)
+
+
+def _actuator_limits(name: str, value: Any) -> NDArray[np.float64]:
+    """One or six values >= 0 (0 = unlimited) of ``name``, as six (ConfigError otherwise)."""
+    limits = numbers(name, value)
+    if limits.size not in (1, 6):
+        msg = f"{name}: expected 1 or 6 numbers, got {limits.size}"
         raise ConfigError(msg)
-    if np.any(speeds < 0.0):
-        msg = f"{name}: expected values >= 0 (0 = unlimited), got {describe(speeds.tolist())}"
+    if np.any(limits < 0.0):
+        msg = f"{name}: expected values >= 0 (0 = unlimited), got {describe(limits.tolist())}"
         raise ConfigError(msg)
-    return CellFrames(tool, work, tools, frozen(np.broadcast_to(speeds, (6,)).copy()))
+    return frozen(np.broadcast_to(limits, (6,)).copy())
 
 
 def _selected(tool: Tool, tools: dict[int, Tool], number: Any) -> Tool:

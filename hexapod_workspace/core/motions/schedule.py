@@ -106,7 +106,9 @@ __all__ = [
     "DEFAULT_SCHEDULE_RELATIVE",
     "LIMIT_KINDS",
     "PathSchedule",
+    "ScheduleProfiles",
     "schedule_path",
+    "schedule_profiles",
 ]
 
 #: Tightness of each interval's bound of |g_i| against its end values (module documentation).
@@ -731,4 +733,79 @@ def _still_schedule(
         rotary=rotary,
         length=length,
         intervals=0,
+    )
+
+
+@dataclass(frozen=True)
+class ScheduleProfiles:
+    """A schedule's quantities at its grid nodes (samples for plots and logs; the certified
+    bounds are :class:`PathSchedule`'s peaks).
+
+    Attributes
+    ----------
+    time : ndarray, shape (n,)
+        s.
+    feed : ndarray, shape (n,)
+        |ṗ| of the tool centre point, m/s.
+    speed : ndarray, shape (n, 6)
+        q̇_i = g_i·ṡ, actuator unit/s.
+    accel : ndarray, shape (n, 6)
+        q̈_i = g_i'·ṡ² + g_i·s̈ with the s̈ of the interval that starts at the node (the last
+        node of a move: of the interval that ends there), actuator unit/s².
+    """
+
+    time: NDArray[np.float64]
+    feed: NDArray[np.float64]
+    speed: NDArray[np.float64]
+    accel: NDArray[np.float64]
+
+
+def schedule_profiles(
+    manipulator: Manipulator,
+    positions: ArrayLike,
+    rotations: ArrayLike,
+    schedule: PathSchedule,
+    *,
+    arcs: ArrayLike | None = None,
+    beziers: ArrayLike | None = None,
+) -> ScheduleProfiles:
+    """Feed, actuator speeds and accelerations at the nodes of ``schedule`` (the path it was
+    computed for; g' by central differences of g, 1e-6 in s, on curved moves)."""
+    p = np.asarray(positions, dtype=np.float64)
+    r = np.asarray(rotations, dtype=np.float64)
+    moves = SlerpMoves(
+        manipulator, p[:-1], p[1:], r[:-1], r[1:], _validate_curves(arcs, beziers, p)
+    )
+    model = ACTUATOR_MODELS[manipulator.architecture]
+    move = schedule.node_move
+    u = np.clip(schedule.s - move, 0.0, 1.0)
+    g, _ = model.evaluate(manipulator, moves.motion(move, u))
+    derivative = _rate_derivatives(manipulator, moves, move, u)
+    curved = ~np.all(np.isfinite(derivative), axis=1)
+    if curved.any():
+        h = 1e-6
+        lo, hi = np.clip(u[curved] - h, 0.0, 1.0), np.clip(u[curved] + h, 0.0, 1.0)
+        g_lo, _ = model.evaluate(manipulator, moves.motion(move[curved], lo))
+        g_hi, _ = model.evaluate(manipulator, moves.motion(move[curved], hi))
+        derivative[curved] = (g_hi - g_lo) / (hi - lo)[:, None]
+    linear = moves.dp[move].copy()
+    if moves.arcs is not None:
+        on = moves.arcs.mask[move]
+        if on.any():
+            linear[on] = moves.arcs.velocities(move[on], u[on])
+    x = schedule.sdot**2
+    # s̈ of the interval starting at each node (a move's last node: the one ending there)
+    same = np.r_[move[1:] == move[:-1], False]
+    width = np.where(same, np.r_[np.diff(schedule.s), 0.0], 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        forward = np.where(
+            width > 0.0, np.r_[np.diff(x), 0.0] / (2.0 * np.where(width > 0, width, 1.0)), 0.0
+        )
+    backward = np.r_[0.0, forward[:-1]]
+    sddot = np.where(same, forward, backward)
+    return ScheduleProfiles(
+        time=schedule.time,
+        feed=np.linalg.norm(linear, axis=1) * schedule.sdot,
+        speed=g * schedule.sdot[:, None],
+        accel=derivative * x[:, None] + g * sddot[:, None],
     )

@@ -1,0 +1,354 @@
+"""``hexapod-workspace schedule FILE``: the fastest feed schedule along a toolpath that is
+certified to run (:mod:`hexapod_workspace.core.motions.schedule`, derivations there).
+
+FILE is what ``check-path`` takes (a path CSV or a CL file, with frames, tools and feeds as
+:mod:`.cam` reads them); the path is checked as ``check-path`` checks it (its verdict is
+``path_ok``) and scheduled along the same moves. Limits: ``limits.actuator_speed_max`` and
+``limits.actuator_accel_max`` (one or six values, actuator unit/s and /s², 0 = unlimited), and
+the tool centre point's speed at most the move's programmed feed (``FEDRAT``, or
+``--feed-mm-min`` where there is none; ``RAPID`` moves ``--rapid-feed-mm-min``, else no
+ceiling; moves without translation ``--rotary-feed-deg-min``) and at most
+``--feed-max-mm-min``: the programmed feed is a ceiling, not a target. The schedule rests at
+both ends of every part (tool changes), at each waypoint where the actuator rates change
+direction (a corner: no finite acceleration passes it) and, with ``--stop-at-rapids``, where
+``RAPID`` moves begin and end.
+
+JSON: ``duration_s`` (every part; tool changes take no time here), ``programmed_duration_s``
+(every move at its programmed feed; ``null`` when a move has none), ``path_ok``,
+``actuator_unit``, ``actuator_speed_max``, ``actuator_accel_max``, ``covers``; per part (the top
+level for one, else ``parts``) ``grid: [{"s", "sdot"}]`` (s = k + u on move k, ṡ in 1/s, s̈
+constant between two nodes of one move so ṡ² is linear in s; at a waypoint the end of one move
+and the start of the next are two entries with the same s) and ``moves: [{"t_start_s",
+"t_end_s", "feed_peak_mm_min" (``feed_peak_deg_min`` for a rotation), "feed_ceiling_mm_min",
+"limited_by": {"kind": "feed"|"velocity"|"acceleration", "actuator": 1-6 or null},
+"actuator_speed_peak", "actuator_accel_peak"}]`` (certified bounds, six each). Exit 0 when a
+schedule is given, 2 for bad input or a move that cannot be scheduled (named with its line).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..core.base.rotations import tt_to_matrix
+from ..core.cell.frames import CellFrames, tool_model
+from ..core.model.manipulator import Manipulator
+from ..core.motions import DEFAULT_PLAN_PSI_STEP, reported_parts
+from ..core.motions.schedule import LIMIT_KINDS, PathSchedule, schedule_path
+from ..core.motions.speeds import ACTUATOR_MODELS
+from ..errors import InputError
+from .cam import (
+    DEG_MIN,
+    MM_MIN,
+    _check_part,
+    _Part,
+    _positive,
+    cell_arguments,
+    read_cell_inputs,
+)
+from .commands import PROG
+from .inputs import PLOT_FORMATS, CliError, output_file
+from .schedule_plot import ScheduledPart, plot_schedule
+
+__all__ = ["SCHEDULE_DESCRIPTION", "SCHEDULE_HELP", "cmd_schedule", "schedule_arguments"]
+
+#: A move whose certified peak feed is this share below its ceiling runs slower than programmed.
+_BELOW = 0.01
+#: What the schedule covers (said in every result).
+SCHEDULE_COVERAGE = (
+    "actuator speeds and accelerations and the tool centre point's feed along the programmed "
+    "moves, certified between grid points; jerk, the controller's look-ahead and its servo "
+    "lag are the controller's"
+)
+
+
+def _ceilings(
+    part: _Part, feeds: tuple[float, float, float], rotary: NDArray[np.bool_]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Per move: the feed ceiling (m/s, inf: none), the rotary ceiling (rad/s) and the
+    programmed feed (m/s, or rad/s for a rotation; NaN: none)."""
+    rapid_feed, rotary_feed, feed_max = feeds
+    rapid = part.rapid[1:]
+    programmed = np.where(rapid, rapid_feed, part.feeds[1:])
+    programmed = np.where(rotary, rotary_feed, programmed)
+    cap = math.inf if math.isnan(feed_max) else feed_max
+    linear = np.minimum(np.where(np.isnan(programmed), math.inf, programmed), cap)
+    turning = np.full(rotary.size, math.inf if math.isnan(rotary_feed) else rotary_feed)
+    return linear, turning, programmed
+
+
+def _limited_by(schedule: PathSchedule, k: int, ceiling: float) -> dict[str, Any]:
+    """What holds move k below its ceiling: the limit at its fastest node (module docs)."""
+    if math.isfinite(ceiling) and schedule.feed_peak[k] >= (1.0 - _BELOW) * ceiling:
+        return {"kind": "feed", "actuator": None}
+    nodes = np.flatnonzero(schedule.node_move == k)
+    fastest = nodes[np.argmax(schedule.sdot[nodes])]
+    kind = LIMIT_KINDS[int(schedule.limit_kind[fastest])]
+    actuator = int(schedule.limit_actuator[fastest])
+    if kind == "rest":  # a move too short to leave rest between two stops
+        kind = "acceleration"
+    return {"kind": kind, "actuator": actuator + 1 if actuator >= 0 else None}
+
+
+def _finite(value: float) -> float | None:
+    return value if math.isfinite(value) else None
+
+
+def _part_document(
+    part: _Part,
+    schedule: PathSchedule,
+    ceilings: NDArray[np.float64],
+    rotary_ceiling: NDArray[np.float64],
+) -> dict[str, Any]:
+    moves = []
+    for k in range(schedule.t_start.size):
+        rotary = bool(schedule.rotary[k])
+        unit = DEG_MIN if rotary else MM_MIN
+        ceiling = float(rotary_ceiling[k] if rotary else ceilings[k])
+        entry: dict[str, Any] = {
+            "t_start_s": float(schedule.t_start[k]),
+            "t_end_s": float(schedule.t_end[k]),
+            ("feed_peak_deg_min" if rotary else "feed_peak_mm_min"): float(
+                schedule.feed_peak[k] / unit
+            ),
+            ("feed_ceiling_deg_min" if rotary else "feed_ceiling_mm_min"): _finite(ceiling / unit),
+            "limited_by": (
+                {"kind": "feed", "actuator": None}
+                if schedule.t_end[k] == schedule.t_start[k]
+                else _limited_by(schedule, k, ceiling)
+            ),
+            "actuator_speed_peak": schedule.speed_peak[k].tolist(),
+            "actuator_accel_peak": schedule.accel_peak[k].tolist(),
+            "rapid": bool(part.rapid[k + 1]),
+        }
+        if part.lines is not None:
+            entry["line"] = int(part.lines[k + 1])
+        moves.append(entry)
+    return {
+        "duration_s": schedule.duration,
+        "grid": [
+            {"s": float(s), "sdot": float(v)}
+            for s, v in zip(schedule.s, schedule.sdot, strict=True)
+        ],
+        "moves": moves,
+        "stops": [int(k) for k in np.flatnonzero(schedule.stops)],
+        "intervals": schedule.intervals,
+    }
+
+
+def _schedule_part(
+    platform: Manipulator,
+    part: _Part,
+    cell: CellFrames,
+    options: argparse.Namespace,
+    feeds: tuple[float, float, float],
+) -> tuple[dict[str, Any], ScheduledPart, float]:
+    """Check one part as ``check-path`` does, then schedule it; returns its document, the
+    part as scheduled and its programmed duration (NaN: some move has no feed)."""
+    model = tool_model(platform, part.tool)
+    result, checked_document, _ = _check_part(platform, part, cell, options, feeds[:2])
+    checked, _ = reported_parts(result)
+    rotations = tt_to_matrix(checked.waypoints.angles)
+    positions = checked.waypoints.positions
+    translation = np.linalg.norm(np.diff(positions, axis=0), axis=1)
+    rotary = translation == 0.0
+    for curves in (part.arcs, part.beziers):
+        if curves is not None:  # a curve's chord may be 0 (a full circle): not a rotation
+            rotary &= np.isnan(curves[:, 0])
+    linear, turning, programmed = _ceilings(part, feeds, rotary)
+    stops = np.zeros(len(positions), dtype=bool)
+    if options.stop_at_rapids:
+        stops[1:-1] = part.rapid[1:-1] != part.rapid[2:]
+    try:
+        schedule = schedule_path(
+            model,
+            positions,
+            rotations,
+            speed_limits=cell.actuator_speed_max,
+            accel_limits=cell.actuator_accel_max,
+            feeds=linear,
+            rotary_feeds=turning,
+            stops=stops,
+            arcs=part.arcs,
+            beziers=part.beziers,
+        )
+    except InputError as error:
+        where = str(error)
+        if part.lines is not None and where.startswith("move "):
+            number = int(where.split(":", 1)[0].split()[1])
+            where = f"CL file {options.file}: line {part.lines[number]}: {where}"
+        raise CliError(where) from error
+    lengths = schedule.length
+    with np.errstate(invalid="ignore", divide="ignore"):
+        durations = np.where(lengths == 0.0, 0.0, lengths / programmed)
+    programmed_time = float(np.sum(durations)) if np.all(np.isfinite(durations)) else math.nan
+    document = _part_document(part, schedule, linear, turning)
+    document["path_ok"] = bool(checked_document["ok"])
+    document["programmed_duration_s"] = _finite(programmed_time)
+    if len(positions) != len(part.positions):  # pragma: no cover - the checks keep every waypoint
+        msg = "schedule: the checked path has other waypoints than the file"
+        raise CliError(msg)
+    scheduled = ScheduledPart(
+        model, positions, rotations, part.arcs, part.beziers, programmed, schedule
+    )
+    return document, scheduled, programmed_time
+
+
+def cmd_schedule(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
+    """``schedule``: the certified fastest schedule of FILE (module documentation)."""
+    plot = (
+        None
+        if options.plot is None
+        else output_file(options.plot, "--plot", force=options.force, suffixes=PLOT_FORMATS)
+    )
+    options.interpolation = "slerp"  # the controller's moves, as the speeds take them
+    feed_max = _positive(options.feed_max_mm_min, "--feed-max-mm-min", "mm/min") * MM_MIN
+    platform, cell, frame, (rapid, rotary), parts, _ = read_cell_inputs(options, err)
+    documents: list[dict[str, Any]] = []
+    schedules: list[ScheduledPart] = []
+    programmed: list[float] = []
+    for part in parts:
+        document, scheduled, planned = _schedule_part(
+            platform, part, cell, options, (rapid, rotary, feed_max)
+        )
+        document["first_waypoint"] = part.first
+        documents.append(document)
+        schedules.append(scheduled)
+        programmed.append(planned)
+    total = float(sum(s.schedule.duration for s in schedules))
+    planned_total = float(sum(programmed))
+    unit = ACTUATOR_MODELS[platform.architecture].unit
+    report: dict[str, Any] = {
+        "duration_s": total,
+        "programmed_duration_s": _finite(planned_total),
+        "path_ok": all(d["path_ok"] for d in documents),
+        "frame": frame,
+        "actuator_unit": unit,
+        "actuator_speed_max": cell.actuator_speed_max.tolist(),
+        "actuator_accel_max": cell.actuator_accel_max.tolist(),
+        "covers": SCHEDULE_COVERAGE,
+    }
+    if len(documents) == 1:
+        report.update(documents[0])
+        report["duration_s"], report["programmed_duration_s"] = total, _finite(planned_total)
+    else:
+        report["parts"] = documents
+    if plot is not None:
+        plot_schedule(schedules, cell, unit, Path(plot))
+    if options.json:
+        out.write(json.dumps(report, allow_nan=False) + "\n")
+    else:
+        _text(report, documents, unit, out)
+        if plot is not None:
+            out.write(f"  plot: {plot}\n")
+    if not report["path_ok"]:
+        err.write(f"{PROG}: the path does not run (check-path FILE says where); scheduled anyway\n")
+    return 0
+
+
+def _text(report: dict[str, Any], documents: list[dict[str, Any]], unit: str, out: IO[str]) -> None:
+    planned = report["programmed_duration_s"]
+    against = (
+        "no programmed time (a move has no feed)"
+        if planned is None
+        else (f"{planned:.3f} s at the programmed feeds")
+    )
+    moves = sum(len(d["moves"]) for d in documents)
+    stops = sum(len(d["stops"]) for d in documents)
+    out.write(
+        f"schedule: {report['duration_s']:.3f} s ({against}), {moves} moves, "
+        f"{stops} stops (ends, corners{', tool changes' if len(documents) > 1 else ''})\n"
+    )
+    speed = ", ".join(f"{v:g}" for v in sorted(set(report["actuator_speed_max"])))
+    accel = ", ".join(f"{v:g}" for v in sorted(set(report["actuator_accel_max"])))
+    out.write(
+        f"  limits: actuator speed {speed} {unit}/s, acceleration {accel} {unit}/s² (0: none)\n"
+    )
+    slow = []
+    for p, document in enumerate(documents):
+        for k, move in enumerate(document["moves"]):
+            limit = move["limited_by"]
+            if limit["kind"] == "feed":
+                continue
+            where = f"line {move['line']}" if "line" in move else f"move {k + 1}"
+            if len(documents) > 1:
+                where = f"part {p}, {where}"
+            peak = move.get("feed_peak_mm_min", move.get("feed_peak_deg_min"))
+            per = "mm/min" if "feed_peak_mm_min" in move else "deg/min"
+            ceiling = move.get("feed_ceiling_mm_min", move.get("feed_ceiling_deg_min"))
+            of = f" of {ceiling:.0f}" if ceiling is not None else ""
+            slow.append(
+                f"    {where}: peak {peak:.0f}{of} {per}, limited by actuator "
+                f"{limit['actuator']} {limit['kind']}\n"
+            )
+    out.write(f"  below the programmed feed: {len(slow)} move(s)\n")
+    for line in slow[:20]:
+        out.write(line)
+    if len(slow) > 20:
+        out.write(f"    ... and {len(slow) - 20} more (--json lists every move)\n")
+    out.write(f"  covers: {report['covers']}\n")
+
+
+SCHEDULE_HELP = (
+    "fastest certified feed schedule along a path: actuator speed and acceleration limits, "
+    "the programmed feed as a ceiling (exit 0 scheduled, 2 bad input)"
+)
+SCHEDULE_DESCRIPTION = (
+    "FILE is what check-path takes (a path CSV or an APT CL file, in the work frame). Along "
+    "the same moves, the time law that minimises the total time with every actuator within "
+    "limits.actuator_speed_max and limits.actuator_accel_max, the tool centre point within "
+    "each move's programmed feed (and --feed-max-mm-min), at rest at both ends and at every "
+    "corner; the limits hold between grid points too (certified bounds, derived in "
+    "hexapod_workspace/core/motions/schedule.py)."
+)
+
+
+def schedule_arguments(sub: argparse.ArgumentParser) -> None:
+    """The ``schedule`` command's options."""
+    sub.add_argument("file", metavar="FILE", help="path CSV or APT CL file (as check-path)")
+    cell_arguments(sub)
+    sub.add_argument(
+        "--feed-max-mm-min",
+        type=float,
+        metavar="F",
+        help="ceiling of every move's feed, mm/min (default: the programmed feeds only)",
+    )
+    sub.add_argument(
+        "--stop-at-rapids",
+        action="store_true",
+        help="also rest where RAPID moves begin and end",
+    )
+    sub.add_argument(
+        "--tol-deg",
+        type=float,
+        metavar="T",
+        help="tolerance of the path check (path_ok), degrees of platform rotation",
+    )
+    sub.add_argument(
+        "--psi-step-deg",
+        type=float,
+        default=math.degrees(DEFAULT_PLAN_PSI_STEP),
+        metavar="S",
+        help="tool axes (CL files): torsion planner's grid step, degrees (default %(default)g)",
+    )
+    sub.add_argument(
+        "--max-dpsi-deg",
+        type=float,
+        metavar="D",
+        help="tool axes: largest torsion change per move, degrees (default: no limit)",
+    )
+    sub.add_argument(
+        "--plot",
+        metavar="FILE.png",
+        help="feed along the path against the programmed feed, and each actuator's speed and "
+        "acceleration against its limits, over time",
+    )
+    sub.add_argument(
+        "--force", action="store_true", help="replace an existing --plot file not of ours"
+    )
