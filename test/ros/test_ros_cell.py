@@ -156,6 +156,7 @@ def test_cell_parameters_round_trip_through_the_node(client, workspace_node):
     names = ["tool.offset", "tool.orientation", "tool.number", "work.origin"]
     names += ["work.orientation", "work.frame_id", "tools.T2.offset", "tools.T2.orientation"]
     names += ["tools.T1.offset", "tools.T1.orientation", "limits.actuator_speed_max"]
+    names += ["limits.actuator_accel_max"]
     values = client.call(
         GetParameters, f"{NODE}/get_parameters", GetParameters.Request(names=names)
     ).values
@@ -170,6 +171,7 @@ def test_cell_parameters_round_trip_through_the_node(client, workspace_node):
     np.testing.assert_array_equal(got["tools.T2.orientation"].double_array_value, T2_ANGLES)
     np.testing.assert_array_equal(got["tools.T1.orientation"].double_array_value, [0.0] * 3)
     assert list(got["limits.actuator_speed_max"].double_array_value) == [SPEED_MAX]
+    assert list(got["limits.actuator_accel_max"].double_array_value) == [0.0]  # the default
 
     t_oc = tool_poses(1, seed=1)[0]
     response = client.call(
@@ -346,6 +348,7 @@ def test_a_tool_change_selects_the_table_entry_and_bad_changes_leave_it(
         (double_array("work.origin", [0.0, math.inf, 0.0]), ["work.origin", "inf"]),
         (double_array("tools.T9.orientation", [0.0, 0.0, 0.0]), ["tools.T9.offset", "missing"]),
         (double_array("limits.actuator_speed_max", [-1.0]), ["actuator_speed_max", "-1"]),
+        (double_array("limits.actuator_accel_max", [0.5, 0.5]), ["actuator_accel_max", "1 or 6"]),
     ):
         (result,) = set_parameters(client, parameter)
         assert not result.successful, parameter.name
