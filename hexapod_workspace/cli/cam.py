@@ -105,6 +105,7 @@ __all__ = [
     "SPEED_COVERAGE",
     "cell_arguments",
     "cell_pipeline_applies",
+    "check_part_path",
     "check_path_any_arguments",
     "cmd_check_cell_path",
     "cmd_check_path_any",
@@ -358,15 +359,11 @@ def work_json(work: WorkFrame) -> dict[str, Any]:
     }
 
 
-def _check_part(
-    platform: Manipulator,
-    part: _Part,
-    cell: CellFrames,
-    options: argparse.Namespace,
-    feeds: tuple[float, float],
-) -> tuple[PathCheck | TorsionPlan, dict[str, Any], tuple[dict[str, Any], dict[str, Any]]]:
-    """Check (or plan) one part and add the speed keys to its document; also return the part
-    as a ``~/check_path`` call (request and response fields, base frame) for ``--record``."""
+def check_part_path(
+    platform: Manipulator, part: _Part, options: argparse.Namespace
+) -> tuple[Manipulator, PathCheck | TorsionPlan, PathCheck, float]:
+    """The certified check of one part, as ``check-path`` runs it: the part's tool model, the
+    check (or the torsion plan, for tool axes), its psi = 0 baseline and the tolerance (rad)."""
     model = tool_model(platform, part.tool)
     tolerance = (
         DEFAULT_PATH_TOLERANCE
@@ -404,6 +401,19 @@ def _check_part(
             beziers=part.beziers,
         )
         baseline = psi_zero_baseline(model, result)
+    return model, result, baseline, tolerance
+
+
+def _check_part(
+    platform: Manipulator,
+    part: _Part,
+    cell: CellFrames,
+    options: argparse.Namespace,
+    feeds: tuple[float, float],
+) -> tuple[PathCheck | TorsionPlan, dict[str, Any], tuple[dict[str, Any], dict[str, Any]]]:
+    """Check (or plan) one part and add the speed keys to its document; also return the part
+    as a ``~/check_path`` call (request and response fields, base frame) for ``--record``."""
+    model, result, baseline, tolerance = check_part_path(platform, part, options)
     document = path_to_json(result, baseline, part.degrees if part.written else None)
     checked, _ = reported_parts(result)
     moves = len(checked.segments)

@@ -37,7 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core.base.rotations import tt_to_matrix
-from ..core.cell.frames import CellFrames, tool_model
+from ..core.cell.frames import CellFrames
 from ..core.model.manipulator import Manipulator
 from ..core.motions import DEFAULT_PLAN_PSI_STEP, reported_parts
 from ..core.motions.schedule import LIMIT_KINDS, PathSchedule, schedule_path
@@ -46,10 +46,11 @@ from ..errors import InputError
 from .cam import (
     DEG_MIN,
     MM_MIN,
-    _check_part,
+    _finite,
     _Part,
     _positive,
     cell_arguments,
+    check_part_path,
     read_cell_inputs,
 )
 from .commands import PROG
@@ -69,17 +70,15 @@ SCHEDULE_COVERAGE = (
 
 
 def _ceilings(
-    part: _Part, feeds: tuple[float, float, float], rotary: NDArray[np.bool_]
+    part: _Part, feeds: tuple[float, float, float]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """Per move: the feed ceiling (m/s, inf: none), the rotary ceiling (rad/s) and the
-    programmed feed (m/s, or rad/s for a rotation; NaN: none)."""
+    """Per move: the feed ceiling (m/s, inf: none), the rotary ceiling of moves without
+    translation (rad/s) and the programmed feed of moves with translation (m/s, NaN: none)."""
     rapid_feed, rotary_feed, feed_max = feeds
-    rapid = part.rapid[1:]
-    programmed = np.where(rapid, rapid_feed, part.feeds[1:])
-    programmed = np.where(rotary, rotary_feed, programmed)
+    programmed = np.where(part.rapid[1:], rapid_feed, part.feeds[1:])
     cap = math.inf if math.isnan(feed_max) else feed_max
     linear = np.minimum(np.where(np.isnan(programmed), math.inf, programmed), cap)
-    turning = np.full(rotary.size, math.inf if math.isnan(rotary_feed) else rotary_feed)
+    turning = np.full(linear.size, math.inf if math.isnan(rotary_feed) else rotary_feed)
     return linear, turning, programmed
 
 
@@ -94,10 +93,6 @@ def _limited_by(schedule: PathSchedule, k: int, ceiling: float) -> dict[str, Any
     if kind == "rest":  # a move too short to leave rest between two stops
         kind = "acceleration"
     return {"kind": kind, "actuator": actuator + 1 if actuator >= 0 else None}
-
-
-def _finite(value: float) -> float | None:
-    return value if math.isfinite(value) else None
 
 
 def _part_document(
@@ -151,17 +146,11 @@ def _schedule_part(
 ) -> tuple[dict[str, Any], ScheduledPart, float]:
     """Check one part as ``check-path`` does, then schedule it; returns its document, the
     part as scheduled and its programmed duration (NaN: some move has no feed)."""
-    model = tool_model(platform, part.tool)
-    result, checked_document, _ = _check_part(platform, part, cell, options, feeds[:2])
-    checked, _ = reported_parts(result)
+    model, result, _, _ = check_part_path(platform, part, options)
+    checked, plan = reported_parts(result)
     rotations = tt_to_matrix(checked.waypoints.angles)
     positions = checked.waypoints.positions
-    translation = np.linalg.norm(np.diff(positions, axis=0), axis=1)
-    rotary = translation == 0.0
-    for curves in (part.arcs, part.beziers):
-        if curves is not None:  # a curve's chord may be 0 (a full circle): not a rotation
-            rotary &= np.isnan(curves[:, 0])
-    linear, turning, programmed = _ceilings(part, feeds, rotary)
+    linear, turning, programmed = _ceilings(part, feeds)
     stops = np.zeros(len(positions), dtype=bool)
     if options.stop_at_rapids:
         stops[1:-1] = part.rapid[1:-1] != part.rapid[2:]
@@ -184,16 +173,14 @@ def _schedule_part(
             number = int(where.split(":", 1)[0].split()[1])
             where = f"CL file {options.file}: line {part.lines[number]}: {where}"
         raise CliError(where) from error
-    lengths = schedule.length
+    # moves without translation are programmed as a rotation rate (rad/s)
+    programmed = np.where(schedule.rotary, feeds[1], programmed)
     with np.errstate(invalid="ignore", divide="ignore"):
-        durations = np.where(lengths == 0.0, 0.0, lengths / programmed)
+        durations = np.where(schedule.length == 0.0, 0.0, schedule.length / programmed)
     programmed_time = float(np.sum(durations)) if np.all(np.isfinite(durations)) else math.nan
     document = _part_document(part, schedule, linear, turning)
-    document["path_ok"] = bool(checked_document["ok"])
+    document["path_ok"] = bool(checked.ok and (plan is None or plan.ok))
     document["programmed_duration_s"] = _finite(programmed_time)
-    if len(positions) != len(part.positions):  # pragma: no cover - the checks keep every waypoint
-        msg = "schedule: the checked path has other waypoints than the file"
-        raise CliError(msg)
     scheduled = ScheduledPart(
         model, positions, rotations, part.arcs, part.beziers, programmed, schedule
     )

@@ -20,7 +20,8 @@ __all__ = ["ScheduledPart", "plot_schedule"]
 @dataclass(frozen=True)
 class ScheduledPart:
     """One part as it was scheduled: its tool model, waypoints (base frame), curved moves,
-    programmed feeds per move (m/s, NaN: none) and schedule."""
+    programmed feeds per move (m/s, or rad/s for a rotation without translation; NaN: none)
+    and schedule."""
 
     model: Manipulator
     positions: NDArray[np.float64]

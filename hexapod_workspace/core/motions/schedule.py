@@ -352,13 +352,17 @@ def schedule_path(
 
     if active.size == 0:
         return _still_schedule(count, stop_at, rotary, length)
-    sub = SlerpMoves(
-        manipulator,
-        p[:-1][active],
-        p[1:][active],
-        r[:-1][active],
-        r[1:][active],
-        None if moves.arcs is None else moves.arcs.take(active),
+    sub = (
+        moves  # the moves that move: all of them, or a new batch without the still ones
+        if active.size == count
+        else SlerpMoves(
+            manipulator,
+            p[:-1][active],
+            p[1:][active],
+            r[:-1][active],
+            r[1:][active],
+            None if moves.arcs is None else moves.arcs.take(active),
+        )
     )
     grid = certified_intervals(
         manipulator, model, sub, active.size, weights, relative, MAX_SCHEDULE_INTERVALS, local=True
@@ -567,8 +571,8 @@ def _rate_derivatives(
     manipulator: Manipulator, sub: SlerpMoves, moves: NDArray[np.int64], s: NDArray[np.float64]
 ) -> NDArray[np.float64]:
     """g_i' = d²q_i/ds² (n, 6) at (moves, s) (module documentation; NaN on curved moves)."""
-    motion = sub.motion(moves, s)
-    v, dv = motion.joint_velocities, sub.joint_accelerations(moves, s)
+    motion, dv = sub.motion_with_accelerations(moves, s)
+    v = motion.joint_velocities
     arch = architectures.module(manipulator.architecture)
     if not arch.MOVING_BASE:  # g' = (|v|² − g²)/ℓ + n·v'
         d = motion.platform - manipulator.base_joints
@@ -667,8 +671,6 @@ def _pass(
     """One pass (1: forward, −1: backward): each node's largest x from its predecessor, capped;
     also the actuator whose acceleration bounds the step (−1: the cap or a junction)."""
     total = cap.size
-    x = np.empty(total)
-    act = np.full(total, -1, dtype=np.int64)
     # predecessor of each node in this direction: an interval (its index) or a junction
     step_interval = np.full(total, -1, dtype=np.int64)
     junction_of = np.full(total, -1, dtype=np.int64)
@@ -681,12 +683,17 @@ def _pass(
         junction_of[ends[:-1]] = np.arange(ends.size - 1)
         order = range(total - 1, -1, -1)
     lam_rows, mu_rows = lam.tolist(), mu.tolist()
-    caps = cap.tolist()
+    caps, steps, junctions, factors = (
+        cap.tolist(),
+        step_interval.tolist(),
+        junction_of.tolist(),
+        factor.tolist(),
+    )
     values = [0.0] * total
     acts = [-1] * total
     previous, previous_act = 0.0, -1
     for node in order:
-        interval = int(step_interval[node])
+        interval = steps[node]
         if interval >= 0:
             best, who = caps[node], -1
             for i, (l_i, m_i) in enumerate(zip(lam_rows[interval], mu_rows[interval], strict=True)):
@@ -694,11 +701,11 @@ def _pass(
                 if reach < best:
                     best, who = reach, i
         else:
-            junction = int(junction_of[node])
+            junction = junctions[node]
             if junction < 0:  # the first node of the pass
                 best, who = caps[node], -1
             else:
-                scale = float(factor[junction])
+                scale = factors[junction]
                 reach = (
                     previous * scale
                     if direction > 0
@@ -707,9 +714,7 @@ def _pass(
                 best, who = (reach, previous_act) if reach < caps[node] else (caps[node], -1)
         values[node], acts[node] = best, who
         previous, previous_act = best, who
-    x[:] = values
-    act[:] = acts
-    return x, act
+    return np.array(values), np.array(acts, dtype=np.int64)
 
 
 def _still_schedule(

@@ -386,8 +386,10 @@ class SlerpMoves:
         if arcs is not None:
             self.jerk = np.where(arcs.mask[:, None], np.nan, self.jerk)
 
-    def motion(self, moves: NDArray[np.int64], s: NDArray[np.float64]) -> LegMotion:
-        """Leg quantities of moves ``moves`` (n,) at parameters ``s`` (n,)."""
+    def _arms(
+        self, moves: NDArray[np.int64], s: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """R(s)·b_i (n, 6, 3) and the angular velocity per unit s, w = Ω·u (n, 3)."""
         angle = s * self.omega[moves]
         u = self.axis[moves]
         cross = np.zeros((u.shape[0], 3, 3))
@@ -399,7 +401,16 @@ class SlerpMoves:
             + (1.0 - np.cos(angle))[:, None, None] * (cross @ cross)
         )
         rotation = turn @ self.r0[moves]
-        arms = np.einsum("nij,kj->nki", rotation, self.joints)  # R·b_i (n, 6, 3)
+        arms: NDArray[np.float64] = np.einsum("nij,kj->nki", rotation, self.joints)
+        return arms, (self.omega[moves])[:, None] * u
+
+    def _leg_motion(
+        self,
+        moves: NDArray[np.int64],
+        s: NDArray[np.float64],
+        arms: NDArray[np.float64],
+        w: NDArray[np.float64],
+    ) -> LegMotion:
         position = self.p0[moves] + s[:, None] * self.dp[moves]
         linear = self.dp[moves]
         if self.arcs is not None:
@@ -408,27 +419,25 @@ class SlerpMoves:
                 position[on_arc] = self.arcs.positions(moves[on_arc], s[on_arc])
                 linear = linear.copy()
                 linear[on_arc] = self.arcs.velocities(moves[on_arc], s[on_arc])
-        w = (self.omega[moves])[:, None] * u
         velocities = linear[:, None, :] + np.cross(w[:, None, :], arms)
         return LegMotion(position[:, None, :] + arms, velocities)
 
-    def joint_accelerations(
+    def motion(self, moves: NDArray[np.int64], s: NDArray[np.float64]) -> LegMotion:
+        """Leg quantities of moves ``moves`` (n,) at parameters ``s`` (n,)."""
+        arms, w = self._arms(moves, s)
+        return self._leg_motion(moves, s, arms, w)
+
+    def motion_with_accelerations(
         self, moves: NDArray[np.int64], s: NDArray[np.float64]
-    ) -> NDArray[np.float64]:
-        """dv_i/ds = w × (w × R(s)·b_i) (n, 6, 3) on straight moves; NaN on curved ones."""
-        angle = s * self.omega[moves]
-        u = self.axis[moves]
-        w = self.omega[moves][:, None] * u
-        r0b = np.einsum("nij,kj->nki", self.r0[moves], self.joints)
-        # R(s)·b = Rodrigues about u of R₀·b
-        c, sn = np.cos(angle)[:, None, None], np.sin(angle)[:, None, None]
-        along = np.einsum("nj,nkj->nk", u, r0b)[:, :, None] * u[:, None, :]
-        arms = c * r0b + sn * np.cross(u[:, None, :], r0b) + (1.0 - c) * along
-        wn = np.broadcast_to(w[:, None, :], arms.shape)
-        accelerations: NDArray[np.float64] = np.cross(wn, np.cross(wn, arms))
+    ) -> tuple[LegMotion, NDArray[np.float64]]:
+        """:meth:`motion` and dv_i/ds = w × (w × R(s)·b_i) (n, 6, 3) on straight moves (NaN on
+        curved ones)."""
+        arms, w = self._arms(moves, s)
+        spin = np.broadcast_to(w[:, None, :], arms.shape)
+        accelerations: NDArray[np.float64] = np.cross(spin, np.cross(spin, arms))
         if self.arcs is not None:
             accelerations[self.arcs.mask[moves]] = np.nan
-        return accelerations
+        return self._leg_motion(moves, s, arms, w), accelerations
 
 
 def _weights(limits: NDArray[np.float64]) -> NDArray[np.float64]:
