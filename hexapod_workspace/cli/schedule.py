@@ -40,7 +40,12 @@ from ..core.base.rotations import tt_to_matrix
 from ..core.cell.frames import CellFrames
 from ..core.model.manipulator import Manipulator
 from ..core.motions import DEFAULT_PLAN_PSI_STEP, reported_parts
-from ..core.motions.schedule import LIMIT_KINDS, PathSchedule, schedule_path
+from ..core.motions.schedule import (
+    PathSchedule,
+    limited_by,
+    programmed_duration,
+    schedule_path,
+)
 from ..core.motions.speeds import ACTUATOR_MODELS
 from ..errors import InputError
 from .cam import (
@@ -59,8 +64,6 @@ from .schedule_plot import ScheduledPart, plot_schedule
 
 __all__ = ["SCHEDULE_DESCRIPTION", "SCHEDULE_HELP", "cmd_schedule", "schedule_arguments"]
 
-#: A move whose certified peak feed is this share below its ceiling runs slower than programmed.
-_BELOW = 0.01
 #: What the schedule covers (said in every result).
 SCHEDULE_COVERAGE = (
     "actuator speeds and accelerations and the tool centre point's feed along the programmed "
@@ -82,19 +85,6 @@ def _ceilings(
     return linear, turning, programmed
 
 
-def _limited_by(schedule: PathSchedule, k: int, ceiling: float) -> dict[str, Any]:
-    """What holds move k below its ceiling: the limit at its fastest node (module docs)."""
-    if math.isfinite(ceiling) and schedule.feed_peak[k] >= (1.0 - _BELOW) * ceiling:
-        return {"kind": "feed", "actuator": None}
-    nodes = np.flatnonzero(schedule.node_move == k)
-    fastest = nodes[np.argmax(schedule.sdot[nodes])]
-    kind = LIMIT_KINDS[int(schedule.limit_kind[fastest])]
-    actuator = int(schedule.limit_actuator[fastest])
-    if kind == "rest":  # a move too short to leave rest between two stops
-        kind = "acceleration"
-    return {"kind": kind, "actuator": actuator + 1 if actuator >= 0 else None}
-
-
 def _part_document(
     part: _Part,
     schedule: PathSchedule,
@@ -102,10 +92,12 @@ def _part_document(
     rotary_ceiling: NDArray[np.float64],
 ) -> dict[str, Any]:
     moves = []
+    ceiling_of = np.where(schedule.rotary, rotary_ceiling, ceilings)
+    kinds, actuators = limited_by(schedule, ceiling_of)
     for k in range(schedule.t_start.size):
         rotary = bool(schedule.rotary[k])
         unit = DEG_MIN if rotary else MM_MIN
-        ceiling = float(rotary_ceiling[k] if rotary else ceilings[k])
+        ceiling = float(ceiling_of[k])
         entry: dict[str, Any] = {
             "t_start_s": float(schedule.t_start[k]),
             "t_end_s": float(schedule.t_end[k]),
@@ -113,11 +105,7 @@ def _part_document(
                 schedule.feed_peak[k] / unit
             ),
             ("feed_ceiling_deg_min" if rotary else "feed_ceiling_mm_min"): _finite(ceiling / unit),
-            "limited_by": (
-                {"kind": "feed", "actuator": None}
-                if schedule.t_end[k] == schedule.t_start[k]
-                else _limited_by(schedule, k, ceiling)
-            ),
+            "limited_by": {"kind": kinds[k], "actuator": int(actuators[k]) or None},
             "actuator_speed_peak": schedule.speed_peak[k].tolist(),
             "actuator_accel_peak": schedule.accel_peak[k].tolist(),
             "rapid": bool(part.rapid[k + 1]),
@@ -173,11 +161,9 @@ def _schedule_part(
             number = int(where.split(":", 1)[0].split()[1])
             where = f"CL file {options.file}: line {part.lines[number]}: {where}"
         raise CliError(where) from error
+    programmed_time = programmed_duration(schedule, programmed, feeds[1])
     # moves without translation are programmed as a rotation rate (rad/s)
     programmed = np.where(schedule.rotary, feeds[1], programmed)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        durations = np.where(schedule.length == 0.0, 0.0, schedule.length / programmed)
-    programmed_time = float(np.sum(durations)) if np.all(np.isfinite(durations)) else math.nan
     document = _part_document(part, schedule, linear, turning)
     document["path_ok"] = bool(checked.ok and (plan is None or plan.ok))
     document["programmed_duration_s"] = _finite(programmed_time)

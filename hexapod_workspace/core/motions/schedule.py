@@ -107,6 +107,8 @@ __all__ = [
     "LIMIT_KINDS",
     "PathSchedule",
     "ScheduleProfiles",
+    "limited_by",
+    "programmed_duration",
     "schedule_path",
     "schedule_profiles",
 ]
@@ -120,6 +122,8 @@ DEFAULT_CORNER = 1e-6
 MAX_SCHEDULE_INTERVALS = 400_000
 #: Rounds of refinement where the schedule ramps.
 REFINE_ROUNDS = 16
+#: A move whose certified peak feed is this share below its ceiling runs slower than programmed.
+BELOW_CEILING = 0.01
 #: What fixes a node's speed: ``rest`` (a stop), ``feed``, ``velocity`` or ``acceleration``.
 LIMIT_KINDS = ("rest", "feed", "velocity", "acceleration")
 _REST, _FEED, _VELOCITY, _ACCELERATION = range(4)
@@ -739,6 +743,69 @@ def _still_schedule(
         length=length,
         intervals=0,
     )
+
+
+def limited_by(schedule: PathSchedule, ceilings: ArrayLike) -> tuple[list[str], NDArray[np.int64]]:
+    """What holds each move of ``schedule`` below its ceiling.
+
+    A move whose certified peak feed is within :data:`BELOW_CEILING` of its ceiling, and a
+    move that takes no time, is held by its ``feed``; otherwise by what fixed the speed at its
+    fastest node: an actuator's ``velocity`` or ``acceleration`` limit (a move too short to
+    leave rest between two stops counts as acceleration).
+
+    Parameters
+    ----------
+    schedule : PathSchedule
+    ceilings : array_like, shape (M,)
+        Each move's feed ceiling, m/s (rad/s for a rotary move); inf: none.
+
+    Returns
+    -------
+    kinds : list of str, length M
+        ``"feed"``, ``"velocity"`` or ``"acceleration"``.
+    actuators : ndarray, shape (M,), int
+        The limiting actuator, 1-based; 0 for ``feed``.
+    """
+    ceiling = np.asarray(ceilings, dtype=np.float64)
+    count = schedule.t_start.size
+    kinds = ["feed"] * count
+    actuators = np.zeros(count, dtype=np.int64)
+    for k in range(count):
+        top = float(ceiling[k])
+        if schedule.t_end[k] == schedule.t_start[k] or (
+            math.isfinite(top) and schedule.feed_peak[k] >= (1.0 - BELOW_CEILING) * top
+        ):
+            continue
+        nodes = np.flatnonzero(schedule.node_move == k)
+        fastest = nodes[np.argmax(schedule.sdot[nodes])]
+        kind = LIMIT_KINDS[int(schedule.limit_kind[fastest])]
+        kinds[k] = "acceleration" if kind == "rest" else kind
+        if kinds[k] != "feed":
+            actuators[k] = int(schedule.limit_actuator[fastest]) + 1
+    return kinds, actuators
+
+
+def programmed_duration(schedule: PathSchedule, feeds: ArrayLike, rotary_feed: float) -> float:
+    """The time of the path with every move at its programmed feed (no ramps), s.
+
+    Parameters
+    ----------
+    schedule : PathSchedule
+        Its ``length`` and ``rotary`` give each move's length (m) or rotation (rad).
+    feeds : array_like, shape (M,)
+        Programmed feed of each translating move, m/s (NaN: none).
+    rotary_feed : float
+        Rotation rate of the moves without translation, rad/s (NaN: none).
+
+    Returns
+    -------
+    float
+        NaN when a move that moves has no feed; moves that do not move take no time.
+    """
+    programmed = np.where(schedule.rotary, rotary_feed, np.asarray(feeds, dtype=np.float64))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        times = np.where(schedule.length == 0.0, 0.0, schedule.length / programmed)
+    return float(np.sum(times)) if np.all(np.isfinite(times)) else math.nan
 
 
 @dataclass(frozen=True)
