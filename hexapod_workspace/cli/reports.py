@@ -530,7 +530,7 @@ def _atlas_json(index: int, record: AtlasRecord, start_ns: int) -> dict[str, Any
 
 
 def log_report(summary: LogSummary) -> dict[str, Any]:
-    from ..logs.paths import path_call_report
+    from ..logs.paths import path_call_report, schedule_call_report
 
     contents = summary.contents
     start = contents.start_ns or 0
@@ -559,6 +559,9 @@ def log_report(summary: LogSummary) -> dict[str, Any]:
         },
         "path_checks": [
             path_call_report(i + 1, call, start) for i, call in enumerate(summary.paths)
+        ],
+        "schedules": [
+            schedule_call_report(i + 1, call, start) for i, call in enumerate(summary.schedules)
         ],
         "trigger_calls": [
             {
@@ -614,7 +617,7 @@ def jsonable(value: Any) -> Any:
 
 
 def log_report_text(report: dict[str, Any], out: IO[str]) -> None:
-    from ..logs.paths import path_call_line
+    from ..logs.paths import path_call_line, schedule_call_line
 
     if report["damaged"]:
         state = (
@@ -676,6 +679,9 @@ def log_report_text(report: dict[str, Any], out: IO[str]) -> None:
     if report["path_checks"]:
         out.write(f"path checks: {len(report['path_checks'])}\n")
         _capped([path_call_line(call) for call in report["path_checks"]], "path checks", out)
+    if report["schedules"]:
+        out.write(f"schedules: {len(report['schedules'])}\n")
+        _capped([schedule_call_line(call) for call in report["schedules"]], "schedules", out)
     if report["trigger_calls"]:
         out.write(f"trigger calls: {len(report['trigger_calls'])}\n")
         lines = [

@@ -170,6 +170,14 @@ INTERFACES: tuple[Interface, ...] = (
         extension="hexapod_workspace.ros.paths",
     ),
     Interface(
+        "schedule_path",
+        "service",
+        f"{_MSGS}/srv/SchedulePath",
+        "the fastest schedule along a path that is certified to keep every actuator within "
+        "its speed and acceleration limits and the tool within each move's feed",
+        extension="hexapod_workspace.ros.schedule",
+    ),
+    Interface(
         "axis_limits",
         "publisher",
         f"{_MSGS}/msg/AxisLimits",

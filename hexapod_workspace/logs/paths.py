@@ -37,6 +37,8 @@ __all__ = [
     "path_call_line",
     "path_call_report",
     "pose_fields",
+    "schedule_call_line",
+    "schedule_call_report",
     "segment_check_fields",
     "segment_checks_fields",
 ]
@@ -309,13 +311,21 @@ def path_call_report(index: int, call: dict[str, Any], start_ns: int) -> dict[st
     }
 
 
-def path_call_line(report: dict[str, Any]) -> str:
-    """One text line for a :func:`path_call_report`."""
+def _call_head(report: dict[str, Any]) -> tuple[str, str | None]:
+    """A recorded call's line head, and its whole line when it has no answer or failed."""
     head = f"[{report['index']}] +{report['time_s']:.3f} s {report['service']}"
     if not report["answered"]:
-        return f"{head}: no response recorded"
+        return head, f"{head}: no response recorded"
     if not report["success"]:
-        return f"{head}: failed: {report['message']}"
+        return head, f"{head}: failed: {report['message']}"
+    return head, None
+
+
+def path_call_line(report: dict[str, Any]) -> str:
+    """One text line for a :func:`path_call_report`."""
+    head, unanswered = _call_head(report)
+    if unanswered is not None:
+        return unanswered
     count = report["n_waypoints"] if report["n_waypoints"] is not None else "?"
     mode = ", torsion planned" if report["planned_torsion"] else ""
     return (
@@ -328,4 +338,54 @@ def path_call_line(report: dict[str, Any]) -> str:
             if report.get("moves_to_slow_down")
             else ""
         )
+    )
+
+
+def schedule_call_report(index: int, call: dict[str, Any], start_ns: int) -> dict[str, Any]:
+    """The JSON summary of one recorded ``~/schedule_path`` call (gathered by
+    :func:`path_call_fields`): its time against the programmed feeds, and the moves an
+    actuator holds below their feed ceiling, with the actuator and the kind of limit."""
+    request, response = call["request"] or {}, call["response"] or {}
+    moves = response.get("moves", [])
+    slow = [
+        {
+            "move": k + 1,
+            "limited_by": move["limited_by"],
+            "actuator": int(move["limiting_actuator"]) or None,
+            "feed_peak": float(move["feed_peak"]),
+        }
+        for k, move in enumerate(moves)
+        if move["limited_by"] != "feed"
+    ]
+    programmed = response.get("programmed_duration_s")
+    return {
+        "index": index,
+        "time_s": (call["log_time_ns"] - start_ns) / 1e9,
+        "service": call["service"],
+        "n_waypoints": len(request.get("poses", [])) if call["request"] else None,
+        "answered": call["response"] is not None,
+        "success": response.get("success"),
+        "message": response.get("message"),
+        "path_ok": response.get("path_ok"),
+        "duration_s": response.get("duration_s"),
+        "programmed_duration_s": (
+            None if programmed is None or math.isnan(programmed) else programmed
+        ),
+        "n_moves": len(moves),
+        "stops": len(response.get("stops", [])),
+        "below_ceiling": slow,
+    }
+
+
+def schedule_call_line(report: dict[str, Any]) -> str:
+    """One text line for a :func:`schedule_call_report`."""
+    head, unanswered = _call_head(report)
+    if unanswered is not None:
+        return unanswered
+    planned = report["programmed_duration_s"]
+    against = "no programmed time" if planned is None else f"{planned:.3f} s programmed"
+    return (
+        f"{head}: {report['n_moves']} moves in {report['duration_s']:.3f} s ({against}), "
+        f"{report['stops']} stops, {len(report['below_ceiling'])} below their feed ceiling; "
+        f"path {'runs' if report['path_ok'] else 'does not run'}"
     )

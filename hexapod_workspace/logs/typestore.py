@@ -108,6 +108,12 @@ RECORDED_TYPES = {
     ),
     f"{INTERFACE_PACKAGE}/srv/CheckPath_Request": f"{INTERFACE_PACKAGE}/msg/CheckPathRequest",
     f"{INTERFACE_PACKAGE}/srv/CheckPath_Response": f"{INTERFACE_PACKAGE}/msg/CheckPathResponse",
+    f"{INTERFACE_PACKAGE}/srv/SchedulePath_Request": (
+        f"{INTERFACE_PACKAGE}/msg/SchedulePathRequest"
+    ),
+    f"{INTERFACE_PACKAGE}/srv/SchedulePath_Response": (
+        f"{INTERFACE_PACKAGE}/msg/SchedulePathResponse"
+    ),
     "std_srvs/srv/Trigger_Request": "std_msgs/msg/Empty",
     "std_srvs/srv/Trigger_Response": f"{INTERFACE_PACKAGE}/msg/TriggerResponse",
 }

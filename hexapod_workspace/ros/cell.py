@@ -84,10 +84,13 @@ __all__ = [
     "PARAMETER_CHANGES_TOPIC",
     "AxisLimitsPublisher",
     "CellStatus",
+    "actuator_limits",
     "angles_to_base",
+    "feed_values",
     "frames_message",
     "in_work_frame",
     "new_dynamic_parameters",
+    "optional_rate",
     "path_speeds",
     "poses_to_base",
 ]
@@ -181,8 +184,9 @@ def frames_message(state: State, request_frame_id: str = "") -> Any:
 
 
 # --------------------------------------------------------------------------- ~/check_path feeds
-def _feed_values(values: Any, count: int, name: str) -> NDArray[np.float64]:
-    """Per-move values from a request array: empty (NaN), one for every move, or one per move."""
+def feed_values(values: Any, count: int, name: str) -> NDArray[np.float64]:
+    """Per-move values (count,) from a request array: empty (all NaN), one for every move, or
+    one per move; each > 0 or NaN (none), else InputError naming ``name[k]``."""
     array = np.asarray(list(values), dtype=np.float64)
     if array.size == 0:
         return np.full(count, np.nan)
@@ -197,7 +201,7 @@ def _feed_values(values: Any, count: int, name: str) -> NDArray[np.float64]:
     return np.broadcast_to(array, (count,)).copy()
 
 
-def _optional_rate(value: float, name: str, unit: str) -> float:
+def optional_rate(value: float, name: str, unit: str) -> float:
     """A request's single rate: 0 = none (NaN), else finite and > 0."""
     value = float(value)
     if value == 0.0:
@@ -206,6 +210,17 @@ def _optional_rate(value: float, name: str, unit: str) -> float:
         msg = f"{name}: expected a finite value > 0 {unit} (0 = none), got {value!r}"
         raise InputError(msg)
     return value
+
+
+def actuator_limits(state: State) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``limits.actuator_speed_max`` and ``limits.actuator_accel_max`` (six each, actuator
+    unit/s and unit/s², 0 = unlimited) of the node's state; zeros without a cell."""
+    if state.cell is None:
+        return np.zeros(6, dtype=np.float64), np.zeros(6, dtype=np.float64)
+    return (
+        np.asarray(state.cell.actuator_speed_max, dtype=np.float64),
+        np.asarray(state.cell.actuator_accel_max, dtype=np.float64),
+    )
 
 
 def speeds_requested(request: Any) -> bool:
@@ -227,7 +242,7 @@ def validate_speed_request(request: Any, interpolation: str) -> None:
     if len(request.rapid) not in (0, count):
         msg = f"rapid: expected none or one per move ({count}), got {len(request.rapid)}"
         raise InputError(msg)
-    _feed_values(request.feeds_mm_min, count, "feeds_mm_min")
+    feed_values(request.feeds_mm_min, count, "feeds_mm_min")
     durations = np.asarray(list(request.durations_s), dtype=np.float64)
     if durations.size not in (0, count):
         msg = f"durations_s: expected one per move ({count}), got {durations.size}"
@@ -236,8 +251,8 @@ def validate_speed_request(request: Any, interpolation: str) -> None:
         k = int(np.flatnonzero(~(np.isfinite(durations) & (durations > 0.0)))[0])
         msg = f"durations_s[{k}]: expected a finite value > 0 s, got {float(durations[k])!r}"
         raise InputError(msg)
-    _optional_rate(request.rapid_feed_mm_min, "rapid_feed_mm_min", "mm/min")
-    _optional_rate(request.rotary_feed_deg_min, "rotary_feed_deg_min", "deg/min")
+    optional_rate(request.rapid_feed_mm_min, "rapid_feed_mm_min", "mm/min")
+    optional_rate(request.rotary_feed_deg_min, "rotary_feed_deg_min", "deg/min")
     if interpolation != "slerp":
         msg = (
             "interpolation: the speed check (feeds, durations) needs SLERP (the controller's moves)"
@@ -253,9 +268,7 @@ def path_speeds(state: State, request: Any, result: PathCheck | TorsionPlan) -> 
     without translation runs at ``rotary_feed_deg_min``. With ``durations_s`` each move's feed is
     its length (or rotation angle) over its duration.
     """
-    limits = (
-        state.cell.actuator_speed_max if state.cell is not None else np.zeros(6, dtype=np.float64)
-    )
+    limits = actuator_limits(state)[0]
     checked, _ = reported_parts(result)
     waypoints = checked.waypoints
     count = len(waypoints) - 1
@@ -274,15 +287,15 @@ def path_speeds(state: State, request: Any, result: PathCheck | TorsionPlan) -> 
     feed: NDArray[Any]
     rotary_feed: NDArray[Any] = np.full(
         count,
-        _optional_rate(request.rotary_feed_deg_min, "rotary_feed_deg_min", "deg/min") * DEG_MIN,
+        optional_rate(request.rotary_feed_deg_min, "rotary_feed_deg_min", "deg/min") * DEG_MIN,
     )
     if len(request.durations_s):
         durations = np.asarray(list(request.durations_s), dtype=np.float64)
         feed = rates.translation / durations
         rotary_feed = rates.rotation / durations
     else:
-        feed = _feed_values(request.feeds_mm_min, count, "feeds_mm_min") * MM_MIN
-        rapid_feed = _optional_rate(request.rapid_feed_mm_min, "rapid_feed_mm_min", "mm/min")
+        feed = feed_values(request.feeds_mm_min, count, "feeds_mm_min") * MM_MIN
+        rapid_feed = optional_rate(request.rapid_feed_mm_min, "rapid_feed_mm_min", "mm/min")
         feed = np.where(rapid, rapid_feed * MM_MIN, feed)
     # a still move (no translation, no rotation) takes no time whatever its feed
     feed = np.where(feed > 0.0, feed, np.nan)

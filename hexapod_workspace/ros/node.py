@@ -126,6 +126,7 @@ from .paths import attach as attach_paths
 from .paths import check_poses_from_poses
 from .qos import COMMAND_QOS, SERVICE_QOS_PROFILE
 from .recorder import Recorder
+from .schedule import attach_schedule
 from .scheduling import (
     realtime_priority_from_argv,
     set_realtime,
@@ -289,6 +290,8 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
             self.recorder,
             lambda: self.configured_state,
         )
+        # ~/schedule_path (hexapod_workspace.ros.schedule)
+        self.schedules = attach_schedule(self, lambda: self.configured_state, self.recorder)
         self.cell_status = cell.CellStatus(self)  # parameter changes: log and /diagnostics
         self._extensions = list(extensions)
         for attach in self._extensions:
@@ -306,8 +309,9 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         current = self.paths.subscription
         return (
             f"{self.get_fully_qualified_name()} serving check_poses, check_poses_flat, "
-            f"check_path, compute_workspace (action){atlas}, compute_orientation_workspace, "
-            "compute_projected_workspace; listening on commanded_pose, workspace_request"
+            f"check_path, schedule_path, compute_workspace (action){atlas}, "
+            "compute_orientation_workspace, compute_projected_workspace; listening on "
+            "commanded_pose, workspace_request"
             + (f", {current.topic_name} (current pose)" if current is not None else "")
         )
 

@@ -71,7 +71,9 @@ __all__ = [
     "check_path_response_fields",
     "check_poses_from_poses",
     "commanded_target",
+    "curve_rows",
     "pose_arrays",
+    "positive_option",
 ]
 
 #: Parameter naming the current-pose topic (geometry_msgs/PoseStamped); "" = none.
@@ -164,10 +166,10 @@ def check_path_response_fields(
             )
             raise InputError(msg)
         interpolation = INTERPOLATIONS[request.interpolation]
-        tolerance = _option(request.tolerance, "tolerance", DEFAULT_PATH_TOLERANCE)
+        tolerance = positive_option(request.tolerance, "tolerance", DEFAULT_PATH_TOLERANCE)
         positions, quaternions = pose_arrays(request.poses)
-        arcs = _curve_rows(request.arcs, len(positions), 7, "arcs")
-        beziers = _curve_rows(request.beziers, len(positions), 6, "beziers")
+        arcs = curve_rows(request.arcs, len(positions), 7, "arcs")
+        beziers = curve_rows(request.beziers, len(positions), 6, "beziers")
         if state is not None:
             positions, quaternions = cell.poses_to_base(
                 state, request.header.frame_id, positions, quaternions
@@ -176,7 +178,7 @@ def check_path_response_fields(
             if speeds:
                 cell.validate_speed_request(request, interpolation)
         if request.free_torsion:
-            psi_step = _option(request.psi_step, "psi_step", DEFAULT_PLAN_PSI_STEP)
+            psi_step = positive_option(request.psi_step, "psi_step", DEFAULT_PLAN_PSI_STEP)
             max_dpsi = None
             if request.limit_dpsi:
                 max_dpsi = float(request.max_dpsi)
@@ -227,7 +229,7 @@ def check_path_response_fields(
     return fields
 
 
-def _curve_rows(values: Any, count: int, width: int, name: str) -> NDArray[np.float64] | None:
+def curve_rows(values: Any, count: int, width: int, name: str) -> NDArray[np.float64] | None:
     """A request's flattened per-move curve rows as (count − 1, width), or None when empty
     (every move straight); the core validates the rows (naming the move)."""
     array = np.asarray(list(values), dtype=np.float64)
@@ -243,7 +245,8 @@ def _curve_rows(values: Any, count: int, width: int, name: str) -> NDArray[np.fl
     return array.reshape(moves, width)
 
 
-def _option(value: float, name: str, default: float) -> float:
+def positive_option(value: float, name: str, default: float) -> float:
+    """A request's angle option: 0 = ``default``, else finite and > 0 rad (InputError)."""
     value = float(value)
     if value == 0.0:
         return default

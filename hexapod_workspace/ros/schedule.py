@@ -1,0 +1,257 @@
+"""The ``~/schedule_path`` service: the fastest certified feed schedule of a path, from ROS.
+
+:func:`attach_schedule` adds to a node the service ``~/schedule_path``
+(``hexapod_workspace_msgs/srv/SchedulePath``): a path of ``geometry_msgs/Pose`` in the base or
+the work frame (``header.frame_id``, as ``~/check_path``), with the arcs and Bézier moves
+``~/check_path`` takes, per-move programmed feeds (ceilings, not targets), rapid moves and the
+stops asked for. The answer is :func:`hexapod_workspace.core.motions.schedule.schedule_path`
+under the node's ``limits.actuator_speed_max`` and ``limits.actuator_accel_max``, as the CLI's
+``schedule`` command gives it (the same moves, ceilings and summary), plus ``path_ok``: the path
+checked as ``~/check_path`` checks it. Requests and responses are recorded in the node's log
+(``replay`` lists them).
+
+A service, not an action: a schedule of 1,000 moves takes about a second of CPU
+(``benchmarks/schedule.py``), and the grid is bounded
+(:data:`~hexapod_workspace.core.motions.schedule.MAX_SCHEDULE_INTERVALS`); a request with more
+than :data:`MAX_WAYPOINTS` waypoints is refused, naming the bound.
+
+Units: m, rad, s; feeds in mm/min (rotations deg/min) as the CL files and ``~/check_path`` give
+them; actuator speeds m/s (legs, slides) or rad/s (cranks).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from hexapod_workspace_msgs.srv import SchedulePath
+from numpy.typing import NDArray
+from rclpy.callback_groups import ReentrantCallbackGroup
+
+from ..core.base.rotations import quaternion_to_matrix
+from ..core.motions import DEFAULT_PATH_TOLERANCE, check_path
+from ..core.motions.schedule import limited_by, programmed_duration, schedule_path
+from ..core.motions.speeds import ACTUATOR_MODELS
+from ..errors import HexapodWorkspaceError, InputError
+from ..logs import SERVICE_QOS, recorded_type, service_topics
+from ..logs.cell import DEG_MIN, MM_MIN, cell_frames_fields
+from ..logs.interfaces import interface, relative_name
+from . import cell
+from .conversions import to_message
+from .parameters import State
+from .paths import curve_rows, pose_arrays, positive_option
+from .qos import SERVICE_QOS_PROFILE
+
+__all__ = ["MAX_WAYPOINTS", "ScheduleService", "attach_schedule", "schedule_response_fields"]
+
+#: The most waypoints one request may give (a bounded answer time; overload is refused).
+MAX_WAYPOINTS = 20_001
+SCHEDULE_TYPE = interface("schedule_path").type
+
+
+def _ceilings(
+    request: Any, count: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64], float, NDArray[np.bool_]]:
+    """Per move: the feed ceiling (m/s, inf: none) and the programmed feed (m/s, NaN: none);
+    the rotary ceiling (rad/s, NaN: none) and the rapid flags (validated, InputError)."""
+    rapid: NDArray[np.bool_] = np.zeros(count, dtype=bool)
+    if len(request.rapid):
+        if len(request.rapid) != count:
+            msg = f"rapid: expected none or one per move ({count}), got {len(request.rapid)}"
+            raise InputError(msg)
+        rapid = np.asarray(list(request.rapid), dtype=bool)
+    feeds = cell.feed_values(request.feeds_mm_min, count, "feeds_mm_min") * MM_MIN
+    rapid_feed = cell.optional_rate(request.rapid_feed_mm_min, "rapid_feed_mm_min", "mm/min")
+    rotary = cell.optional_rate(request.rotary_feed_deg_min, "rotary_feed_deg_min", "deg/min")
+    feed_max = cell.optional_rate(request.feed_max_mm_min, "feed_max_mm_min", "mm/min")
+    programmed = np.where(rapid, rapid_feed * MM_MIN, feeds)
+    cap = math.inf if math.isnan(feed_max) else feed_max * MM_MIN
+    linear = np.minimum(np.where(np.isnan(programmed), math.inf, programmed), cap)
+    return linear, programmed, rotary * DEG_MIN, rapid
+
+
+def _stops(request: Any, count: int, rapid: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """The waypoints the request asks to rest at (the ends always rest)."""
+    stops: NDArray[np.bool_] = np.zeros(count + 1, dtype=bool)
+    if len(request.stops):
+        if len(request.stops) != count + 1:
+            msg = (
+                f"stops: expected none or one per waypoint ({count + 1}), got {len(request.stops)}"
+            )
+            raise InputError(msg)
+        stops = np.asarray(list(request.stops), dtype=bool)
+    if request.stop_at_rapids and count > 1:
+        stops[1:-1] |= rapid[:-1] != rapid[1:]
+    return stops
+
+
+def _moves(
+    schedule: Any, linear: NDArray[np.float64], rotary: float, rapid: NDArray[np.bool_]
+) -> list[dict[str, Any]]:
+    """``ScheduledMove`` fields of every move (mm/min, deg/min for rotations)."""
+    turning = math.inf if math.isnan(rotary) else rotary
+    ceiling = np.where(schedule.rotary, turning, linear)
+    kinds, actuators = limited_by(schedule, ceiling)
+    moves = []
+    for k in range(schedule.t_start.size):
+        unit = DEG_MIN if schedule.rotary[k] else MM_MIN
+        top = float(ceiling[k])
+        moves.append(
+            {
+                "actuator_speed_peak": [float(v) for v in schedule.speed_peak[k]],
+                "actuator_accel_peak": [float(v) for v in schedule.accel_peak[k]],
+                "t_start_s": float(schedule.t_start[k]),
+                "t_end_s": float(schedule.t_end[k]),
+                "feed_peak": float(schedule.feed_peak[k] / unit),
+                "feed_ceiling": top / unit if math.isfinite(top) else math.nan,
+                "rotary": bool(schedule.rotary[k]),
+                "rapid": bool(rapid[k]),
+                "limited_by": kinds[k],
+                "limiting_actuator": int(actuators[k]),
+            }
+        )
+    return moves
+
+
+def _summary(duration: float, programmed: float, moves: list[dict[str, Any]]) -> str:
+    against = (
+        "no programmed time (a move has no feed)"
+        if math.isnan(programmed)
+        else f"{programmed:.3f} s at the programmed feeds"
+    )
+    slow = [m for m in moves if m["limited_by"] != "feed"]
+    return (
+        f"schedule: {duration:.3f} s ({against}), {len(moves)} moves, {len(slow)} below "
+        "their feed ceiling (actuator speed or acceleration)"
+    )
+
+
+def schedule_response_fields(state: State, request: Any) -> dict[str, Any]:
+    """``SchedulePath_Response`` fields answering ``request`` with the node's state (a refusal,
+    ``success`` false with the reason, for a bad request or a move that cannot be scheduled).
+    """
+    frames = cell_frames_fields(state.cell, request.header.frame_id)
+    unit = ACTUATOR_MODELS.get(state.manipulator.architecture)
+    try:
+        count = len(request.poses) - 1
+        if count + 1 > MAX_WAYPOINTS:
+            msg = f"poses: at most {MAX_WAYPOINTS} waypoints per request, got {count + 1}"
+            raise InputError(msg)
+        if count < 1:
+            msg = f"poses: expected at least 2 waypoints, got {count + 1}"
+            raise InputError(msg)
+        tolerance = positive_option(request.tolerance, "tolerance", DEFAULT_PATH_TOLERANCE)
+        positions, quaternions = pose_arrays(request.poses)
+        arcs = curve_rows(request.arcs, count + 1, 7, "arcs")
+        beziers = curve_rows(request.beziers, count + 1, 6, "beziers")
+        linear, programmed, rotary, rapid = _ceilings(request, count)
+        stops = _stops(request, count, rapid)
+        positions, quaternions = cell.poses_to_base(
+            state, request.header.frame_id, positions, quaternions
+        )
+        arcs, beziers = cell.curves_to_base(state, request.header.frame_id, arcs, beziers)
+        manipulator = state.manipulator
+        checked = check_path(
+            manipulator,
+            positions,
+            quaternions=quaternions,
+            tolerance=tolerance,
+            arcs=arcs,
+            beziers=beziers,
+        )
+        limits = cell.actuator_limits(state)
+        schedule = schedule_path(
+            manipulator,
+            positions,
+            quaternion_to_matrix(quaternions),
+            speed_limits=limits[0],
+            accel_limits=limits[1],
+            feeds=linear,
+            rotary_feeds=np.full(count, math.inf if math.isnan(rotary) else rotary),
+            stops=stops,
+            arcs=arcs,
+            beziers=beziers,
+        )
+    except HexapodWorkspaceError as error:
+        return {"success": False, "message": str(error), "frames": frames}
+    planned = programmed_duration(schedule, programmed, rotary)
+    moves = _moves(schedule, linear, rotary, rapid)
+    return {
+        "success": True,
+        "message": _summary(schedule.duration, planned, moves),
+        "path_ok": bool(checked.ok),
+        "s": [float(v) for v in schedule.s],
+        "duration_s": schedule.duration,
+        "sdot": [float(v) for v in schedule.sdot],
+        "programmed_duration_s": planned,
+        "moves": moves,
+        "stops": [int(k) for k in np.flatnonzero(schedule.stops)],
+        "intervals": int(schedule.intervals),
+        "actuator_speed_max": [float(v) for v in limits[0]],
+        "actuator_accel_max": [float(v) for v in limits[1]],
+        "actuator_unit": unit.unit if unit is not None else "",
+        "frames": frames,
+    }
+
+
+class ScheduleService:
+    """``~/schedule_path`` on a node (see the module documentation).
+
+    Parameters
+    ----------
+    node : rclpy.node.Node
+    get_state : callable
+        Returns the node's configured :class:`~hexapod_workspace.ros.parameters.State`
+        (``InputError`` while it is inactive: the request is refused with the reason).
+    recorder : object, optional
+        The node's MCAP recorder (``add_channel``, ``write``): requests and responses are
+        recorded there.
+    """
+
+    def __init__(
+        self, node: Any, get_state: Callable[[], State], recorder: Any | None = None
+    ) -> None:
+        self._node = node
+        self._get_state = get_state
+        self._recorder = recorder
+        name = relative_name("schedule_path")
+        self.service = node.create_service(
+            SchedulePath,
+            name,
+            self._on_request,
+            qos_profile=SERVICE_QOS_PROFILE,
+            callback_group=ReentrantCallbackGroup(),
+        )
+        self._request_topic, self._response_topic = service_topics(node.resolve_service_name(name))
+        if recorder is not None:
+            for topic, part in (
+                (self._request_topic, "Request"),
+                (self._response_topic, "Response"),
+            ):
+                recorder.add_channel(topic, recorded_type(f"{SCHEDULE_TYPE}_{part}"), SERVICE_QOS)
+
+    def _on_request(self, request: Any, response: Any) -> Any:
+        self._record(self._request_topic, request)
+        try:
+            fields = schedule_response_fields(self._get_state(), request)
+        except HexapodWorkspaceError as error:  # inactive: the reason goes back
+            fields = {"success": False, "message": str(error)}
+        except Exception as error:  # keep serving; the reason goes back to the caller
+            self._node.get_logger().error(f"schedule_path: internal error: {error!r}")
+            fields = {"success": False, "message": f"internal error: {error}"}
+        response = to_message(SchedulePath.Response, fields)
+        self._record(self._response_topic, response)
+        return response
+
+    def _record(self, topic: str, message: Any) -> None:
+        if self._recorder is not None:
+            self._recorder.write(topic, message)
+
+
+def attach_schedule(
+    node: Any, get_state: Callable[[], State], recorder: Any | None = None
+) -> ScheduleService:
+    """Create ``~/schedule_path`` on ``node``; see :class:`ScheduleService`."""
+    return ScheduleService(node, get_state, recorder)
