@@ -28,27 +28,22 @@ from typing import Any
 import numpy as np
 from hexapod_workspace_msgs.srv import SchedulePath
 from numpy.typing import NDArray
-from rclpy.callback_groups import ReentrantCallbackGroup
 
 from ..core.base.rotations import quaternion_to_matrix
 from ..core.motions import DEFAULT_PATH_TOLERANCE, check_path
 from ..core.motions.schedule import limited_by, programmed_duration, schedule_path
 from ..core.motions.speeds import ACTUATOR_MODELS
 from ..errors import HexapodWorkspaceError, InputError
-from ..logs import SERVICE_QOS, recorded_type, service_topics
 from ..logs.cell import DEG_MIN, MM_MIN, cell_frames_fields
-from ..logs.interfaces import interface, relative_name
 from . import cell
-from .conversions import to_message
 from .parameters import State
 from .paths import curve_rows, pose_arrays, positive_option
-from .qos import SERVICE_QOS_PROFILE
+from .services import RecordedService
 
-__all__ = ["MAX_WAYPOINTS", "ScheduleService", "attach_schedule", "schedule_response_fields"]
+__all__ = ["MAX_WAYPOINTS", "attach_schedule", "schedule_response_fields"]
 
 #: The most waypoints one request may give (a bounded answer time; overload is refused).
 MAX_WAYPOINTS = 20_001
-SCHEDULE_TYPE = interface("schedule_path").type
 
 
 def _ceilings(
@@ -196,62 +191,12 @@ def schedule_response_fields(state: State, request: Any) -> dict[str, Any]:
     }
 
 
-class ScheduleService:
-    """``~/schedule_path`` on a node (see the module documentation).
-
-    Parameters
-    ----------
-    node : rclpy.node.Node
-    get_state : callable
-        Returns the node's configured :class:`~hexapod_workspace.ros.parameters.State`
-        (``InputError`` while it is inactive: the request is refused with the reason).
-    recorder : object, optional
-        The node's MCAP recorder (``add_channel``, ``write``): requests and responses are
-        recorded there.
-    """
-
-    def __init__(
-        self, node: Any, get_state: Callable[[], State], recorder: Any | None = None
-    ) -> None:
-        self._node = node
-        self._get_state = get_state
-        self._recorder = recorder
-        name = relative_name("schedule_path")
-        self.service = node.create_service(
-            SchedulePath,
-            name,
-            self._on_request,
-            qos_profile=SERVICE_QOS_PROFILE,
-            callback_group=ReentrantCallbackGroup(),
-        )
-        self._request_topic, self._response_topic = service_topics(node.resolve_service_name(name))
-        if recorder is not None:
-            for topic, part in (
-                (self._request_topic, "Request"),
-                (self._response_topic, "Response"),
-            ):
-                recorder.add_channel(topic, recorded_type(f"{SCHEDULE_TYPE}_{part}"), SERVICE_QOS)
-
-    def _on_request(self, request: Any, response: Any) -> Any:
-        self._record(self._request_topic, request)
-        try:
-            fields = schedule_response_fields(self._get_state(), request)
-        except HexapodWorkspaceError as error:  # inactive: the reason goes back
-            fields = {"success": False, "message": str(error)}
-        except Exception as error:  # keep serving; the reason goes back to the caller
-            self._node.get_logger().error(f"schedule_path: internal error: {error!r}")
-            fields = {"success": False, "message": f"internal error: {error}"}
-        response = to_message(SchedulePath.Response, fields)
-        self._record(self._response_topic, response)
-        return response
-
-    def _record(self, topic: str, message: Any) -> None:
-        if self._recorder is not None:
-            self._recorder.write(topic, message)
-
-
 def attach_schedule(
     node: Any, get_state: Callable[[], State], recorder: Any | None = None
-) -> ScheduleService:
-    """Create ``~/schedule_path`` on ``node``; see :class:`ScheduleService`."""
-    return ScheduleService(node, get_state, recorder)
+) -> RecordedService:
+    """Create ``~/schedule_path`` on ``node``, answered by :func:`schedule_response_fields`
+    with the state ``get_state`` returns, its calls recorded by ``recorder``
+    (:class:`~hexapod_workspace.ros.services.RecordedService`)."""
+    return RecordedService(
+        node, SchedulePath, "schedule_path", schedule_response_fields, get_state, recorder
+    )
