@@ -178,6 +178,14 @@ INTERFACES: tuple[Interface, ...] = (
         extension="hexapod_workspace.ros.schedule",
     ),
     Interface(
+        "loads",
+        "service",
+        f"{_MSGS}/srv/Loads",
+        "the loads at a pose: actuator forces under the payload and the process wrench, "
+        "stiffness, deflection and accuracy at the tool",
+        extension="hexapod_workspace.ros.loads",
+    ),
+    Interface(
         "axis_limits",
         "publisher",
         f"{_MSGS}/msg/AxisLimits",

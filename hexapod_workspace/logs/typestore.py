@@ -114,6 +114,8 @@ RECORDED_TYPES = {
     f"{INTERFACE_PACKAGE}/srv/SchedulePath_Response": (
         f"{INTERFACE_PACKAGE}/msg/SchedulePathResponse"
     ),
+    f"{INTERFACE_PACKAGE}/srv/Loads_Request": f"{INTERFACE_PACKAGE}/msg/LoadsRequest",
+    f"{INTERFACE_PACKAGE}/srv/Loads_Response": f"{INTERFACE_PACKAGE}/msg/LoadsResponse",
     "std_srvs/srv/Trigger_Request": "std_msgs/msg/Empty",
     "std_srvs/srv/Trigger_Response": f"{INTERFACE_PACKAGE}/msg/TriggerResponse",
 }

@@ -86,7 +86,7 @@ from hexapod_workspace.core import kernels
 from hexapod_workspace.core.base import params
 from hexapod_workspace.core.base.params import NODE_PARAMETERS, ROS_PARAMETERS, unknown_parameter
 from hexapod_workspace.core.evaluation.check import check
-from hexapod_workspace.core.evaluation.loads import LOAD_PARAMETERS
+from hexapod_workspace.core.evaluation.loads import LOAD_LIMITS
 from hexapod_workspace.core.kernels import planner as planner_kernels
 from hexapod_workspace.core.model.manipulator import Manipulator
 from hexapod_workspace.errors import ConfigError, InputError
@@ -110,7 +110,9 @@ from .conversions import (
 )
 from .flat import attach as attach_flat
 from .lifecycle import ManagedTransitions, autostart_from_argv
+from .loads import attach_loads
 from .parameters import (
+    LOAD_LIMIT_REASON,
     MODEL_GROUPS,
     State,
     command_line_override_names,
@@ -292,6 +294,8 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         )
         # ~/schedule_path (hexapod_workspace.ros.schedule)
         self.schedules = attach_schedule(self, lambda: self.configured_state, self.recorder)
+        # ~/loads (hexapod_workspace.ros.loads)
+        self.loads = attach_loads(self, lambda: self.configured_state, self.recorder)
         self.cell_status = cell.CellStatus(self)  # parameter changes: log and /diagnostics
         self._extensions = list(extensions)
         for attach in self._extensions:
@@ -309,7 +313,7 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         current = self.paths.subscription
         return (
             f"{self.get_fully_qualified_name()} serving check_poses, check_poses_flat, "
-            f"check_path, schedule_path, compute_workspace (action){atlas}, "
+            f"check_path, schedule_path, loads, compute_workspace (action){atlas}, "
             "compute_orientation_workspace, compute_projected_workspace; listening on "
             "commanded_pose, workspace_request"
             + (f", {current.topic_name} (current pose)" if current is not None else "")
@@ -425,14 +429,9 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         With no model parameter given the packaged example is the model, and the log says so."""
         names = set(self._override_names) | set(getattr(self, "_parameter_overrides", {}))
         self._specs.update(dynamic_specs(names))  # the tool table and collision.* given
-        loads = sorted(name for name in names if name in LOAD_PARAMETERS)
-        if loads:
-            msg = (
-                f"{loads[0]}: a loads parameter, read by 'hexapod-workspace loads' and "
-                "'check'; the node does not take the loads yet (leave it out of the node's "
-                "parameters)"
-            )
-            raise ConfigError(msg)
+        limits = sorted(name for name in names if name in LOAD_LIMITS)
+        if limits:
+            raise ConfigError(f"{limits[0]}: {LOAD_LIMIT_REASON}")
         unknown = unknown_parameter(names, (*self._specs, *NODE_PARAMETERS, *ROS_PARAMETERS))
         if unknown is not None:
             raise ConfigError(f"unknown parameter given to the node: {unknown}")

@@ -24,7 +24,7 @@ import math
 import os
 import re
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -46,6 +46,13 @@ from hexapod_workspace.core.evaluation.loading import (
     manipulator_from_mapping,
     require_usable,
 )
+from hexapod_workspace.core.evaluation.loads import (
+    LOAD_LIMITS,
+    LOAD_PARAMETERS,
+    LoadCase,
+    load_case_from_mapping,
+    require_plausible_loads,
+)
 from hexapod_workspace.core.model.architectures import ARCHITECTURES
 from hexapod_workspace.core.model.manipulator import (
     ARCHITECTURE_PARAMETERS,
@@ -58,6 +65,8 @@ from hexapod_workspace.errors import ConfigError
 from .recorder import Rotation
 
 __all__ = [
+    "LOAD_DESCRIPTIONS",
+    "LOAD_LIMIT_REASON",
     "MODEL_DESCRIPTIONS",
     "MODEL_GROUPS",
     "Settings",
@@ -315,6 +324,7 @@ def parameter_specs() -> dict[str, Spec]:
             float_range=(0.0, 1e9),
         ),
         *_cell_specs(),
+        *_load_specs(),
         Spec(
             "recording.cloud_points",
             20_000,
@@ -364,6 +374,47 @@ CELL_DESCRIPTIONS = {
         "0 = unlimited (the schedule command's limit; validated with the cell)."
     ),
 }
+#: The loads the node takes (hexapod_workspace.core.evaluation.loads), settable at run time;
+#: the loads' limits (LOAD_LIMITS) are not among them yet: no verdict of the node carries them.
+LOAD_DESCRIPTIONS = {
+    "load.mass": "Payload on the platform, kg (>= 0; ~/loads).",
+    "load.center_of_mass": (
+        "Payload's centre of mass in the platform frame (the frame of "
+        "geometry.platform_joints), m, 3 floats (~/loads)."
+    ),
+    "load.gravity": (
+        "Gravity in the base frame, m/s², 3 floats: [0, 0, -9.81] on a pedestal, "
+        "[0, 0, 9.81] on a ceiling (~/loads)."
+    ),
+    "process.wrench": (
+        "Centre of the process wrench box in the tool frame at the tool centre point: "
+        "fx fy fz (N), mx my mz (N·m) (~/loads)."
+    ),
+    "process.wrench_range": "Half-widths of the process wrench box, N and N·m, 6 floats >= 0.",
+    "stiffness.actuator": (
+        "Axial actuator stiffness, N/m (legs, slides) or N·m/rad (cranks), 1 or 6 values > 0; "
+        "empty = not given (~/loads' stiffness and deflection)."
+    ),
+    "accuracy.actuator_error": (
+        "Actuator error bound, m or rad, 1 or 6 values >= 0; empty = not given (~/loads' accuracy)."
+    ),
+}
+#: Why the node refuses a loads limit (the node's verdicts are geometric).
+LOAD_LIMIT_REASON = (
+    "a loads limit, read by 'hexapod-workspace loads' and 'check'; the node's verdicts do not "
+    "take the loads' limits yet (leave it out of the node's parameters; ~/loads reports the "
+    "forces, the deflection and the accuracy without it)"
+)
+
+
+def _load_specs() -> list[Spec]:
+    """The loads parameters (typed at run time: integers and floats both are numbers)."""
+    return [
+        Spec(name, LOAD_PARAMETERS[name], description, dynamic_typing=True)
+        for name, description in LOAD_DESCRIPTIONS.items()
+    ]
+
+
 #: The tool table's parameter names (declared from the parameters given at start, or when a
 #: client sets a new one).
 TOOL_TABLE_NAME = re.compile(r"^tools\.T([1-9][0-9]*)\.(offset|orientation)$")
@@ -492,12 +543,16 @@ class State:
         The model as the parameters give it (platform frame).
     cell : CellFrames
         The active tool, the work frame, the tool table and the actuator speed limits.
+    loads : LoadCase
+        The payload, the process wrench, the actuator stiffness and errors (no limits; the
+        centre of mass in the platform frame).
     """
 
     manipulator: Manipulator
     settings: Settings
     platform: Manipulator | None = None
     cell: CellFrames | None = None
+    loads: LoadCase = field(default_factory=LoadCase)
 
 
 def _plain(value: Any) -> Any:
@@ -535,6 +590,8 @@ def refusal(specs: dict[str, Spec], parameter: Parameter) -> str | None:
     """
     name, value = parameter.name, parameter.value
     spec = specs.get(name)
+    if spec is None and name in LOAD_LIMITS:
+        return f"{name}: {LOAD_LIMIT_REASON} (value {_shown(value)} refused)"
     if spec is None:
         return f"{name}: no such parameter of this node (value {_shown(value)} refused)"
     if spec.read_only:
@@ -592,6 +649,12 @@ def state_from(values: dict[str, Any]) -> State:
     if frame not in AXIS_LIMITS_FRAMES:
         msg = f"axis_limits.frame: expected one of {', '.join(AXIS_LIMITS_FRAMES)}, got {frame!r}"
         raise ConfigError(msg)
+    loads = require_plausible_loads(
+        platform,
+        load_case_from_mapping(
+            {name: _plain(values[name]) for name in LOAD_DESCRIPTIONS if name in values}
+        ),
+    )
     manipulator = tool_model(platform, cell.tool)
     method = str(values["resolution.projected_method"])
     if method not in PROJECTED_METHODS:
@@ -630,7 +693,7 @@ def state_from(values: dict[str, Any]) -> State:
         axis_limits_rate=float(values.get("axis_limits.rate", 2.0)),
         recording_cloud_points=int(values["recording.cloud_points"]),
     )
-    return State(manipulator, settings, platform, cell)
+    return State(manipulator, settings, platform, cell, loads)
 
 
 #: Name prefixes of the model's parameters (``frame_id`` only names the frame).

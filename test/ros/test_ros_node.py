@@ -310,11 +310,18 @@ def test_a_parameters_file_check_knows_every_parameter_of_the_node(client):
         ROS_PARAMETERS,
         unknown_parameter,
     )
+    from hexapod_workspace.core.evaluation.loads import LOAD_PARAMETERS
     from hexapod_workspace.core.model.manipulator import PARAMETER_DEFAULTS
 
     listed = client.call(ListParameters, f"{NODE}/list_parameters", ListParameters.Request())
     names = set(listed.result.names)
-    known = (*PARAMETER_DEFAULTS, *NODE_PARAMETERS, *CELL_PARAMETERS, *ROS_PARAMETERS)
+    known = (
+        *PARAMETER_DEFAULTS,
+        *NODE_PARAMETERS,
+        *CELL_PARAMETERS,
+        *LOAD_PARAMETERS,
+        *ROS_PARAMETERS,
+    )
     assert unknown_parameter(names, known) is None
     assert set(NODE_PARAMETERS) <= names
 
