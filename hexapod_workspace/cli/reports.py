@@ -530,7 +530,7 @@ def _atlas_json(index: int, record: AtlasRecord, start_ns: int) -> dict[str, Any
 
 
 def log_report(summary: LogSummary) -> dict[str, Any]:
-    from ..logs.paths import path_call_report, schedule_call_report
+    from ..logs.paths import loads_call_report, path_call_report, schedule_call_report
 
     contents = summary.contents
     start = contents.start_ns or 0
@@ -563,6 +563,7 @@ def log_report(summary: LogSummary) -> dict[str, Any]:
         "schedules": [
             schedule_call_report(i + 1, call, start) for i, call in enumerate(summary.schedules)
         ],
+        "loads": [loads_call_report(i + 1, call, start) for i, call in enumerate(summary.loads)],
         "trigger_calls": [
             {
                 "topic": t["topic"],
@@ -617,7 +618,7 @@ def jsonable(value: Any) -> Any:
 
 
 def log_report_text(report: dict[str, Any], out: IO[str]) -> None:
-    from ..logs.paths import path_call_line, schedule_call_line
+    from ..logs.paths import loads_call_line, path_call_line, schedule_call_line
 
     if report["damaged"]:
         state = (
@@ -682,6 +683,9 @@ def log_report_text(report: dict[str, Any], out: IO[str]) -> None:
     if report["schedules"]:
         out.write(f"schedules: {len(report['schedules'])}\n")
         _capped([schedule_call_line(call) for call in report["schedules"]], "schedules", out)
+    if report["loads"]:
+        out.write(f"loads: {len(report['loads'])}\n")
+        _capped([loads_call_line(call) for call in report["loads"]], "loads", out)
     if report["trigger_calls"]:
         out.write(f"trigger calls: {len(report['trigger_calls'])}\n")
         lines = [

@@ -33,6 +33,8 @@ __all__ = [
     "check_path_request_fields",
     "check_path_response_fields",
     "failed_check_path_response_fields",
+    "loads_call_line",
+    "loads_call_report",
     "path_call_fields",
     "path_call_line",
     "path_call_report",
@@ -389,3 +391,36 @@ def schedule_call_line(report: dict[str, Any]) -> str:
         f"{report['stops']} stops, {len(report['below_ceiling'])} below their feed ceiling; "
         f"path {'runs' if report['path_ok'] else 'does not run'}"
     )
+
+
+def loads_call_report(index: int, call: dict[str, Any], start_ns: int) -> dict[str, Any]:
+    """The JSON summary of one recorded ``~/loads`` call: the pose asked (m, quaternion
+    ``x, y, z, w``, in ``frame_id``), the payload, the worst actuator force and the answer's
+    one-line summary (NaN and infinities as null)."""
+    request, response = call["request"] or {}, call["response"] or {}
+    pose = request.get("pose")
+    worst = [float(v) for v in response.get("actuator_force_worst", [])]
+    return {
+        "index": index,
+        "time_s": (call["log_time_ns"] - start_ns) / 1e9,
+        "service": call["service"],
+        "answered": call["response"] is not None,
+        "success": response.get("success"),
+        "message": response.get("message"),
+        "frame_id": request["header"]["frame_id"] if call["request"] else None,
+        "position": [pose["position"][k] for k in "xyz"] if pose else None,
+        "orientation": [pose["orientation"][k] for k in "xyzw"] if pose else None,
+        "mass_kg": response.get("mass_kg"),
+        "singular": response.get("singular"),
+        "actuator_force_worst": [v if math.isfinite(v) else None for v in worst],
+        "force_unit": response.get("force_unit"),
+    }
+
+
+def loads_call_line(report: dict[str, Any]) -> str:
+    """One text line for a :func:`loads_call_report`."""
+    head, unanswered = _call_head(report)
+    if unanswered is not None:
+        return unanswered
+    where = ", ".join(f"{v:.4g}" for v in report["position"] or [])
+    return f"{head}: at ({where}) m: {report['message']}"

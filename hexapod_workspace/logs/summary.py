@@ -39,6 +39,8 @@ _PATH_REQUEST = "hexapod_workspace_msgs/srv/CheckPath_Request"
 _PATH_RESPONSE = "hexapod_workspace_msgs/srv/CheckPath_Response"
 _SCHEDULE_REQUEST = "hexapod_workspace_msgs/srv/SchedulePath_Request"
 _SCHEDULE_RESPONSE = "hexapod_workspace_msgs/srv/SchedulePath_Response"
+_LOADS_REQUEST = "hexapod_workspace_msgs/srv/Loads_Request"
+_LOADS_RESPONSE = "hexapod_workspace_msgs/srv/Loads_Response"
 _PARAMETER_CHANGE = "hexapod_workspace_msgs/msg/ParameterChange"
 _AXIS_LIMITS = "hexapod_workspace_msgs/msg/AxisLimits"
 
@@ -134,6 +136,8 @@ class LogSummary:
     paths: list[dict[str, Any]] = field(default_factory=list)
     #: the ~/schedule_path calls (request and response fields, paired as ``paths``)
     schedules: list[dict[str, Any]] = field(default_factory=list)
+    #: the ~/loads calls (request and response fields, paired as ``paths``)
+    loads: list[dict[str, Any]] = field(default_factory=list)
     atlases: list[AtlasRecord] = field(default_factory=list)
     #: the node's set_parameters calls (ParameterChange fields, with ``log_time_ns``)
     parameter_changes: list[dict[str, Any]] = field(default_factory=list)
@@ -242,6 +246,8 @@ def summarize_log(
             path_call_fields(summary.paths, item.topic, item.log_time_ns, item.message)
         elif msgtype in (_SCHEDULE_REQUEST, _SCHEDULE_RESPONSE):
             path_call_fields(summary.schedules, item.topic, item.log_time_ns, item.message)
+        elif msgtype in (_LOADS_REQUEST, _LOADS_RESPONSE):
+            path_call_fields(summary.loads, item.topic, item.log_time_ns, item.message)
         elif msgtype == _TRIGGER_RESPONSE:
             fields = message_to_fields(item.message)
             fields.update(topic=item.topic, log_time_ns=item.log_time_ns)

@@ -7,11 +7,13 @@ libraries read it."""
 
 from __future__ import annotations
 
+import json
 import math
 import time
 
 import numpy as np
 import pytest
+from cli_support import run_main
 from recording_support import read_with_foxglove, read_with_mcap_ros2, read_with_rosbags
 from ros_support import require_ros
 
@@ -166,3 +168,16 @@ def test_loads_at_a_tool_pose_follow_the_parameters(client, workspace_node):
     foxglove = read_with_foxglove(log, workspace_node.record_dir)[f"{SERVICE}/response"]
     assert foxglove["count"] == 10
     assert foxglove["messages"][0]["actuator_force"] == list(response.actuator_force)
+    # replay lists every call: the pose asked, the payload, the answer
+    code, out, _ = run_main("replay", str(log), "--json")
+    assert code == 0
+    calls = json.loads(out)["loads"]
+    assert len(calls) == 10
+    assert calls[0]["position"] == position and calls[0]["mass_kg"] == 40.0
+    assert calls[1]["frame_id"] == "part"
+    assert calls[0]["actuator_force_worst"] == list(response.actuator_force_worst)
+    assert not calls[-3]["success"] and "elsewhere" in calls[-3]["message"]
+    assert calls[-1]["singular"] and calls[-1]["actuator_force_worst"] == [None] * 6
+    code, text, _ = run_main("replay", str(log))
+    assert code == 0
+    assert f"at (0.02, -0.01, -1.42) m: {response.message}" in text
