@@ -356,8 +356,8 @@ def test_loads_command_answers_the_pose_and_the_searches_refuse_its_limits(tmp_p
     assert code == 2
     assert one_error_line(err).endswith(
         "limits.actuator_force_max: a loads limit, read by 'hexapod-workspace loads' and "
-        "'check' only; the workspace searches, motions and the node do not take it as a "
-        "constraint yet (leave it out of this file)"
+        "'check' only (and the node's pose verdicts); the workspace searches and motions do "
+        "not take it as a constraint yet (leave it out of this file)"
     )
     # Without the limits, the same file's loads do not change a geometric verdict.
     relaxed = dict(WORKED, limits=dict(WORKED["limits"], actuator_force_max=[]))

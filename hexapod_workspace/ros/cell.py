@@ -77,6 +77,7 @@ from hexapod_workspace.logs.cell import (
 )
 
 from .conversions import to_message, type_name
+from .load_rows import require_geometric
 from .parameters import State, dynamic_specs
 from .scheduling import time_sharing, worker_policy
 
@@ -475,14 +476,21 @@ class AxisLimitsPublisher:
                 state, frame_id, position[None, :], quaternion[None, :]
             )
             rotation = quaternion_to_matrix(quaternions)[0]
-            limits = self._compute(state.manipulator, rotation, positions[0], frame, work)
+            limits: dict[str, Any] | None = None
+            try:
+                manipulator = require_geometric(state, "the axis limits")
+            except InputError as error:  # a loads limit set: no certified limits yet
+                message = str(error)
+            else:
+                limits = self._compute(manipulator, rotation, positions[0], frame, work)
+                message = _verdict(limits)
             fields = axis_limits_fields(
                 limits,
                 **where,
                 position=positions[0],
                 quaternion=quaternions[0],
                 cell=state.cell,
-                message=_verdict(limits),
+                message=message,
             )
         except InputError as error:  # a current pose in another frame, or not a rotation
             fields = axis_limits_fields(

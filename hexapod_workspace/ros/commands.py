@@ -29,6 +29,7 @@ from numpy.typing import NDArray
 from rclpy.exceptions import InvalidHandle
 from rclpy.serialization import deserialize_message
 
+from hexapod_workspace.core.base.rotations import tt_to_matrix
 from hexapod_workspace.core.constraints.table import constraint_names
 from hexapod_workspace.core.evaluation.check import check
 from hexapod_workspace.errors import InputError
@@ -36,6 +37,7 @@ from hexapod_workspace.logs import messages
 
 from .cell import angles_to_base, frames_message
 from .conversions import to_message
+from .load_rows import load_rows_of, with_load_rows
 from .paths import commanded_target
 
 __all__ = ["BATCH", "CommandStream"]
@@ -138,8 +140,9 @@ class CommandStream:
         checks: dict[int, list[dict[str, Any]]] = {}
         for k, command in enumerate(batch):
             result, index, reason = verdicts[k]
-            if result is not None and id(result) not in checks:
-                checks[id(result)] = messages.pose_checks_fields(result)
+            if result is not None and id(result) not in checks:  # with the loads rows set
+                rows = load_rows_of(state, tt_to_matrix(result.angles), result.position)
+                checks[id(result)] = with_load_rows(messages.pose_checks_fields(result), rows)
             fields = messages.reachability_result_fields(
                 result,
                 index=index,

@@ -24,12 +24,15 @@ import numpy as np
 from hexapod_workspace_msgs.srv import CheckPosesFlat
 from numpy.typing import NDArray
 
+from hexapod_workspace.core.base.rotations import tt_to_matrix
 from hexapod_workspace.core.constraints.table import constraint_names
 from hexapod_workspace.core.evaluation.check import CONSTRAINT_NAMES, CheckResult, check
+from hexapod_workspace.core.evaluation.loads import LoadRows
 from hexapod_workspace.errors import InputError
 
 from .cell import angles_to_base, frames_message
 from .conversions import position_from_point
+from .load_rows import load_rows_of
 
 __all__ = ["angles_from_flat", "attach", "flat_margins", "flat_response"]
 
@@ -90,20 +93,31 @@ def flat_response(
     *,
     message: str | None = None,
     names: Sequence[str] = CONSTRAINT_NAMES,
+    loads: LoadRows | None = None,
 ) -> CheckPosesFlat.Response:
     """The answer to a flat request: the verdicts of ``result``, or a refusal (``result`` None,
     ``message`` the reason; every array empty, ``constraint_names`` still given: ``names``, the
-    model's)."""
+    model's). ``loads``: the loads rows of the same poses, appended as columns after the
+    geometric rows (:mod:`~hexapod_workspace.ros.load_rows`); a pose is reachable only where
+    they hold too."""
     names = list(result.margins) if result is not None else list(names)
+    if result is not None and loads is not None:
+        names += list(loads.margins)
     response = CheckPosesFlat.Response(constraint_names=names)
     if result is None:
         response.success = False
         response.message = message or "request failed"
         return response
     reachable = np.asarray(result.reachable, dtype=bool)
+    margins = flat_margins(result)
+    suffix = ""
+    if loads is not None:
+        reachable = reachable & loads.holds
+        margins = np.column_stack([margins, *loads.margins.values()])
+        suffix = " (loads' limits included)"
     response.success = True
-    response.message = f"{int(np.count_nonzero(reachable))}/{reachable.size} reachable"
-    response.margins = _doubles(flat_margins(result).reshape(-1))
+    response.message = f"{int(np.count_nonzero(reachable))}/{reachable.size} reachable{suffix}"
+    response.margins = _doubles(margins.reshape(-1))
     response.reachable = reachable.tolist()
     response.limiting_leg = _int32s(np.asarray(result.limiting_leg))
     if "collision" in result.margins:  # a scene: one pair per pose (none: empty, no cost)
@@ -134,7 +148,8 @@ def attach(node: Any, name: str) -> Any:
                     angles,
                     position,
                     singularity=state.settings.report_singularity,
-                )
+                ),
+                loads=load_rows_of(state, tt_to_matrix(angles), position),
             )
         except InputError as error:
             answer = flat_response(None, message=str(error), names=names)

@@ -7,8 +7,9 @@ node's ``load.*``, ``process.*``, ``stiffness.actuator`` and ``accuracy.actuator
 force (set at run time as one validated whole with the model and the cell: a tool change or a
 new payload between two requests; every change is on ``~/parameter_changes``). The centre of
 mass is given in the platform frame and moved into the active tool's frame here, as the CLI's
-``loads`` does. The loads' limits are not node parameters yet (no verdict of the node carries
-them), so ``force_margin`` and ``payload_capacity_kg`` are NaN. Calls are recorded.
+``loads`` does. With ``limits.actuator_force_max`` set, ``force_margin`` and
+``payload_capacity_kg`` are given (NaN without it); the loads' limits also enter every pose
+verdict of the node (:mod:`~hexapod_workspace.ros.load_rows`). Calls are recorded.
 
 Units: N (legs, slides) or N·m (cranks), m, rad, kg; matrices row-major.
 """
@@ -29,6 +30,7 @@ from ..core.model.architectures import module as architecture_module
 from ..errors import HexapodWorkspaceError, InputError
 from ..logs.cell import cell_frames_fields
 from . import cell
+from .load_rows import tool_case
 from .parameters import State
 from .paths import pose_arrays
 from .services import RecordedService
@@ -77,9 +79,7 @@ def loads_response_fields(state: State, request: Any) -> dict[str, Any]:
         rotation = quaternion_to_matrix(quaternions)[0]
     except HexapodWorkspaceError as error:
         return {"success": False, "message": str(error), "frames": frames}
-    case = state.loads
-    if state.cell is not None:
-        case = case.in_tool_frame(state.cell.tool.offset, state.cell.tool.rotation)
+    case = tool_case(state)
     manipulator = state.manipulator
     result = loads_at(manipulator, case, rotation, positions[0])
     unit = architecture_module(manipulator.architecture).FORCE_UNIT

@@ -21,7 +21,8 @@ The cone
     at ψ = 0; ``exact``: with some torsion) and ``resolution.tolerance``, on
     :data:`CONE_AZIMUTHS` azimuths (a picture: every boundary point is certified, the rim
     between them is drawn straight). No cone when the reference orientation is unreachable at
-    the position.
+    the position, nor while a loads limit is set (:mod:`~hexapod_workspace.ros.load_rows`:
+    the cone would pass over it).
 The collision scene
     :func:`node_scene`: the scene of the node's model (``collision.*``, read from the
     parameters file and changed at run time like every model parameter); without one the
@@ -44,6 +45,7 @@ from ..errors import HexapodWorkspaceError
 from ..logs.interfaces import relative_name
 from ..logs.markers import marker_array_fields
 from .conversions import to_message
+from .load_rows import require_geometric
 
 __all__ = ["CONE_AZIMUTHS", "MARKER_RATE", "MarkerPublisher", "attach", "node_scene"]
 
@@ -129,6 +131,7 @@ class MarkerPublisher:
         cone_for = self._cone_for
         if cone_for is None or cone_for[0] is not state or cone_for[1] != pose[0]:
             try:
+                require_geometric(state, "the cone of tool directions")  # none with loads
                 workspace = projected_workspace(
                     manipulator,
                     position,

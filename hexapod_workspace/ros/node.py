@@ -85,8 +85,8 @@ from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import kernels
 from hexapod_workspace.core.base import params
 from hexapod_workspace.core.base.params import NODE_PARAMETERS, ROS_PARAMETERS, unknown_parameter
+from hexapod_workspace.core.base.rotations import tt_to_matrix
 from hexapod_workspace.core.evaluation.check import check
-from hexapod_workspace.core.evaluation.loads import LOAD_LIMITS
 from hexapod_workspace.core.kernels import planner as planner_kernels
 from hexapod_workspace.core.model.manipulator import Manipulator
 from hexapod_workspace.errors import ConfigError, InputError
@@ -110,9 +110,9 @@ from .conversions import (
 )
 from .flat import attach as attach_flat
 from .lifecycle import ManagedTransitions, autostart_from_argv
+from .load_rows import check_poses_with_loads, load_rows_of, require_geometric
 from .loads import attach_loads
 from .parameters import (
-    LOAD_LIMIT_REASON,
     MODEL_GROUPS,
     State,
     command_line_override_names,
@@ -149,7 +149,9 @@ def _attach_atlas(node: WorkspaceNode) -> object:
     from .atlas_action import attach_atlas_action
 
     return attach_atlas_action(
-        node, lambda: node.configured_state.manipulator, recorder=node.recorder
+        node,
+        lambda: require_geometric(node.configured_state, "the atlas"),
+        recorder=node.recorder,
     )
 
 
@@ -429,9 +431,6 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
         With no model parameter given the packaged example is the model, and the log says so."""
         names = set(self._override_names) | set(getattr(self, "_parameter_overrides", {}))
         self._specs.update(dynamic_specs(names))  # the tool table and collision.* given
-        limits = sorted(name for name in names if name in LOAD_LIMITS)
-        if limits:
-            raise ConfigError(f"{limits[0]}: {LOAD_LIMIT_REASON}")
         unknown = unknown_parameter(names, (*self._specs, *NODE_PARAMETERS, *ROS_PARAMETERS))
         if unknown is not None:
             raise ConfigError(f"unknown parameter given to the node: {unknown}")
@@ -604,7 +603,8 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
                     position,
                     singularity=state.settings.report_singularity,
                 )
-                return messages.check_poses_response_fields(result)
+                rows = load_rows_of(state, tt_to_matrix(angles), position)
+                return check_poses_with_loads(messages.check_poses_response_fields(result), rows)
             except InputError as error:
                 reason = str(error)
         return messages.check_poses_response_fields(None, success=False, message=reason)

@@ -47,7 +47,6 @@ from hexapod_workspace.core.evaluation.loading import (
     require_usable,
 )
 from hexapod_workspace.core.evaluation.loads import (
-    LOAD_LIMITS,
     LOAD_PARAMETERS,
     LoadCase,
     load_case_from_mapping,
@@ -66,7 +65,6 @@ from .recorder import Rotation
 
 __all__ = [
     "LOAD_DESCRIPTIONS",
-    "LOAD_LIMIT_REASON",
     "MODEL_DESCRIPTIONS",
     "MODEL_GROUPS",
     "Settings",
@@ -374,8 +372,9 @@ CELL_DESCRIPTIONS = {
         "0 = unlimited (the schedule command's limit; validated with the cell)."
     ),
 }
-#: The loads the node takes (hexapod_workspace.core.evaluation.loads), settable at run time;
-#: the loads' limits (LOAD_LIMITS) are not among them yet: no verdict of the node carries them.
+#: The loads the node takes (hexapod_workspace.core.evaluation.loads), settable at run time:
+#: the payload, the process wrench, the actuators and the loads' limits
+#: (hexapod_workspace.ros.load_rows).
 LOAD_DESCRIPTIONS = {
     "load.mass": "Payload on the platform, kg (>= 0; ~/loads).",
     "load.center_of_mass": (
@@ -398,13 +397,24 @@ LOAD_DESCRIPTIONS = {
     "accuracy.actuator_error": (
         "Actuator error bound, m or rad, 1 or 6 values >= 0; empty = not given (~/loads' accuracy)."
     ),
+    "limits.actuator_force_max": (
+        "Largest actuator push, N (legs, slides) or N·m (cranks), 1 or 6 values > 0; empty = "
+        "no force limit. Set, every pose verdict carries the actuator_force row; moves and "
+        "workspaces are refused until their rate bounds exist."
+    ),
+    "limits.actuator_force_min": (
+        "Largest pull (a value below the push limit, usually negative), 1 or 6 values; empty "
+        "= minus limits.actuator_force_max."
+    ),
+    "limits.deflection_max": (
+        "Largest tool translation under the process box, m; 0 = no limit (needs "
+        "stiffness.actuator). Set: the deflection row in every pose verdict."
+    ),
+    "limits.accuracy_max": (
+        "Largest tool translation from the actuator errors, m; 0 = no limit (needs "
+        "accuracy.actuator_error). Set: the accuracy row in every pose verdict."
+    ),
 }
-#: Why the node refuses a loads limit (the node's verdicts are geometric).
-LOAD_LIMIT_REASON = (
-    "a loads limit, read by 'hexapod-workspace loads' and 'check'; the node's verdicts do not "
-    "take the loads' limits yet (leave it out of the node's parameters; ~/loads reports the "
-    "forces, the deflection and the accuracy without it)"
-)
 
 
 def _load_specs() -> list[Spec]:
@@ -590,8 +600,6 @@ def refusal(specs: dict[str, Spec], parameter: Parameter) -> str | None:
     """
     name, value = parameter.name, parameter.value
     spec = specs.get(name)
-    if spec is None and name in LOAD_LIMITS:
-        return f"{name}: {LOAD_LIMIT_REASON} (value {_shown(value)} refused)"
     if spec is None:
         return f"{name}: no such parameter of this node (value {_shown(value)} refused)"
     if spec.read_only:
@@ -702,9 +710,15 @@ MODEL_GROUPS = ("geometry.", "limits.", "pose.")
 
 def model_given(names: Iterable[str]) -> list[str]:
     """The model parameters (``geometry.*``, ``limits.*``, ``pose.*``) among ``names`` (the
-    cell's ``limits.actuator_speed_max`` is not part of the model)."""
+    cell's ``limits.actuator_speed_max`` and the loads' limits are not part of the model)."""
     return sorted(
-        {name for name in names if name.startswith(MODEL_GROUPS) and name not in CELL_DEFAULTS}
+        {
+            name
+            for name in names
+            if name.startswith(MODEL_GROUPS)
+            and name not in CELL_DEFAULTS
+            and name not in LOAD_PARAMETERS
+        }
     )
 
 
@@ -736,6 +750,8 @@ def model_default(name: str, declared: dict[str, Any]) -> Any:
         return list(declared["geometry.home_position"])
     if name in CELL_DEFAULTS:  # limits.actuator_speed_max: the cell's own default
         return CELL_DEFAULTS[name]
+    if name in LOAD_PARAMETERS:  # the loads' limits: not set
+        return LOAD_PARAMETERS[name]
     if name in _ARCHITECTURE_ARRAYS:
         return []  # not this architecture's: left empty
     return PARAMETER_DEFAULTS[name]

@@ -61,6 +61,7 @@ from ..logs import paths as path_fields
 from ..logs.interfaces import relative_name
 from . import cell
 from .conversions import to_message, type_name
+from .load_rows import check_poses_with_loads, load_rows_of, require_geometric
 from .parameters import State
 from .qos import SERVICE_QOS_PROFILE
 
@@ -145,9 +146,12 @@ def check_poses_from_poses(
                 state, request.header.frame_id, positions, quaternions
             )
         result = check_waypoints(manipulator, positions, quaternions=quaternions)
+        rows = None
+        if state is not None:
+            rows = load_rows_of(state, quaternion_to_matrix(quaternions), positions)
     except InputError as error:
         return messages.check_poses_response_fields(None, success=False, message=str(error))
-    return messages.check_poses_response_fields(result)
+    return check_poses_with_loads(messages.check_poses_response_fields(result), rows)
 
 
 def check_path_response_fields(
@@ -171,6 +175,7 @@ def check_path_response_fields(
         arcs = curve_rows(request.arcs, len(positions), 7, "arcs")
         beziers = curve_rows(request.beziers, len(positions), 6, "beziers")
         if state is not None:
+            require_geometric(state, "a path")
             positions, quaternions = cell.poses_to_base(
                 state, request.header.frame_id, positions, quaternions
             )
@@ -431,6 +436,12 @@ class PathServices:
         if current is None or not fields.get("success", False):
             return fields
         fields = dict(fields)
+        if self._get_state is not None:
+            try:
+                require_geometric(self._get_state(), "the move from the current pose")
+            except InputError as error:
+                fields["message"] += f"; move not checked: {error}"
+                return fields
         position_now, quaternion_now = current.position, current.quaternion
         try:
             if self._get_state is not None:

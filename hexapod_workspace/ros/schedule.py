@@ -36,6 +36,7 @@ from ..core.motions.speeds import ACTUATOR_MODELS
 from ..errors import HexapodWorkspaceError, InputError
 from ..logs.cell import DEG_MIN, MM_MIN, cell_frames_fields
 from . import cell
+from .load_rows import require_geometric
 from .parameters import State
 from .paths import curve_rows, pose_arrays, positive_option
 from .services import RecordedService
@@ -130,6 +131,7 @@ def schedule_response_fields(state: State, request: Any) -> dict[str, Any]:
     frames = cell_frames_fields(state.cell, request.header.frame_id)
     unit = ACTUATOR_MODELS.get(state.manipulator.architecture)
     try:
+        require_geometric(state, "a schedule")
         count = len(request.poses) - 1
         if count + 1 > MAX_WAYPOINTS:
             msg = f"poses: at most {MAX_WAYPOINTS} waypoints per request, got {count + 1}"

@@ -37,6 +37,7 @@ from hexapod_workspace.logs.cell import cell_frames_fields
 from .clouds import RESULT_MAX_POINTS, CloudTopics
 from .conversions import position_from_point, to_message, type_name
 from .jobs import JobQueue, Ticket, completion
+from .load_rows import require_geometric
 from .parameters import RAYS_RANGE
 from .qos import FEEDBACK_QOS_PROFILE
 from .worker import CanceledError, WorkspaceJob
@@ -116,6 +117,10 @@ class WorkspaceServer:
         inactive = self._node.inactive_reason()
         if inactive is not None:  # not active (lifecycle): refused, never silence
             return _Failed(inactive)
+        try:
+            require_geometric(self._node.state, "a workspace")
+        except InputError as error:
+            return _Failed(str(error))
         settings = self._node.state.settings
         base = self._node.state.manipulator.frame_id
         if request.header.frame_id not in ("", base):

@@ -141,14 +141,8 @@ def test_invalid_overrides_refuse_to_start(ros_context, overrides, named):
             "limit: unknown section",
         ),
         ({"resolution.n_rayz": 36}, "resolution.n_rayz: unknown parameter"),
-        # a loads limit is not a typo: it is read by the CLI, not yet by the node's verdicts
-        (
-            {**example_model(), "limits.actuator_force_max": [700.0]},
-            "limits.actuator_force_max: a loads limit, read by 'hexapod-workspace loads' and "
-            "'check'; the node's verdicts do not take the loads' limits yet",
-        ),
     ],
-    ids=["misspelt-key", "misspelt-section", "misspelt-setting", "loads-limit"],
+    ids=["misspelt-key", "misspelt-section", "misspelt-setting"],
 )
 def test_an_unknown_parameter_stops_the_node_with_its_name(ros_context, overrides, named):
     with pytest.raises(ConfigError) as raised:

@@ -113,8 +113,9 @@ def manipulator_from_mapping(
         The caller reads the loads' limits (``limits.actuator_force_max``,
         ``limits.deflection_max``, ...: :mod:`~hexapod_workspace.core.evaluation.loads`), as
         ``hexapod-workspace loads`` and ``check`` do. Otherwise a limit set to a value is
-        refused: the constraint table, the searches, the motions and the node do not take it
-        yet, and a verdict that ignored it would be for another machine.
+        refused: the constraint table, the searches and the motions do not take it yet (the
+        node takes it into its pose verdicts only), and a verdict that ignored it would be
+        for another machine.
 
     Returns
     -------
@@ -212,8 +213,8 @@ def _checked_values(flat: Mapping[str, Any], loads_read: bool) -> dict[str, Any]
         if given:
             msg = (
                 f"{given[0]}: a loads limit, read by 'hexapod-workspace loads' and 'check' "
-                "only; the workspace searches, motions and the node do not take it as a "
-                "constraint yet (leave it out of this file)"
+                "only (and the node's pose verdicts); the workspace searches and motions do "
+                "not take it as a constraint yet (leave it out of this file)"
             )
             raise ConfigError(msg)
     values = dict(PARAMETER_DEFAULTS)
