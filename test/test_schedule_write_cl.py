@@ -288,3 +288,54 @@ def test_refusals_exit_2_in_one_line(tmp_path):
     assert (
         code == 2 and "--write-cl" in one_error_line(err) and "FILE itself" in one_error_line(err)
     )
+
+
+def test_a_nurbs_record_through_the_cli_gets_one_fedrat_the_least_of_its_spans(tmp_path):
+    """The real NX spline (its first record, moved into the example's volume as in
+    test_cli_cam): one FEDRAT before the NURBS line, the smallest of its Bézier moves' feeds."""
+    lines = (DATA / "nx_nurbs.cls").read_text(encoding="utf-8").splitlines()
+    first = tmp_path / "first_spline.cls"
+    first.write_text("\n".join([*lines[:23], *lines[-3:]]) + "\n", encoding="utf-8")
+    text = CELL.read_text(encoding="utf-8").replace("[0.0, 0.0, -1.40]", "[0.255, -0.4595, -1.574]")
+    text = text.replace("actuator_speed_max: [0.05]", "actuator_speed_max: [0.0005]")
+    config = tmp_path / "cell.yaml"
+    config.write_text(text, encoding="utf-8")
+    out = tmp_path / "out.cls"
+    code, report_text, err = run_main(
+        "--config", str(config), "schedule", str(first), "--write-cl", str(out), "--json"
+    )
+    assert code == 0, err
+    moves = json.loads(report_text)["moves"]
+    spans = [m for m in moves if m["line"] == 13]
+    assert len(spans) == 5
+    least = min(m["feed_steady_mm_min"] for m in spans)
+    assert least < 250.0 and all(m["feed_steady_mm_min"] == least for m in spans)
+    written = out.read_text(encoding="utf-8").splitlines()
+    record = written.index(lines[12])  # the NURBS line
+    assert written[record - 1] == f"FEDRAT/MMPM,{least:.4f}"
+    _same_program(read_cldata(first), read_cldata(out))
+
+
+def test_steady_feeds_unbounded_and_refused_moves():
+    from hexapod_workspace.core.evaluation.loading import example_manipulator
+    from hexapod_workspace.core.motions.schedule import steady_feeds
+    from hexapod_workspace.errors import InputError
+
+    model = example_manipulator()
+    positions = np.array([[0.0, 0.0, -1.3], [0.05, 0.0, -1.3], [0.05, 0.0, -1.3]])
+    rotations = np.repeat(np.eye(3)[None], 3, axis=0)
+    none = steady_feeds(model, positions, rotations, speed_limits=[0.0], accel_limits=[0.0])
+    assert np.all(np.isinf(none))  # no limit; the second move does not move
+    rate = steady_feeds(model, positions, rotations, speed_limits=[0.02], accel_limits=[0.0])
+    assert 0.0 < rate[0] < math.inf and math.isinf(rate[1])
+    # speed-bound: at u' the certified peak is the limit, so the feed u'·L is at most
+    # 0.02 m/s over the largest |dq/ds| per metre (a leg can never outrun the tool: ≤ 1)
+    assert rate[0] * 0.05 >= 0.02 * (1 - 1e-9)
+    # a 6-PUS whose legs cannot reach the end of move 2: refused, the move named
+    from test_schedule import machine
+    from test_speeds import CASES
+
+    pus = machine("pus")
+    path = np.array(CASES["pus"][1]) + np.array([[0, 0, 0], [0.005, 0, 0], [0.005, 0, -2.0]])
+    with pytest.raises(InputError, match="move 2: actuator [1-6] has no inverse-kinematics"):
+        steady_feeds(pus, path, rotations, speed_limits=[0.02], accel_limits=[0.2])
