@@ -23,6 +23,26 @@ and the start of the next are two entries with the same s) and ``moves: [{"t_sta
 "limited_by": {"kind": "feed"|"velocity"|"acceleration", "actuator": 1-6 or null},
 "actuator_speed_peak", "actuator_accel_peak"}]`` (certified bounds, six each). Exit 0 when a
 schedule is given, 2 for bad input or a move that cannot be scheduled (named with its line).
+
+``--write-cl OUT`` (CL files only): FILE written again with the ``FEDRAT`` each move can run at,
+a CAM user's way to apply the result without a controller that follows s(t). **The feed a move
+can run at** is the largest constant feed F, at most the move's programmed feed (``FEDRAT``, or
+``--feed-mm-min``) and at most ``--feed-max-mm-min``, such that running the move at constant
+parameter rate u' = F/L (L its length as check-path's speeds take it, a lower bound on curves:
+how check-path models "a move at feed F") keeps every actuator within
+``limits.actuator_speed_max`` and ``limits.actuator_accel_max`` everywhere on it, certified:
+with s̈ = 0, ``|q̇_i| ≤ G_i·u'`` and ``|q̈_i| ≤ K_i·u'²`` on every interval of the move
+(:func:`~hexapod_workspace.core.motions.schedule.steady_feeds`); it is also at most
+check-path's own certified speed bound (looser by up to 1 %), so that check-path on OUT finds
+every cutting move within the speed limits. The corners between moves (from one feed to the
+next) are not bounded: they stay the controller's look-ahead. ``RAPID`` moves and moves
+without translation keep their programmed feed. How the file is written (every other line
+kept, the file's own ``FEDRAT`` dialect, one per statement, the smallest of a ``NURBS``
+record's moves): :mod:`~hexapod_workspace.core.cell.cl_feeds`. OUT must not be FILE, nor an
+existing file without ``--force``. Text: ``wrote OUT: N FEDRAT statements (M moves slower
+than programmed)``; JSON: ``"write_cl": {"path", "fedrat_statements", "moves_slowed"}`` and
+per move ``"feed_steady_mm_min"`` (the feed written, mm/min; ``null``: the programmed feed
+kept).
 """
 
 from __future__ import annotations
@@ -37,6 +57,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core.base.rotations import tt_to_matrix
+from ..core.cell.cl_feeds import rewrite_feeds
+from ..core.cell.cldata import CL_SUFFIXES, CLProgram
 from ..core.cell.frames import CellFrames
 from ..core.model.manipulator import Manipulator
 from ..core.motions import DEFAULT_PLAN_PSI_STEP, reported_parts
@@ -45,8 +67,9 @@ from ..core.motions.schedule import (
     limited_by,
     programmed_duration,
     schedule_path,
+    steady_feeds,
 )
-from ..core.motions.speeds import ACTUATOR_MODELS
+from ..core.motions.speeds import ACTUATOR_MODELS, actuator_rates, feed_limits
 from ..errors import InputError
 from .cam import (
     DEG_MIN,
@@ -56,6 +79,7 @@ from .cam import (
     _positive,
     cell_arguments,
     check_part_path,
+    is_cl_file,
     read_cell_inputs,
 )
 from .commands import PROG
@@ -170,11 +194,94 @@ def _schedule_part(
     scheduled = ScheduledPart(
         model, positions, rotations, part.arcs, part.beziers, programmed, schedule
     )
+    if options.write_cl is not None:  # replaced by each move's written feed (_write_cl)
+        document["steady"] = _steady_part(scheduled, part.rapid, cell, linear)
     return document, scheduled, programmed_time
+
+
+def _steady_part(
+    scheduled: ScheduledPart, rapid: NDArray[np.bool_], cell: CellFrames, ceilings: NDArray[Any]
+) -> NDArray[np.float64]:
+    """Per move of the part, the feed it can run at (module documentation, ``--write-cl``),
+    m/s; NaN for ``RAPID`` moves, moves without translation and moves no limit bounds."""
+    model, positions, rotations = scheduled.model, scheduled.positions, scheduled.rotations
+    schedule = scheduled.schedule
+    limits = cell.actuator_speed_max
+    curves: dict[str, Any] = {"arcs": scheduled.arcs, "beziers": scheduled.beziers}
+    try:
+        rate = steady_feeds(
+            model,
+            positions,
+            rotations,
+            speed_limits=limits,
+            accel_limits=cell.actuator_accel_max,
+            **curves,
+        )
+    except InputError as error:  # the schedule refused the same moves first
+        raise CliError(str(error)) from error
+    # check-path's own certified speed bound (looser, DEFAULT_RELATIVE): so that check-path on
+    # OUT finds every move within the speed limits too
+    none = np.full(rate.size, math.nan)
+    rates = actuator_rates(model, positions, rotations, speed_limits=limits, **curves)
+    checked = feed_limits(rates, none, none, limits).feed_max
+    with np.errstate(invalid="ignore"):
+        feed = np.minimum(np.minimum(ceilings, rate * schedule.length), checked)
+    keep = rapid[1:] | schedule.rotary | ~np.isfinite(feed)
+    return np.where(keep, math.nan, feed)
+
+
+def _write_cl_target(options: argparse.Namespace) -> Path | None:
+    """``--write-cl OUT``, checked before any work: FILE a CL file, OUT not FILE, OUT not an
+    existing file (but with ``--force``)."""
+    if options.write_cl is None:
+        return None
+    if not is_cl_file(options.file):
+        msg = f"--write-cl: only for CL files ({options.file} is read as a path CSV)"
+        raise CliError(msg)
+    if Path(options.write_cl).resolve() == Path(options.file).resolve():
+        msg = f"--write-cl: {options.write_cl} is FILE itself; give another file name"
+        raise CliError(msg)
+    return output_file(options.write_cl, "--write-cl", force=options.force, suffixes=CL_SUFFIXES)
+
+
+def _write_cl(
+    options: argparse.Namespace,
+    target: Path,
+    program: CLProgram | None,
+    parts: list[_Part],
+    documents: list[dict[str, Any]],
+) -> dict[str, Any]:
+    """Write FILE again with each move's feed (:mod:`~hexapod_workspace.core.cell.cl_feeds`);
+    each move's document gets ``feed_steady_mm_min`` (null: the programmed feed kept)."""
+    assert program is not None
+    wanted = np.full(len(program), math.nan)
+    for part, document in zip(parts, documents, strict=True):
+        steady = document.pop("steady")
+        wanted[part.first + 1 : part.first + 1 + steady.size] = steady
+    try:
+        with Path(options.file).open(encoding="utf-8", newline="") as handle:
+            text = handle.read()
+        result = rewrite_feeds(text, program, wanted)
+        with target.open("w", encoding="utf-8", newline="") as handle:
+            handle.write(result.text)
+    except OSError as error:
+        msg = f"--write-cl: cannot write {target}: {error.strerror or error}"
+        raise CliError(msg) from error
+    slowed = 0
+    for part, document in zip(parts, documents, strict=True):
+        for k, move in enumerate(document["moves"]):
+            feed = float(result.feeds[part.first + 1 + k])
+            move["feed_steady_mm_min"] = _finite(feed / MM_MIN)
+            ceiling = move.get("feed_ceiling_mm_min")
+            # slower than programmed: below the ceiling by more than the 4 decimals' rounding
+            if math.isfinite(feed) and ceiling is not None:
+                slowed += int(feed / MM_MIN < ceiling * (1.0 - 1e-6) - 2e-4)
+    return {"path": str(target), "fedrat_statements": result.statements, "moves_slowed": slowed}
 
 
 def cmd_schedule(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int:
     """``schedule``: the certified fastest schedule of FILE (module documentation)."""
+    target = _write_cl_target(options)
     plot = (
         None
         if options.plot is None
@@ -182,7 +289,7 @@ def cmd_schedule(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int
     )
     options.interpolation = "slerp"  # the controller's moves, as the speeds take them
     feed_max = _positive(options.feed_max_mm_min, "--feed-max-mm-min", "mm/min") * MM_MIN
-    platform, cell, frame, (rapid, rotary), parts, _ = read_cell_inputs(options, err)
+    platform, cell, frame, (rapid, rotary), parts, program = read_cell_inputs(options, err)
     documents: list[dict[str, Any]] = []
     schedules: list[ScheduledPart] = []
     programmed: list[float] = []
@@ -207,6 +314,8 @@ def cmd_schedule(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int
         "actuator_accel_max": cell.actuator_accel_max.tolist(),
         "covers": SCHEDULE_COVERAGE,
     }
+    if target is not None:
+        report["write_cl"] = _write_cl(options, target, program, parts, documents)
     if len(documents) == 1:
         report.update(documents[0])
         report["duration_s"], report["programmed_duration_s"] = total, _finite(planned_total)
@@ -220,6 +329,12 @@ def cmd_schedule(options: argparse.Namespace, out: IO[str], err: IO[str]) -> int
         _text(report, documents, unit, out)
         if plot is not None:
             out.write(f"  plot: {plot}\n")
+        if target is not None:
+            written = report["write_cl"]
+            out.write(
+                f"wrote {written['path']}: {written['fedrat_statements']} FEDRAT statements "
+                f"({written['moves_slowed']} moves slower than programmed)\n"
+            )
     if not report["path_ok"]:
         err.write(f"{PROG}: the path does not run (check-path FILE says where); scheduled anyway\n")
     return 0
@@ -323,5 +438,17 @@ def schedule_arguments(sub: argparse.ArgumentParser) -> None:
         "acceleration against its limits, over time",
     )
     sub.add_argument(
-        "--force", action="store_true", help="replace an existing --plot file not of ours"
+        "--write-cl",
+        metavar="OUT",
+        help="CL files: write FILE again as OUT (every line kept) with a FEDRAT before each "
+        "cutting move whose feed changes: the largest constant feed, at most the programmed one "
+        "and --feed-max-mm-min, at which the move keeps every actuator within "
+        "limits.actuator_speed_max and limits.actuator_accel_max everywhere on it (certified; "
+        "RAPID moves and rotations keep theirs; the corners between moves stay the "
+        "controller's look-ahead). See docs/cell.md",
+    )
+    sub.add_argument(
+        "--force",
+        action="store_true",
+        help="replace an existing --plot file not of ours, or an existing --write-cl file",
     )

@@ -92,7 +92,13 @@ _END_OF_PATH = re.compile(r"\s*END-OF-PATH\s*(?:/.*)?$", re.IGNORECASE)
 def _statements(text: str) -> list[tuple[int, str]]:
     """Logical statements with the line they start on: comments removed, continuations
     joined; ``PPRINT``/``PARTNO``/``TPRINT``/``INSERT`` lines kept literal."""
-    statements: list[tuple[int, str]] = []
+    return [(start, statement) for start, _, statement in _statement_spans(text)]
+
+
+def _statement_spans(text: str) -> list[tuple[int, int, str]]:
+    """:func:`_statements` with the last line of each statement: (first, last, statement),
+    1-based lines of ``text.splitlines()``."""
+    statements: list[tuple[int, int, str]] = []
     pending: list[str] = []
     start = 0
     for number, raw in enumerate(text.splitlines(), start=1):
@@ -100,7 +106,7 @@ def _statements(text: str) -> list[tuple[int, str]]:
             start = number
             word = _WORD.match(raw)
             if word and word.group(1).upper() in _LITERAL:
-                statements.append((number, raw.strip()))
+                statements.append((number, number, raw.strip()))
                 continue
         line = raw.split("$$", 1)[0].rstrip()
         if line.endswith("$"):
@@ -110,7 +116,7 @@ def _statements(text: str) -> list[tuple[int, str]]:
         statement = " ".join(part.strip() for part in pending).strip()
         pending = []
         if statement:
-            statements.append((start, statement))
+            statements.append((start, number, statement))
     if pending and " ".join(pending).strip():
         msg = f"line {start}: statement continued with '$' past the end of the file"
         raise InputError(msg)

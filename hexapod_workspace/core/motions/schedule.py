@@ -77,6 +77,17 @@ what fixed its x (rest, the feed, an actuator's speed or acceleration), and ever
 certified peak feed and actuator speeds and accelerations (the bounds above at the schedule's
 x and u). A move where some actuator has no inverse-kinematics solution, or a transmission of 0,
 on the move is refused with the move named, as is a move no limit bounds.
+**Steady feeds.** What a CAM user can apply without a controller that follows s(t): the largest
+*constant* rate u' = ṡ per move (s̈ = 0) that holds the actuator limits everywhere on it
+(:func:`steady_feeds`). With s̈ = 0, ``q̇_i = g_i·u'`` and ``q̈_i = g_i'·u'²``, so on each interval
+``|q̇_i| ≤ G_i·u'`` and ``|q̈_i| ≤ K_i·u'²`` and the move holds every limit when
+``u'² ≤ min over its intervals and actuators of min((v_i/G_i)², a_i/K_i)`` (the caps X_I
+above without the feed). ``schedule --write-cl`` writes F = u'·L as the move's ``FEDRAT``
+(L = :attr:`PathSchedule.length`, a lower bound on curves: the tool-tip speed ``|p'|·u'`` may
+exceed F on a curve, as check-path's speeds take a move at feed F). The intervals that bind are
+bisected again (K shrinks with them on straight moves) while that raises some move's rate by
+more than ``relative``/4. The corners between moves (one feed to the next) are not bounded:
+they stay the controller's look-ahead.
 """
 
 from __future__ import annotations
@@ -111,6 +122,7 @@ __all__ = [
     "programmed_duration",
     "schedule_path",
     "schedule_profiles",
+    "steady_feeds",
 ]
 
 #: Tightness of each interval's bound of |g_i| against its end values (module documentation).
@@ -208,6 +220,130 @@ def _ceilings(values: ArrayLike | None, count: int, name: str) -> NDArray[np.flo
         msg = f"{name}: expected values > 0 per move (inf: no ceiling)"
         raise InputError(msg)
     return np.asarray(array, dtype=np.float64)
+
+
+def _prepared(
+    manipulator: Manipulator,
+    positions: ArrayLike,
+    rotations: ArrayLike,
+    arcs: ArrayLike | None,
+    beziers: ArrayLike | None,
+    relative: float,
+) -> tuple[
+    NDArray[np.float64],
+    NDArray[np.float64],
+    SlerpMoves,
+    NDArray[np.bool_],
+    NDArray[np.float64],
+    NDArray[np.int64],
+    SlerpMoves | None,
+]:
+    """The validated poses (N, 3) and (N, 3, 3), the moves, which are rotations only, each
+    move's length (m, or rad for a rotation), the moves that move and their batch (None when
+    none does)."""
+    p = np.asarray(positions, dtype=np.float64)
+    r = np.asarray(rotations, dtype=np.float64)
+    if p.ndim != 2 or p.shape[1] != 3 or r.shape != (p.shape[0], 3, 3) or p.shape[0] < 2:
+        msg = (
+            "poses: expected positions (N, 3) and rotations (N, 3, 3), N >= 2, "
+            f"got {p.shape}, {r.shape}"
+        )
+        raise InputError(msg)
+    if not (np.all(np.isfinite(p)) and np.all(np.isfinite(r))):
+        msg = "poses: expected finite positions and rotations"
+        raise InputError(msg)
+    if not 0.0 < relative < 0.5:
+        msg = f"relative: expected a value in (0, 0.5), got {relative!r}"
+        raise InputError(msg)
+    name = manipulator.architecture
+    if name not in ACTUATOR_MODELS:
+        msg = f"architecture: expected one of {', '.join(ACTUATOR_MODELS)}, got {name!r}"
+        raise InputError(msg)
+    moves = SlerpMoves(
+        manipulator, p[:-1], p[1:], r[:-1], r[1:], _validate_curves(arcs, beziers, p)
+    )
+    rotary = moves.translation == 0.0
+    length = np.where(rotary, moves.omega, moves.translation)
+    active = np.flatnonzero(length != 0.0)
+    count = p.shape[0] - 1
+    if active.size == 0:
+        return p, r, moves, rotary, length, active, None
+    sub = (
+        moves  # the moves that move: all of them, or a new batch without the still ones
+        if active.size == count
+        else SlerpMoves(
+            manipulator,
+            p[:-1][active],
+            p[1:][active],
+            r[:-1][active],
+            r[1:][active],
+            None if moves.arcs is None else moves.arcs.take(active),
+        )
+    )
+    return p, r, moves, rotary, length, active, sub
+
+
+def _bisected(
+    manipulator: Manipulator,
+    sub: SlerpMoves,
+    count: int,
+    weights: NDArray[np.float64],
+    relative: float,
+    grid: Intervals,
+    split: NDArray[np.bool_],
+) -> Intervals:
+    """The grid with the intervals ``split`` (m,) cut in two, its bounds certified anew."""
+    mid = 0.5 * (grid.a[split] + grid.b[split])
+    move = np.concatenate([grid.move, grid.move[split]])
+    a = np.concatenate([grid.a, mid])
+    b = np.concatenate([np.where(split, 0.5 * (grid.a + grid.b), grid.b), grid.b[split]])
+    order = np.lexsort((a, move))
+    return certified_intervals(
+        manipulator,
+        ACTUATOR_MODELS[manipulator.architecture],
+        sub,
+        count,
+        weights,
+        relative,
+        MAX_SCHEDULE_INTERVALS,
+        local=True,
+        start=(move[order], a[order], b[order]),
+    )
+
+
+def _checked_rates(
+    manipulator: Manipulator, sub: SlerpMoves, grid: Intervals, active: NDArray[np.int64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """K and G per interval (:func:`_local_rates`), (m, 6) each; a move where one is infinite
+    (no inverse-kinematics solution, a transmission of 0) refused, named (1-based)."""
+    big_k, big_g = _local_rates(manipulator, sub, grid)
+    bad = np.flatnonzero(~np.all(np.isfinite(big_g) & np.isfinite(big_k), axis=1))
+    if bad.size:
+        k = int(active[grid.move[bad[0]]])
+        which_leg = int(
+            np.flatnonzero(~np.isfinite(big_g[bad[0]]) | ~np.isfinite(big_k[bad[0]]))[0]
+        )
+        msg = (
+            f"move {k + 1}: actuator {which_leg + 1} has no inverse-kinematics solution or a "
+            "transmission of 0 on it (no speed can be scheduled; see the ik and transmission "
+            "constraints)"
+        )
+        raise InputError(msg)
+    return big_k, big_g
+
+
+def _actuator_caps(
+    big_g: NDArray[np.float64],
+    big_k: NDArray[np.float64],
+    vmax: NDArray[np.float64],
+    amax: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The caps of ṡ² per interval and actuator, (m, 6) each: (v_i/G_i)² and a_i/K_i (+inf
+    where the bound is 0 or the limit is none)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        speed_cap = np.where(big_g > 0.0, (vmax / big_g) ** 2, np.inf)
+        accel_cap = np.where(big_k > 0.0, amax / big_k, np.inf)
+    return speed_cap, accel_cap
 
 
 def _tcp_bounds(
@@ -310,27 +446,13 @@ def schedule_path(
         inverse-kinematics solution or a transmission of 0, or whose speed no limit bounds
         (naming the move, 1-based).
     """
-    p = np.asarray(positions, dtype=np.float64)
-    r = np.asarray(rotations, dtype=np.float64)
-    if p.ndim != 2 or p.shape[1] != 3 or r.shape != (p.shape[0], 3, 3) or p.shape[0] < 2:
-        msg = (
-            "poses: expected positions (N, 3) and rotations (N, 3, 3), N >= 2, "
-            f"got {p.shape}, {r.shape}"
-        )
-        raise InputError(msg)
-    if not (np.all(np.isfinite(p)) and np.all(np.isfinite(r))):
-        msg = "poses: expected finite positions and rotations"
-        raise InputError(msg)
-    if not 0.0 < relative < 0.5:
-        msg = f"relative: expected a value in (0, 0.5), got {relative!r}"
-        raise InputError(msg)
     if not 0.0 <= corner <= 0.1:
         msg = f"corner: expected an angle in [0, 0.1] rad, got {corner!r}"
         raise InputError(msg)
+    p, r, _, rotary, length, active, sub = _prepared(
+        manipulator, positions, rotations, arcs, beziers, relative
+    )
     name = manipulator.architecture
-    if name not in ACTUATOR_MODELS:
-        msg = f"architecture: expected one of {', '.join(ACTUATOR_MODELS)}, got {name!r}"
-        raise InputError(msg)
     count = p.shape[0] - 1
     vmax = _limits(speed_limits, "speed_limits", "actuator unit/s")
     amax = _limits(accel_limits, "accel_limits", "actuator unit/s²")
@@ -344,30 +466,10 @@ def schedule_path(
             raise InputError(msg)
         stop_at |= asked
     stop_at[0] = stop_at[-1] = True
-    moves = SlerpMoves(
-        manipulator, p[:-1], p[1:], r[:-1], r[1:], _validate_curves(arcs, beziers, p)
-    )
-    rotary = moves.translation == 0.0
-    length = np.where(rotary, moves.omega, moves.translation)
-    still = length == 0.0
-    active = np.flatnonzero(~still)
     model = ACTUATOR_MODELS[name]
     weights = _weights(np.where(np.isfinite(vmax), vmax, 0.0))
-
-    if active.size == 0:
+    if sub is None:
         return _still_schedule(count, stop_at, rotary, length)
-    sub = (
-        moves  # the moves that move: all of them, or a new batch without the still ones
-        if active.size == count
-        else SlerpMoves(
-            manipulator,
-            p[:-1][active],
-            p[1:][active],
-            r[:-1][active],
-            r[1:][active],
-            None if moves.arcs is None else moves.arcs.take(active),
-        )
-    )
     grid = certified_intervals(
         manipulator, model, sub, active.size, weights, relative, MAX_SCHEDULE_INTERVALS, local=True
     )
@@ -378,22 +480,7 @@ def schedule_path(
     for _ in range(REFINE_ROUNDS):
         if not ramp.any() or grid.move.size + int(ramp.sum()) > MAX_SCHEDULE_INTERVALS:
             break
-        mid = 0.5 * (grid.a[ramp] + grid.b[ramp])
-        move = np.concatenate([grid.move, grid.move[ramp]])
-        a = np.concatenate([grid.a, mid])
-        b = np.concatenate([np.where(ramp, 0.5 * (grid.a + grid.b), grid.b), grid.b[ramp]])
-        order = np.lexsort((a, move))
-        finer = certified_intervals(
-            manipulator,
-            model,
-            sub,
-            active.size,
-            weights,
-            relative,
-            MAX_SCHEDULE_INTERVALS,
-            local=True,
-            start=(move[order], a[order], b[order]),
-        )
+        finer = _bisected(manipulator, sub, active.size, weights, relative, grid, ramp)
         candidate, candidate_ramp = _solve(manipulator, sub, finer, active, given, corner)
         gain = schedule.duration - candidate.duration
         if gain < 0.0:
@@ -402,6 +489,90 @@ def schedule_path(
         if gain <= 0.25 * relative * schedule.duration:
             break
     return schedule
+
+
+def steady_feeds(
+    manipulator: Manipulator,
+    positions: ArrayLike,
+    rotations: ArrayLike,
+    *,
+    speed_limits: ArrayLike,
+    accel_limits: ArrayLike,
+    arcs: ArrayLike | None = None,
+    beziers: ArrayLike | None = None,
+    relative: float = DEFAULT_SCHEDULE_RELATIVE,
+) -> NDArray[np.float64]:
+    """The largest certified constant parameter rate of each of the N − 1 slerp moves of a
+    path (module documentation, "Steady feeds").
+
+    Running move k at ``u' = rate[k]`` (u ∈ [0, 1] its parameter, s̈ = 0) keeps every
+    actuator within ``speed_limits`` and ``accel_limits`` everywhere on it: with G_i ≥ |g_i|
+    and K_i ≥ |g_i'| on each interval (:func:`~hexapod_workspace.core.motions.speeds.
+    certified_intervals`, :func:`_local_rates`), ``|q̇_i| ≤ G_i·u'`` and ``|q̈_i| ≤ K_i·u'²``,
+    so ``u'² = min over the move's intervals and actuators of min((v_i/G_i)², a_i/K_i)``.
+    The feed F = u'·L (L = :attr:`PathSchedule.length`) is that of check-path's speed verdicts.
+    Junctions between moves are not bounded (the controller's look-ahead).
+
+    Parameters
+    ----------
+    manipulator : Manipulator
+        The model of the poses' frame (a tool model for tool-centre-point poses).
+    positions, rotations : array_like, shapes (N, 3) and (N, 3, 3)
+        The waypoints: tool centre point (m) and orientation, both in the base frame.
+    speed_limits, accel_limits : array_like, shape (6,) or (1,)
+        v_i (actuator unit/s) and a_i (actuator unit/s²), 0 = unlimited.
+    arcs, beziers : array_like, optional
+        The curved moves, as for :func:`schedule_path`.
+    relative : float
+        Tightness of the grid's bounds, in (0, 0.5).
+
+    Returns
+    -------
+    ndarray, shape (N − 1,)
+        u' per move, 1/s; +inf where no limit bounds it (no limits, or a move that does not
+        move).
+
+    Raises
+    ------
+    InputError
+        Bad shapes or values (naming the parameter); a move where an actuator has no
+        inverse-kinematics solution or a transmission of 0 (naming the move, 1-based).
+    """
+    p, _, _, _, _, active, sub = _prepared(
+        manipulator, positions, rotations, arcs, beziers, relative
+    )
+    vmax = _limits(speed_limits, "speed_limits", "actuator unit/s")
+    amax = _limits(accel_limits, "accel_limits", "actuator unit/s²")
+    rate = np.full(p.shape[0] - 1, np.inf)
+    if sub is None:
+        return rate
+    model = ACTUATOR_MODELS[manipulator.architecture]
+    weights = _weights(np.where(np.isfinite(vmax), vmax, 0.0))
+    grid = certified_intervals(
+        manipulator, model, sub, active.size, weights, relative, MAX_SCHEDULE_INTERVALS, local=True
+    )
+    best = np.zeros(active.size)
+    for round_ in range(REFINE_ROUNDS + 1):
+        big_k, big_g = _checked_rates(manipulator, sub, grid, active)
+        speed_cap, accel_cap = _actuator_caps(big_g, big_k, vmax, amax)
+        cap = np.minimum(speed_cap, accel_cap).min(axis=1)  # of ṡ², per interval
+        lowest = np.full(active.size, np.inf)
+        np.minimum.at(lowest, grid.move, cap)
+        value = np.sqrt(lowest)
+        gained = round_ == 0 or bool(np.any(value > best * (1.0 + 0.25 * relative)))
+        best = np.maximum(best, value)  # every grid's value is certified
+        # bisect the intervals that may bind (within 10 % of their move's rate) while it pays
+        binding = np.isfinite(cap) & (cap <= 1.21 * lowest[grid.move])
+        if (
+            not gained
+            or round_ == REFINE_ROUNDS
+            or not binding.any()
+            or grid.move.size + int(binding.sum()) > MAX_SCHEDULE_INTERVALS
+        ):
+            break
+        grid = _bisected(manipulator, sub, active.size, weights, relative, grid, binding)
+    rate[active] = best
+    return rate
 
 
 def _solve(
@@ -419,24 +590,10 @@ def _solve(
 
     move, a, b = grid.move, grid.a, grid.b
     width = b - a
-    big_k, big_g = _local_rates(manipulator, sub, grid)
-    bad = np.flatnonzero(~np.all(np.isfinite(big_g) & np.isfinite(big_k), axis=1))
-    if bad.size:
-        k = int(active[move[bad[0]]])
-        which_leg = int(
-            np.flatnonzero(~np.isfinite(big_g[bad[0]]) | ~np.isfinite(big_k[bad[0]]))[0]
-        )
-        msg = (
-            f"move {k + 1}: actuator {which_leg + 1} has no inverse-kinematics solution or a "
-            "transmission of 0 on it (no speed can be scheduled; see the ik and transmission "
-            "constraints)"
-        )
-        raise InputError(msg)
+    big_k, big_g = _checked_rates(manipulator, sub, grid, active)
 
     # the caps X_I per interval, and what sets them
-    with np.errstate(divide="ignore", invalid="ignore"):
-        speed_cap = np.where(big_g > 0.0, (vmax / big_g) ** 2, np.inf)
-        accel_cap = np.where(big_k > 0.0, amax / big_k, np.inf)
+    speed_cap, accel_cap = _actuator_caps(big_g, big_k, vmax, amax)
     tcp = np.where(rotary[active][move], sub.omega[move], _tcp_bounds(sub, move, a, b))
     ceiling = np.where(rotary[active][move], rotary_feed[active][move], feed[active][move])
     with np.errstate(divide="ignore"):
