@@ -290,3 +290,17 @@ def test_core_imports_without_ros_or_the_outer_layers() -> None:
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
     assert done.returncode == 0, done.stderr
     assert "rclpy" not in done.stdout.split()
+
+
+#: The longest a module may be (lines): past it, a module holds more than one concept.
+MODULE_LINES_MAX = 800
+
+
+def test_no_module_is_longer_than_the_limit() -> None:
+    lengths = {
+        str(path.relative_to(PACKAGE_DIR)): len(path.read_text(encoding="utf-8").splitlines())
+        for path in sorted(PACKAGE_DIR.rglob("*.py"))
+    }
+    assert len(lengths) > 100, "the package's modules were not found"
+    longer = {name: count for name, count in lengths.items() if count > MODULE_LINES_MAX}
+    assert not longer, f"modules over {MODULE_LINES_MAX} lines: {longer}"

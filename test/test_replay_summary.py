@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from hexapod_workspace import logs
+from hexapod_workspace.cli.log_report import LIST_CAP
 from hexapod_workspace.cli.replay import run_replay
-from hexapod_workspace.cli.reports import LIST_CAP
 from hexapod_workspace.core.evaluation import check as constraints
 from hexapod_workspace.logs import messages
 from hexapod_workspace.logs.paths import pose_fields

@@ -250,7 +250,7 @@ def test_second_order_bounds_hold_against_finite_differences(random_case):
     """On every grid interval the tightened bounds of |dq_i/ds| and |d²q_i/ds²| (module
     "Second order") lie above central differences of the formulas' coordinates, and the
     exact g' at the nodes agrees with them."""
-    from hexapod_workspace.core.motions.schedule import _local_rates, _rate_derivatives
+    from hexapod_workspace.core.motions.schedule_bounds import local_rates, rate_derivatives
     from hexapod_workspace.core.motions.speeds import (
         ACTUATOR_MODELS,
         SlerpMoves,
@@ -263,7 +263,7 @@ def test_second_order_bounds_hold_against_finite_differences(random_case):
     grid = certified_intervals(
         model, ACTUATOR_MODELS[architecture], moves, count, np.ones(6), 0.002, 10**5, local=True
     )
-    rate, upper = _local_rates(model, moves, grid)
+    rate, upper = local_rates(model, moves, grid)
     assert np.all(rate <= grid.rate) and np.all(upper <= grid.upper)
     assert np.median(rate / grid.rate) < 0.5  # tighter where it matters
     h = 1e-4
@@ -284,5 +284,5 @@ def test_second_order_bounds_hold_against_finite_differences(random_case):
         scale = np.max(np.abs(second)) + 1e-12
         assert np.all(np.abs(first) <= upper[which] * (1 + 1e-6) + 1e-9), k
         assert np.all(np.abs(second) <= rate[which] + 1e-4 * scale), k
-        exact = _rate_derivatives(model, moves, np.full(s.size, k), s)
+        exact = rate_derivatives(model, moves, np.full(s.size, k), s)
         np.testing.assert_allclose(exact, second, atol=1e-4 * scale + 1e-9)

@@ -18,7 +18,7 @@ from hexapod_workspace.core.base.resolution import WorkspaceKind
 from hexapod_workspace.errors import LogReadError
 from hexapod_workspace.logs.summary import LogSummary, WorkspaceRecord, summarize_log
 
-from . import reports
+from . import log_report
 from .commands import PROG
 
 # --------------------------------------------------------------------------- plots
@@ -179,12 +179,12 @@ def run_replay(
     if summary.decoded == 0 and (contents.problems or not contents.finished):
         err.write(f"{PROG}: error: nothing usable in {log}\n")
         return 2
-    report = reports.log_report(summary)
+    report = log_report.log_report(summary)
     if as_json:
-        json.dump(reports.jsonable(report), out, indent=1, allow_nan=False)
+        json.dump(log_report.jsonable(report), out, indent=1, allow_nan=False)
         out.write("\n")
     else:
-        reports.log_report_text(report, out)
+        log_report.log_report_text(report, out)
     if plot_dir is not None:
         try:
             _plot(summary, Path(plot_dir), err if as_json else out, err)

@@ -62,13 +62,8 @@ from ..core.cell.cldata import CL_SUFFIXES, CLProgram
 from ..core.cell.frames import CellFrames
 from ..core.model.manipulator import Manipulator
 from ..core.motions import DEFAULT_PLAN_PSI_STEP, reported_parts
-from ..core.motions.schedule import (
-    PathSchedule,
-    limited_by,
-    programmed_duration,
-    schedule_path,
-    steady_feeds,
-)
+from ..core.motions.schedule import PathSchedule, schedule_path, steady_feeds
+from ..core.motions.schedule_report import limited_by, programmed_duration
 from ..core.motions.speeds import ACTUATOR_MODELS, actuator_rates, feed_limits
 from ..errors import InputError
 from .cam import (

@@ -11,7 +11,8 @@ from numpy.typing import NDArray
 
 from ..core.cell.frames import CellFrames
 from ..core.model.manipulator import Manipulator
-from ..core.motions.schedule import PathSchedule, schedule_profiles
+from ..core.motions.schedule import PathSchedule
+from ..core.motions.schedule_report import schedule_profiles
 from .cam import MM_MIN
 
 __all__ = ["ScheduledPart", "plot_schedule"]

@@ -31,7 +31,8 @@ from numpy.typing import NDArray
 
 from ..core.base.rotations import quaternion_to_matrix
 from ..core.motions import DEFAULT_PATH_TOLERANCE, check_path
-from ..core.motions.schedule import limited_by, programmed_duration, schedule_path
+from ..core.motions.schedule import schedule_path
+from ..core.motions.schedule_report import limited_by, programmed_duration
 from ..core.motions.speeds import ACTUATOR_MODELS
 from ..errors import HexapodWorkspaceError, InputError
 from ..logs.cell import DEG_MIN, MM_MIN, cell_frames_fields

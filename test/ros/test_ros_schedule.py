@@ -27,7 +27,8 @@ from hexapod_workspace.core.base.rotations import (  # noqa: E402
 )
 from hexapod_workspace.core.evaluation.loading import load_manipulator  # noqa: E402
 from hexapod_workspace.core.motions import check_path  # noqa: E402
-from hexapod_workspace.core.motions.schedule import limited_by, schedule_path  # noqa: E402
+from hexapod_workspace.core.motions.schedule import schedule_path  # noqa: E402
+from hexapod_workspace.core.motions.schedule_report import limited_by  # noqa: E402
 
 NODE = "/hexapod_workspace"
 SERVICE = f"{NODE}/schedule_path"

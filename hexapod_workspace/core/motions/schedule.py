@@ -1,8 +1,9 @@
 """The fastest feed schedule along a path that is certified to run: actuator speeds and
 accelerations, the tool centre point's feed, rest at both ends.
 
-**The problem.** Along a path of M moves (the moves :func:`~hexapod_workspace.core.motions.checks.
-check_path` checks: position linear, or an arc, or a cubic Bézier curve, orientation by slerp),
+**The problem.** Along a path of M moves (the moves
+:func:`~hexapod_workspace.core.motions.checks.check_path` checks: position linear, or an arc,
+or a cubic Bézier curve, orientation by slerp),
 s = k + u on move k with u ∈ [0, 1] its own parameter, find the time law s(t) that minimises the
 total time subject to, for every actuator i and every s,
 
@@ -19,7 +20,8 @@ On an interval I = [a, b] of width w it gives two certified bounds, valid for ev
 G_i ≥ |g_i(s)| and K_i ≥ |g_i'(s)| (derived in :mod:`.speeds`). The tool centre point's speed
 per unit s is bounded the same way: ``P = |Δp|`` on a straight move; on a curve
 ``P = min(P₁, (|p'(a)| + |p'(b)| + P₂·w)/2)`` with P₁, P₂ the curve's bounds of |p'| and |p''|
-(:mod:`.interpolation`); a rotation without translation takes ``P = Ω`` against the rotary feed.
+(``hexapod_workspace.core.motions.interpolation``); a rotation without translation takes
+``P = Ω`` against the rotary feed.
 
 **The schedule's form.** On every interval s̈ = u is constant, so x is linear in s:
 ``x(s) = x_a + 2u·(s − a)``, and ``max_I x = max(x_a, x_b)``. Then, on the whole interval,
@@ -31,24 +33,9 @@ so the schedule holds every limit everywhere (not only at grid points) when, at 
 
     x ≤ X_I := min_i((v_i/G_i)², a_i/K_i) and (f/P)²,    |u| ≤ U_I(x) := min_i (a_i − K_i x)/G_i.
 
-**Second order.** The bound K of :mod:`.speeds` is a move-wide worst case: it does not shrink
-with the interval, and ``K·x`` would slow every fast stretch down. On straight moves (where
-``v_i' = w × (w × R b_i)`` and ``|v_i''| ≤ J_i := Ω³·|b_i|``) each interval therefore takes
-``K_loc = min(K, (|g'(a)| + |g'(b)| + K2·w)/2)`` (the argument of the certified peak, one
-order up), with g' evaluated exactly at the nodes and K2 ≥ |g''| on the interval. Then G is
-re-derived from K_loc (``G = (|g(a)| + |g(b)| + K_loc·w)/2``, valid for any bound of |g'|).
-
-* 6-UPS: ``g' = (|v|² − g²)/ℓ + n·v'``; differentiating, with ``ℓ' = g``, ``|n'| ≤ V/ℓ``,
-  ``|g| ≤ V`` and ``|g'| ≤ K``: ``|g''| ≤ (3VA + 2VK)/ℓ_f + V³/ℓ_f² + J =: K2``.
-* 6-PUS and 6-RUS (ρ, τ_f, L, N as in :mod:`.speeds`; A' = dA/dq, A'' and A''' of norm r for
-  a crank, 0 for a slide; ``h = ρτ = n·A'``): ``h·g' = E := L|n'|² + n·v' − g²·n·A''`` with
-  ``n' = (v − A'g)/L``. Differentiating, ``n'' = (v' − A''g² − A'g')/L``,
-  ``h' = n'·A' + g·n·A''`` and ``E' = 2L·n'·n'' + n'·v' + n·v'' − 2gg'·n·A'' −
-  g²(n'·A'' + g·n·A''')``, so ``g'' = (E' − h'g')/h`` and, with ``|g| ≤ Ĝ := V/(ρτ_f)``,
-  ``|n'| ≤ N``, ``|n''| ≤ (A + rĜ² + ρK)/L``, ``|h'| ≤ ρN + rĜ``:
-  ``|g''| ≤ (2LN|n''| + NA + J + 2ĜKr + Ĝ²(Nr + rĜ) + |h'|K)/(ρτ_f) =: K2``.
-
-Curved moves (arcs, Bézier spans) keep K (their third derivative is not bounded here).
+**Second order.** The bound K of :mod:`.speeds` is a move-wide worst case; on straight moves
+each interval takes the tighter ``K_loc`` of :mod:`.schedule_bounds` (derived there) and G
+from it. Curved moves (arcs, Bézier spans) keep K.
 
 **The passes.** U_I decreases in x, which makes the classic two-pass construction both optimal
 on this grid and feasible. Forward from rest, each node takes the largest x the interval allows
@@ -100,16 +87,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InputError
-from ..model import architectures
 from ..model.manipulator import Manipulator
 from .interpolation import _validate_curves
+from .schedule_bounds import local_rates, tcp_bounds
 from .speeds import (
     ACTUATOR_MODELS,
     Intervals,
     SlerpMoves,
     _weights,
     certified_intervals,
-    interval_nodes,
 )
 
 __all__ = [
@@ -117,11 +103,7 @@ __all__ = [
     "DEFAULT_SCHEDULE_RELATIVE",
     "LIMIT_KINDS",
     "PathSchedule",
-    "ScheduleProfiles",
-    "limited_by",
-    "programmed_duration",
     "schedule_path",
-    "schedule_profiles",
     "steady_feeds",
 ]
 
@@ -314,9 +296,10 @@ def _bisected(
 def _checked_rates(
     manipulator: Manipulator, sub: SlerpMoves, grid: Intervals, active: NDArray[np.int64]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """K and G per interval (:func:`_local_rates`), (m, 6) each; a move where one is infinite
-    (no inverse-kinematics solution, a transmission of 0) refused, named (1-based)."""
-    big_k, big_g = _local_rates(manipulator, sub, grid)
+    """K and G per interval (:func:`.schedule_bounds.local_rates`), (m, 6) each; a move where
+    one is infinite (no inverse-kinematics solution, a transmission of 0) refused, named
+    (1-based)."""
+    big_k, big_g = local_rates(manipulator, sub, grid)
     bad = np.flatnonzero(~np.all(np.isfinite(big_g) & np.isfinite(big_k), axis=1))
     if bad.size:
         k = int(active[grid.move[bad[0]]])
@@ -344,24 +327,6 @@ def _actuator_caps(
         speed_cap = np.where(big_g > 0.0, (vmax / big_g) ** 2, np.inf)
         accel_cap = np.where(big_k > 0.0, amax / big_k, np.inf)
     return speed_cap, accel_cap
-
-
-def _tcp_bounds(
-    moves: SlerpMoves, move: NDArray[np.int64], a: NDArray[np.float64], b: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """P per interval: a certified bound of |p'(s)| on [a, b] (module documentation)."""
-    bound: NDArray[np.float64] = np.linalg.norm(moves.dp[move], axis=1)
-    curves = moves.arcs
-    if curves is not None:
-        on = curves.mask[move]
-        if on.any():
-            m = move[on]
-            ends = np.linalg.norm(curves.velocities(m, a[on]), axis=1) + np.linalg.norm(
-                curves.velocities(m, b[on]), axis=1
-            )
-            local = 0.5 * (ends + curves.accel[m] * (b[on] - a[on]))
-            bound[on] = np.minimum(curves.speed[m], local)
-    return bound
 
 
 def _junctions(
@@ -507,9 +472,10 @@ def steady_feeds(
 
     Running move k at ``u' = rate[k]`` (u ∈ [0, 1] its parameter, s̈ = 0) keeps every
     actuator within ``speed_limits`` and ``accel_limits`` everywhere on it: with G_i ≥ |g_i|
-    and K_i ≥ |g_i'| on each interval (:func:`~hexapod_workspace.core.motions.speeds.
-    certified_intervals`, :func:`_local_rates`), ``|q̇_i| ≤ G_i·u'`` and ``|q̈_i| ≤ K_i·u'²``,
-    so ``u'² = min over the move's intervals and actuators of min((v_i/G_i)², a_i/K_i)``.
+    and K_i ≥ |g_i'| on each interval
+    (:func:`~hexapod_workspace.core.motions.speeds.certified_intervals`,
+    :func:`.schedule_bounds.local_rates`), ``|q̇_i| ≤ G_i·u'`` and ``|q̈_i| ≤ K_i·u'²``, so
+    ``u'² = min over the move's intervals and actuators of min((v_i/G_i)², a_i/K_i)``.
     The feed F = u'·L (L = :attr:`PathSchedule.length`) is that of check-path's speed verdicts.
     Junctions between moves are not bounded (the controller's look-ahead).
 
@@ -594,7 +560,7 @@ def _solve(
 
     # the caps X_I per interval, and what sets them
     speed_cap, accel_cap = _actuator_caps(big_g, big_k, vmax, amax)
-    tcp = np.where(rotary[active][move], sub.omega[move], _tcp_bounds(sub, move, a, b))
+    tcp = np.where(rotary[active][move], sub.omega[move], tcp_bounds(sub, move, a, b))
     ceiling = np.where(rotary[active][move], rotary_feed[active][move], feed[active][move])
     with np.errstate(divide="ignore"):
         feed_cap = np.where(tcp > 0.0, (ceiling / tcp) ** 2, np.inf)
@@ -728,97 +694,6 @@ def _solve(
     ), ramp
 
 
-def _rate_derivatives(
-    manipulator: Manipulator, sub: SlerpMoves, moves: NDArray[np.int64], s: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """g_i' = d²q_i/ds² (n, 6) at (moves, s) (module documentation; NaN on curved moves)."""
-    motion, dv = sub.motion_with_accelerations(moves, s)
-    v = motion.joint_velocities
-    arch = architectures.module(manipulator.architecture)
-    if not arch.MOVING_BASE:  # g' = (|v|² − g²)/ℓ + n·v'
-        d = motion.platform - manipulator.base_joints
-        length = np.linalg.norm(d, axis=2)
-        n = d / length[..., None]
-        g = np.sum(n * v, axis=2)
-        result: NDArray[np.float64] = (np.sum(v * v, axis=2) - g * g) / length + np.sum(
-            n * dv, axis=2
-        )
-        return result
-    q, _ = arch.inverse_kinematics(manipulator, motion.platform)
-    q = np.where(np.isfinite(q), q, 0.0)  # unsolved legs are refused by G = inf
-    d = motion.platform - arch.base_ends(manipulator, q)
-    length = np.linalg.norm(d, axis=2)
-    n = d / length[..., None]
-    first, second = arch.base_end_derivatives(manipulator, q)
-    h = np.sum(n * first, axis=2)  # ρ·τ
-    with np.errstate(divide="ignore", invalid="ignore"):
-        g = np.sum(n * v, axis=2) / h
-        dn = (v - first * g[..., None]) / length[..., None]
-        # ρτ·g' = L|n'|² + n·v' − g²·n·A″
-        derivative: NDArray[np.float64] = (
-            length * np.sum(dn * dn, axis=2)
-            + np.sum(n * dv, axis=2)
-            - g * g * np.sum(n * second, axis=2)
-        ) / h
-    return derivative
-
-
-def _third_bound(
-    manipulator: Manipulator,
-    speed: NDArray[np.float64],
-    accel: NDArray[np.float64],
-    jerk: NDArray[np.float64],
-    floor: NDArray[np.float64],
-    rate: NDArray[np.float64],
-) -> NDArray[np.float64]:
-    """K2_i ≥ |g_i″| on an interval where |v| ≤ V, |v′| ≤ A, |v″| ≤ J, the floor holds and
-    |g′| ≤ K (module documentation, "Second order")."""
-    arch = architectures.module(manipulator.architecture)
-    v, a, j, k = speed, accel, jerk, rate
-    if not arch.MOVING_BASE:
-        bound: NDArray[np.float64] = (3.0 * v * a + 2.0 * v * k) / floor + v**3 / floor**2 + j
-        return bound
-    length = manipulator.leg_lengths
-    assert length is not None
-    rho = arch.actuator_lever(manipulator)
-    turning = rho if arch.TURNING_BASE else np.zeros(6)  # |A″| = |A‴| = r for a crank
-    g = v / (rho * floor)  # |g|
-    n1 = v * (1.0 + 1.0 / floor) / length  # |n′|
-    n2 = (a + turning * g * g + rho * k) / length  # |n″|
-    h1 = rho * n1 + g * turning  # |(ρτ)′|
-    e1 = 2.0 * length * n1 * n2 + n1 * a + j + 2.0 * g * k * turning
-    e1 = e1 + g * g * (n1 * turning + turning * g)
-    bound = (e1 + h1 * k) / (rho * floor)
-    return bound
-
-
-def _local_rates(
-    manipulator: Manipulator, sub: SlerpMoves, grid: Intervals
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Tighter certified bounds of |g_i′| and |g_i| per interval: the second-order bound
-    ``(|g′(a)| + |g′(b)| + K2·w)/2`` where it is smaller than K (straight moves), and G from
-    it (module documentation, "Second order")."""
-    move, a, b = grid.move, grid.a, grid.b
-    node_move, node_s, end_node = interval_nodes(move, a, b)
-    derivative = np.abs(_rate_derivatives(manipulator, sub, node_move, node_s))
-    width = (b - a)[:, None]
-    positive = grid.floor > 0.0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        k2 = _third_bound(
-            manipulator,
-            sub.speed[move],
-            sub.accel[move],
-            sub.jerk[move],
-            np.where(positive, grid.floor, 1.0),
-            np.where(np.isfinite(grid.rate), grid.rate, 0.0),
-        )
-        local = 0.5 * (derivative[: move.size] + derivative[end_node] + k2 * width)
-    usable = positive & np.isfinite(local) & np.isfinite(grid.rate)
-    rate = np.where(usable, np.minimum(grid.rate, local), grid.rate)
-    upper = np.minimum(grid.upper, 0.5 * (grid.g_a + grid.g_b + rate * width))
-    return rate, upper
-
-
 def _pass(
     cap: NDArray[np.float64],
     lam: NDArray[np.float64],
@@ -899,142 +774,4 @@ def _still_schedule(
         rotary=rotary,
         length=length,
         intervals=0,
-    )
-
-
-def limited_by(schedule: PathSchedule, ceilings: ArrayLike) -> tuple[list[str], NDArray[np.int64]]:
-    """What holds each move of ``schedule`` below its ceiling.
-
-    A move whose certified peak feed is within :data:`BELOW_CEILING` of its ceiling, and a
-    move that takes no time, is held by its ``feed``; otherwise by what fixed the speed at its
-    fastest node: an actuator's ``velocity`` or ``acceleration`` limit (a move too short to
-    leave rest between two stops counts as acceleration).
-
-    Parameters
-    ----------
-    schedule : PathSchedule
-    ceilings : array_like, shape (M,)
-        Each move's feed ceiling, m/s (rad/s for a rotary move); inf: none.
-
-    Returns
-    -------
-    kinds : list of str, length M
-        ``"feed"``, ``"velocity"`` or ``"acceleration"``.
-    actuators : ndarray, shape (M,), int
-        The limiting actuator, 1-based; 0 for ``feed``.
-    """
-    ceiling = np.asarray(ceilings, dtype=np.float64)
-    count = schedule.t_start.size
-    kinds = ["feed"] * count
-    actuators = np.zeros(count, dtype=np.int64)
-    for k in range(count):
-        top = float(ceiling[k])
-        if schedule.t_end[k] == schedule.t_start[k] or (
-            math.isfinite(top) and schedule.feed_peak[k] >= (1.0 - BELOW_CEILING) * top
-        ):
-            continue
-        nodes = np.flatnonzero(schedule.node_move == k)
-        fastest = nodes[np.argmax(schedule.sdot[nodes])]
-        kind = LIMIT_KINDS[int(schedule.limit_kind[fastest])]
-        kinds[k] = "acceleration" if kind == "rest" else kind
-        if kinds[k] != "feed":
-            actuators[k] = int(schedule.limit_actuator[fastest]) + 1
-    return kinds, actuators
-
-
-def programmed_duration(schedule: PathSchedule, feeds: ArrayLike, rotary_feed: float) -> float:
-    """The time of the path with every move at its programmed feed (no ramps), s.
-
-    Parameters
-    ----------
-    schedule : PathSchedule
-        Its ``length`` and ``rotary`` give each move's length (m) or rotation (rad).
-    feeds : array_like, shape (M,)
-        Programmed feed of each translating move, m/s (NaN: none).
-    rotary_feed : float
-        Rotation rate of the moves without translation, rad/s (NaN: none).
-
-    Returns
-    -------
-    float
-        NaN when a move that moves has no feed; moves that do not move take no time.
-    """
-    programmed = np.where(schedule.rotary, rotary_feed, np.asarray(feeds, dtype=np.float64))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        times = np.where(schedule.length == 0.0, 0.0, schedule.length / programmed)
-    return float(np.sum(times)) if np.all(np.isfinite(times)) else math.nan
-
-
-@dataclass(frozen=True)
-class ScheduleProfiles:
-    """A schedule's quantities at its grid nodes (samples for plots and logs; the certified
-    bounds are :class:`PathSchedule`'s peaks).
-
-    Attributes
-    ----------
-    time : ndarray, shape (n,)
-        s.
-    feed : ndarray, shape (n,)
-        |ṗ| of the tool centre point, m/s.
-    speed : ndarray, shape (n, 6)
-        q̇_i = g_i·ṡ, actuator unit/s.
-    accel : ndarray, shape (n, 6)
-        q̈_i = g_i'·ṡ² + g_i·s̈ with the s̈ of the interval that starts at the node (the last
-        node of a move: of the interval that ends there), actuator unit/s².
-    """
-
-    time: NDArray[np.float64]
-    feed: NDArray[np.float64]
-    speed: NDArray[np.float64]
-    accel: NDArray[np.float64]
-
-
-def schedule_profiles(
-    manipulator: Manipulator,
-    positions: ArrayLike,
-    rotations: ArrayLike,
-    schedule: PathSchedule,
-    *,
-    arcs: ArrayLike | None = None,
-    beziers: ArrayLike | None = None,
-) -> ScheduleProfiles:
-    """Feed, actuator speeds and accelerations at the nodes of ``schedule`` (the path it was
-    computed for; g' by central differences of g, 1e-6 in s, on curved moves)."""
-    p = np.asarray(positions, dtype=np.float64)
-    r = np.asarray(rotations, dtype=np.float64)
-    moves = SlerpMoves(
-        manipulator, p[:-1], p[1:], r[:-1], r[1:], _validate_curves(arcs, beziers, p)
-    )
-    model = ACTUATOR_MODELS[manipulator.architecture]
-    move = schedule.node_move
-    u = np.clip(schedule.s - move, 0.0, 1.0)
-    g, _ = model.evaluate(manipulator, moves.motion(move, u))
-    derivative = _rate_derivatives(manipulator, moves, move, u)
-    curved = ~np.all(np.isfinite(derivative), axis=1)
-    if curved.any():
-        h = 1e-6
-        lo, hi = np.clip(u[curved] - h, 0.0, 1.0), np.clip(u[curved] + h, 0.0, 1.0)
-        g_lo, _ = model.evaluate(manipulator, moves.motion(move[curved], lo))
-        g_hi, _ = model.evaluate(manipulator, moves.motion(move[curved], hi))
-        derivative[curved] = (g_hi - g_lo) / (hi - lo)[:, None]
-    linear = moves.dp[move].copy()
-    if moves.arcs is not None:
-        on = moves.arcs.mask[move]
-        if on.any():
-            linear[on] = moves.arcs.velocities(move[on], u[on])
-    x = schedule.sdot**2
-    # s̈ of the interval starting at each node (a move's last node: the one ending there)
-    same = np.r_[move[1:] == move[:-1], False]
-    width = np.where(same, np.r_[np.diff(schedule.s), 0.0], 0.0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        forward = np.where(
-            width > 0.0, np.r_[np.diff(x), 0.0] / (2.0 * np.where(width > 0, width, 1.0)), 0.0
-        )
-    backward = np.r_[0.0, forward[:-1]]
-    sddot = np.where(same, forward, backward)
-    return ScheduleProfiles(
-        time=schedule.time,
-        feed=np.linalg.norm(linear, axis=1) * schedule.sdot,
-        speed=g * schedule.sdot[:, None],
-        accel=derivative * x[:, None] + g * sddot[:, None],
     )
