@@ -5,7 +5,10 @@ the geometric pose check of the same pose, one pose per call, measured in one ru
 architecture (the packaged examples).
 
 Prints µs per pose for both and their ratio (the issue's goal for a check with the three loads
-rows: at most 3× the geometric check), and the cost of the Jacobian alone for a batch.
+rows: at most 3× the geometric check), the cost of the Jacobian alone for a batch, and a batch
+check of all the poses (:func:`~hexapod_workspace.core.evaluation.check.check`, as the CLI's
+``check`` and the node's ``~/check_poses`` run it) without and with the three rows
+(:func:`~hexapod_workspace.core.evaluation.loads.load_rows`, every pose at once).
 
 Usage: python benchmarks/loads.py [--poses N] [--repeat R]
 """
@@ -20,11 +23,12 @@ import numpy as np
 
 from hexapod_workspace._resources import data_path
 from hexapod_workspace.core.base.rotations import tt_to_matrix
-from hexapod_workspace.core.evaluation.check import check_pose
+from hexapod_workspace.core.evaluation.check import check, check_pose
 from hexapod_workspace.core.evaluation.loading import load_manipulator
 from hexapod_workspace.core.evaluation.loads import (
     actuator_jacobian,
     load_case_from_mapping,
+    load_rows,
     loads_at,
 )
 
@@ -50,8 +54,9 @@ def _best(function: Callable[[], object], repeat: int) -> float:
     return min(times)
 
 
-def _figures(name: str, case: object, poses: int, repeat: int) -> tuple[float, float, float]:
-    """Seconds per pose: check_pose, loads_at, and the batch Jacobian."""
+def _figures(name: str, case: object, poses: int, repeat: int) -> tuple[float, ...]:
+    """Seconds per pose: check_pose, loads_at, the batch Jacobian, the batch check, and the
+    batch check with the rows."""
     manipulator = load_manipulator(data_path("config", name))
     rng = np.random.default_rng(4)
     angles = np.column_stack(
@@ -64,6 +69,7 @@ def _figures(name: str, case: object, poses: int, repeat: int) -> tuple[float, f
     rotations = tt_to_matrix(angles)
     position = manipulator.position
     check_pose(manipulator, *angles[0], position)  # compiled before timing
+    check(manipulator, angles[:2], position)
 
     def geometric() -> None:
         for row in angles:
@@ -76,7 +82,15 @@ def _figures(name: str, case: object, poses: int, repeat: int) -> tuple[float, f
     def batch() -> None:
         actuator_jacobian(manipulator, rotations, position)
 
-    return tuple(_best(f, repeat) / poses for f in (geometric, loads, batch))  # type: ignore[return-value]
+    def batch_check() -> None:
+        check(manipulator, angles, position)
+
+    def batch_rows() -> None:
+        check(manipulator, angles, position)
+        load_rows(manipulator, case, rotations, position)  # type: ignore[arg-type]
+
+    functions = (geometric, loads, batch, batch_check, batch_rows)
+    return tuple(_best(f, repeat) / poses for f in functions)
 
 
 def main() -> None:
@@ -87,14 +101,19 @@ def main() -> None:
     case = load_case_from_mapping(CASE)
     print(f"{options.poses} poses, best of {options.repeat}, one pose per call")
     print(
-        f"{'arch':5} {'check_pose µs':>14} {'loads_at µs':>12} {'ratio':>6} {'J batch µs/pose':>16}"
+        f"{'arch':5} {'check_pose µs':>14} {'loads_at µs':>12} {'ratio':>6} "
+        f"{'J batch µs/pose':>16} {'check batch':>12} {'+ rows':>8} {'ratio':>6}"
     )
     for architecture, name in EXAMPLES.items():
-        geometric, loads, batch = _figures(name, case, options.poses, options.repeat)
+        geometric, loads, batch, many, with_rows = _figures(
+            name, case, options.poses, options.repeat
+        )
         print(
             f"{architecture:5} {geometric * 1e6:14.1f} {loads * 1e6:12.1f} "
-            f"{loads / geometric:6.2f} {batch * 1e6:16.2f}"
+            f"{loads / geometric:6.2f} {batch * 1e6:16.2f} {many * 1e6:12.2f} "
+            f"{with_rows * 1e6:8.2f} {with_rows / many:6.2f}"
         )
+    print("(check batch and + rows: µs per pose of one call for all the poses)")
 
 
 if __name__ == "__main__":

@@ -37,6 +37,7 @@ from hexapod_workspace.core.evaluation.loads import (
     LoadCase,
     actuator_jacobian,
     load_case_from_mapping,
+    load_rows,
     loads_at,
 )
 from hexapod_workspace.errors import ConfigError
@@ -505,3 +506,41 @@ def test_the_worked_example_of_the_loads_page_is_what_the_command_prints(tmp_pat
         code, out, _ = run_main(*args)
         assert code == status, command
         assert out.splitlines() == lines, command
+
+
+@pytest.mark.parametrize("architecture", ["ups", "pus", "rus"])
+def test_the_batch_rows_are_the_per_pose_loads(architecture):
+    """load_rows evaluates every pose at once; each row equals what loads_at gives pose by pose,
+    at random poses that include legs without a solution and near-singular ones (-inf)."""
+    path = CONFIG / EXAMPLES[architecture]
+    reference, manipulator = ra.load(path), load_manipulator(path)
+    rotations, positions = random_poses(reference, 400, seed=11)
+    # and two poses without a regular J: the 6-UPS legs in the base plane (its platform joints
+    # 0.1 m above the platform frame's origin), a position no 6-PUS or 6-RUS leg reaches
+    rotations = np.concatenate([rotations, np.stack([np.eye(3), np.eye(3)])])
+    far = np.asarray(reference.position, dtype=float) + [0.0, 0.0, -3.0]
+    positions = np.concatenate([positions, [[0.0, 0.0, -0.1], far]])
+    case = case_for(architecture)
+    rows = load_rows(manipulator, case, rotations, positions)
+    assert rows is not None and list(rows.margins) == ["actuator_force", "deflection", "accuracy"]
+    singular = 0
+    for k, (rotation, position) in enumerate(zip(rotations, positions, strict=True)):
+        one = loads_at(manipulator, case, rotation, position)
+        expected = {
+            "actuator_force": one.force_margin,
+            "deflection": case.deflection_max - one.deflection_m,
+            "accuracy": case.accuracy_max - one.accuracy_m,
+        }
+        singular += one.singular
+        for name, value in expected.items():
+            got = rows.margins[name][k]
+            if math.isinf(value):
+                assert got == value, (name, k)
+            else:
+                assert got == pytest.approx(value, rel=1e-9, abs=1e-12 * max(1.0, abs(value)))
+        assert rows.limiting_actuator[k] == one.limiting_actuator
+    assert 0 < singular < len(rotations), "need both regular and singular poses"
+    # one pose at a time gives the same rows
+    single = load_rows(manipulator, case, rotations[:1], positions[0])
+    assert single is not None
+    assert single.margins["deflection"][0] == rows.margins["deflection"][0]

@@ -430,6 +430,16 @@ def _largest(
     )
 
 
+def _largest_translations(
+    inverse: NDArray[np.float64], centre: NDArray[np.float64], half: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Per pose, the largest |translation| of ``inverse[n] @ (centre + σ∘half)`` over the 64
+    sign vertices σ (``inverse`` (N, 6, 6)): :func:`_largest` for N poses at once."""
+    moves = np.einsum("vj,nij->nvi", centre + _VERTICES * half, inverse)
+    result: NDArray[np.float64] = np.max(np.linalg.norm(moves[..., :3], axis=-1), axis=1)
+    return result
+
+
 def loads_at(
     manipulator: Manipulator, case: LoadCase, rotation: ArrayLike, position: ArrayLike
 ) -> Loads:
@@ -584,19 +594,40 @@ def load_rows(
     r = np.asarray(rotations, dtype=np.float64).reshape(-1, 3, 3)
     count = r.shape[0]
     p = np.broadcast_to(np.asarray(positions, dtype=np.float64), (count, 3))
-    margins: dict[str, NDArray[np.float64]] = {name: np.empty(count) for name in names}
-    limiting = np.zeros(count, dtype=np.int64)
-    for k in range(count):
-        loads = loads_at(manipulator, case, r[k], p[k])
-        if "actuator_force" in margins:
-            assert loads.force_margin is not None
-            margins["actuator_force"][k] = loads.force_margin
-            limiting[k] = loads.limiting_actuator
-        if "deflection" in margins:
-            assert loads.deflection_m is not None
-            margins["deflection"][k] = case.deflection_max - loads.deflection_m
-        if "accuracy" in margins:
-            assert loads.accuracy_m is not None
-            margins["accuracy"][k] = case.accuracy_max - loads.accuracy_m
+    jacobian = actuator_jacobian(manipulator, r, p)
+    # the same formulas as loads_at, for every pose at once; singular poses answer -inf
+    finite = np.all(np.isfinite(jacobian), axis=(1, 2))
+    safe = np.where(finite[:, None, None], jacobian, np.eye(6))
+    sigma = np.linalg.svd(safe, compute_uv=False)
+    regular = finite & (sigma[:, -1] > SINGULAR_RATIO * sigma[:, 0])
+    safe = np.where(regular[:, None, None], safe, np.eye(6))
+    inverse = np.linalg.inv(safe)
+    margins: dict[str, NDArray[np.float64]] = {}
+    limiting: NDArray[np.int64] = np.zeros(count, dtype=np.int64)
+    rotation6 = np.zeros((count, 6, 6))
+    rotation6[:, :3, :3] = rotation6[:, 3:, 3:] = r
+    if "actuator_force" in names:
+        assert case.force_max is not None and case.force_min is not None
+        to_forces = -np.swapaxes(inverse, 1, 2)  # τ = −J⁻ᵀ·w
+        g = case.gravity
+        load = np.concatenate(
+            [np.broadcast_to(g, (count, 3)), np.cross(r @ case.center_of_mass, g)], axis=1
+        )
+        force = case.mass * np.einsum("nij,nj->ni", to_forces, load) + np.einsum(
+            "nij,nj->ni", to_forces, rotation6 @ case.wrench
+        )
+        spread = np.abs(to_forces @ rotation6) @ case.wrench_range
+        each = np.minimum(case.force_max - (force + spread), (force - spread) - case.force_min)
+        margins["actuator_force"] = np.where(regular, np.min(each, axis=1), -math.inf)
+        limiting = np.where(regular, np.argmin(each, axis=1) + 1, 1).astype(np.int64)
+    if "deflection" in names:
+        assert case.stiffness is not None
+        compliance = inverse @ (np.swapaxes(inverse, 1, 2) / case.stiffness[:, None])
+        worst = _largest_translations(compliance @ rotation6, case.wrench, case.wrench_range)
+        margins["deflection"] = np.where(regular, case.deflection_max - worst, -math.inf)
+    if "accuracy" in names:
+        assert case.actuator_error is not None
+        worst = _largest_translations(inverse, np.zeros(6), case.actuator_error)
+        margins["accuracy"] = np.where(regular, case.accuracy_max - worst, -math.inf)
     unit = architecture_module(manipulator.architecture).FORCE_UNIT
     return LoadRows(margins=margins, limiting_actuator=limiting, force_unit=unit)
