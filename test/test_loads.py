@@ -518,7 +518,7 @@ def test_the_batch_rows_are_the_per_pose_loads(architecture):
     # and two poses without a regular J: the 6-UPS legs in the base plane (its platform joints
     # 0.1 m above the platform frame's origin), a position no 6-PUS or 6-RUS leg reaches
     rotations = np.concatenate([rotations, np.stack([np.eye(3), np.eye(3)])])
-    far = np.asarray(reference.position, dtype=float) + [0.0, 0.0, -3.0]
+    far = np.asarray(reference.position, dtype=float) + np.array([0.0, 0.0, -3.0])
     positions = np.concatenate([positions, [[0.0, 0.0, -0.1], far]])
     case = case_for(architecture)
     rows = load_rows(manipulator, case, rotations, positions)

@@ -53,11 +53,14 @@ def rodrigues(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
     )
 
 
-def coordinates_at(model: Manipulator, p0, p1, r0, r1, s: np.ndarray) -> np.ndarray:
-    """Actuated coordinates (len(s), 6) at ``s`` along the slerp move, from the formulas."""
+def coordinates_at(
+    model: Manipulator, p0, p1, r0, r1, s: np.ndarray, points: np.ndarray | None = None
+) -> np.ndarray:
+    """Actuated coordinates (len(s), 6) at ``s`` along the slerp move, from the formulas; the
+    tool centre point on the chord, or at ``points`` (len(s), 3) for a curved move."""
     axis, angle = log_axis_angle(r1 @ r0.T)
     rotations = rodrigues(axis, s * angle) @ r0
-    positions = p0 + s[:, None] * (p1 - p0)
+    positions = p0 + s[:, None] * (p1 - p0) if points is None else points
     points = positions[:, None, :] + np.einsum("nij,kj->nki", rotations, model.platform_joints)
     d = points - model.base_joints[None]
     if model.architecture == "ups":

@@ -83,12 +83,14 @@ ARC_TOLERANCE = 1e-6
 
 class _CurveKind:
     """One kind of curved move over a batch: arrays with one row per move (``mask``: the moves
-    of this kind; ``speed``, ``length``, ``accel``: the bounds of the module documentation)."""
+    of this kind; ``speed``, ``length``, ``accel``, ``jerk``: the bounds of |p'|, the length,
+    |p''| and |p'''| of the module documentation)."""
 
     mask: NDArray[np.bool_]
     speed: NDArray[np.float64]
     length: NDArray[np.float64]
     accel: NDArray[np.float64]
+    jerk: NDArray[np.float64]
 
     def take(self, moves: NDArray[np.int64]) -> Self:
         """The moves ``moves`` (a new batch of the same kind, in that order)."""
@@ -141,6 +143,8 @@ class _Arcs(_CurveKind):
         self.speed = np.sqrt(base + (largest * self.phi) ** 2)
         self.length = np.sqrt(base + (smallest * self.phi) ** 2)
         self.accel = 2.0 * np.abs(self.drho * self.phi) + largest * self.phi**2
+        # p''' = −3·Δρ·φ²·T − ρ·φ³·A (T, A the unit radial and tangential directions)
+        self.jerk = 3.0 * np.abs(self.drho) * self.phi**2 + largest * np.abs(self.phi) ** 3
 
     def _turned(
         self, moves: NDArray[np.int64], s: NDArray[np.float64]
@@ -170,6 +174,16 @@ class _Arcs(_CurveKind):
             + self.drho[moves][:, None] * turned
             + (rho * self.phi[moves])[:, None] * along
         )
+        return result
+
+    def accelerations(
+        self, moves: NDArray[np.int64], s: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """p''(s) = 2·Δρ·φ·A − ρ·φ²·T (n, 3), m per unit s²."""
+        turned, along, rho = self._turned(moves, s)
+        phi = self.phi[moves]
+        bend = (2.0 * self.drho[moves] * phi)[:, None] * along
+        result: NDArray[np.float64] = bend - (rho * phi**2)[:, None] * turned
         return result
 
 
@@ -243,6 +257,7 @@ class _Beziers(_CurveKind):
         #: Bound of |p'(s)| (m per unit s), the lower bound of the length (m), bound of |p''|.
         self.speed = 3.0 * np.linalg.norm(d, axis=2).max(axis=1)
         self.accel = 6.0 * np.linalg.norm(e, axis=2).max(axis=1)
+        self.jerk = 6.0 * np.linalg.norm(e[:, 1] - e[:, 0], axis=1)  # p''' is constant
         grid = np.linspace(0.0, 1.0, _LENGTH_POINTS, dtype=np.float64)
         points = np.einsum("sk,nkj->nsj", _bernstein(grid), self.control)
         self.length = np.linalg.norm(np.diff(points, axis=1), axis=2).sum(axis=1)
@@ -257,6 +272,16 @@ class _Beziers(_CurveKind):
         d = np.diff(self.control[moves], axis=1)
         weights = np.column_stack([(1.0 - s) ** 2, 2.0 * s * (1.0 - s), s**2]) * 3.0
         result: NDArray[np.float64] = np.einsum("nk,nkj->nj", weights, d)
+        return result
+
+    def accelerations(
+        self, moves: NDArray[np.int64], s: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """p''(s) = 6·((1 − s)·e₀ + s·e₁) (n, 3), m per unit s² (e: second differences of the
+        control points)."""
+        e = np.diff(self.control[moves], n=2, axis=1)
+        weights = np.column_stack([1.0 - s, s]) * 6.0
+        result: NDArray[np.float64] = np.einsum("nk,nkj->nj", weights, e)
         return result
 
 
@@ -278,6 +303,7 @@ class _Curves:
         self.speed = self._merged([k.speed for k in self.kinds])
         self.length = self._merged([k.length for k in self.kinds])
         self.accel = self._merged([k.accel for k in self.kinds])
+        self.jerk = self._merged([k.jerk for k in self.kinds])
 
     def _merged(self, values: list[NDArray[np.float64]]) -> NDArray[np.float64]:
         merged = np.zeros(self.mask.shape)
@@ -291,7 +317,7 @@ class _Curves:
         taken.kinds = [kind.take(moves) for kind in self.kinds]
         taken.mask = self.mask[moves]
         taken.speed, taken.length = self.speed[moves], self.length[moves]
-        taken.accel = self.accel[moves]
+        taken.accel, taken.jerk = self.accel[moves], self.jerk[moves]
         return taken
 
     def _each(
@@ -311,6 +337,12 @@ class _Curves:
     def velocities(self, moves: NDArray[np.int64], s: NDArray[np.float64]) -> NDArray[np.float64]:
         """p'(s) (n, 3), m per unit s."""
         return self._each("velocities", moves, s)
+
+    def accelerations(
+        self, moves: NDArray[np.int64], s: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """p''(s) (n, 3), m per unit s²."""
+        return self._each("accelerations", moves, s)
 
 
 def _validate_beziers(beziers: ArrayLike | None, positions: NDArray[np.float64]) -> _Beziers | None:

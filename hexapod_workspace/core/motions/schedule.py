@@ -33,9 +33,9 @@ so the schedule holds every limit everywhere (not only at grid points) when, at 
 
     x ≤ X_I := min_i((v_i/G_i)², a_i/K_i) and (f/P)²,    |u| ≤ U_I(x) := min_i (a_i − K_i x)/G_i.
 
-**Second order.** The bound K of :mod:`.speeds` is a move-wide worst case; on straight moves
-each interval takes the tighter ``K_loc`` of :mod:`.schedule_bounds` (derived there) and G
-from it. Curved moves (arcs, Bézier spans) keep K.
+**Second order.** The bound K of :mod:`.speeds` is a move-wide worst case; each interval
+takes the tighter ``K_loc`` of :mod:`.schedule_bounds` (derived there, for straight moves,
+arcs and Bézier spans alike) and G from it.
 
 **The passes.** U_I decreases in x, which makes the classic two-pass construction both optimal
 on this grid and feasible. Forward from rest, each node takes the largest x the interval allows

@@ -5,8 +5,12 @@ the tighter second-order bound of |g_i'| on straight moves.
 With g_i = dq_i/du (:mod:`.speeds`) and an interval I = [a, b] of width w:
 
 **Second order.** The bound K of :mod:`.speeds` is a move-wide worst case: it does not shrink
-with the interval, and ``K·x`` would slow every fast stretch down. On straight moves (where
-``v_i' = w × (w × R b_i)`` and ``|v_i''| ≤ J_i := Ω³·|b_i|``) each interval therefore takes
+with the interval, and ``K·x`` would slow every fast stretch down. With the platform joint's
+velocity ``v_i = p' + w × R b_i`` (w = Ω·axis constant along a slerp), ``v_i' = p'' + w × (w ×
+R b_i)`` and ``v_i'' = p''' + w × (w × (w × R b_i))``, so ``|v_i''| ≤ J_i := |p'''| + Ω³·|b_i|``
+with p''' = 0 on a straight move, ``−3Δρφ²·T − ρφ³·A`` on an arc (|p'''| ≤ 3|Δρ|φ² + ρ_max|φ|³)
+and the constant ``6(e₁ − e₀)`` on a Bézier span (``hexapod_workspace.core.motions.interpolation``).
+Each interval therefore takes
 ``K_loc = min(K, (|g'(a)| + |g'(b)| + K2·w)/2)`` (the argument of the certified peak, one
 order up), with g' evaluated exactly at the nodes and K2 ≥ |g''| on the interval. Then G is
 re-derived from K_loc (``G = (|g(a)| + |g(b)| + K_loc·w)/2``, valid for any bound of |g'|).
@@ -20,8 +24,6 @@ re-derived from K_loc (``G = (|g(a)| + |g(b)| + K_loc·w)/2``, valid for any bou
   g²(n'·A'' + g·n·A''')``, so ``g'' = (E' − h'g')/h`` and, with ``|g| ≤ Ĝ := V/(ρτ_f)``,
   ``|n'| ≤ N``, ``|n''| ≤ (A + rĜ² + ρK)/L``, ``|h'| ≤ ρN + rĜ``:
   ``|g''| ≤ (2LN|n''| + NA + J + 2ĜKr + Ĝ²(Nr + rĜ) + |h'|K)/(ρτ_f) =: K2``.
-
-Curved moves (arcs, Bézier spans) keep K (their third derivative is not bounded here).
 
 The tool centre point's speed per unit s: ``P = |Δp|`` on a straight move; on a curve
 ``P = min(P₁, (|p'(a)| + |p'(b)| + P₂·w)/2)`` with P₁, P₂ the curve's bounds of |p'| and |p''|
@@ -61,7 +63,7 @@ def tcp_bounds(
 def rate_derivatives(
     manipulator: Manipulator, sub: SlerpMoves, moves: NDArray[np.int64], s: NDArray[np.float64]
 ) -> NDArray[np.float64]:
-    """g_i' = d²q_i/ds² (n, 6) at (moves, s) (module documentation; NaN on curved moves)."""
+    """g_i' = d²q_i/ds² (n, 6) at (moves, s), exact (module documentation)."""
     motion, dv = sub.motion_with_accelerations(moves, s)
     v = motion.joint_velocities
     arch = architectures.module(manipulator.architecture)

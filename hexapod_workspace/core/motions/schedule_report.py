@@ -119,7 +119,8 @@ def schedule_profiles(
     beziers: ArrayLike | None = None,
 ) -> ScheduleProfiles:
     """Feed, actuator speeds and accelerations at the nodes of ``schedule`` (the path it was
-    computed for; g' by central differences of g, 1e-6 in s, on curved moves)."""
+    computed for; g' exact:
+    :func:`~hexapod_workspace.core.motions.schedule_bounds.rate_derivatives`)."""
     p = np.asarray(positions, dtype=np.float64)
     r = np.asarray(rotations, dtype=np.float64)
     moves = SlerpMoves(
@@ -130,13 +131,6 @@ def schedule_profiles(
     u = np.clip(schedule.s - move, 0.0, 1.0)
     g, _ = model.evaluate(manipulator, moves.motion(move, u))
     derivative = rate_derivatives(manipulator, moves, move, u)
-    curved = ~np.all(np.isfinite(derivative), axis=1)
-    if curved.any():
-        h = 1e-6
-        lo, hi = np.clip(u[curved] - h, 0.0, 1.0), np.clip(u[curved] + h, 0.0, 1.0)
-        g_lo, _ = model.evaluate(manipulator, moves.motion(move[curved], lo))
-        g_hi, _ = model.evaluate(manipulator, moves.motion(move[curved], hi))
-        derivative[curved] = (g_hi - g_lo) / (hi - lo)[:, None]
     linear = moves.dp[move].copy()
     if moves.arcs is not None:
         on = moves.arcs.mask[move]

@@ -381,10 +381,10 @@ class SlerpMoves:
             self.translation = np.where(arcs.mask, arcs.length, self.translation)
         self.speed = travel[:, None] + self.omega[:, None] * radius  # V_i (M, 6)
         self.accel = curvature[:, None] + self.omega[:, None] ** 2 * radius  # A_i (M, 6)
-        # J_i ≥ |d²v_i/ds²| = |w × (w × (w × Rb_i))| on a straight move; curves: NaN (unknown)
-        self.jerk = self.omega[:, None] ** 3 * radius
-        if arcs is not None:
-            self.jerk = np.where(arcs.mask[:, None], np.nan, self.jerk)
+        # J_i ≥ |d²v_i/ds²| = |p''' + w × (w × (w × Rb_i))|, so J_i = |p'''| + Ω³|b_i| (p''' = 0
+        # on a straight move; the curve's bound on arcs and Bézier moves, interpolation)
+        jolt = np.zeros_like(travel) if arcs is None else np.where(arcs.mask, arcs.jerk, 0.0)
+        self.jerk = jolt[:, None] + self.omega[:, None] ** 3 * radius
 
     def _arms(
         self, moves: NDArray[np.int64], s: NDArray[np.float64]
@@ -430,13 +430,16 @@ class SlerpMoves:
     def motion_with_accelerations(
         self, moves: NDArray[np.int64], s: NDArray[np.float64]
     ) -> tuple[LegMotion, NDArray[np.float64]]:
-        """:meth:`motion` and dv_i/ds = w × (w × R(s)·b_i) (n, 6, 3) on straight moves (NaN on
-        curved ones)."""
+        """:meth:`motion` and dv_i/ds = p'' + w × (w × R(s)·b_i) (n, 6, 3) (p'' = 0 on a
+        straight move, the curve's on arcs and Bézier moves)."""
         arms, w = self._arms(moves, s)
         spin = np.broadcast_to(w[:, None, :], arms.shape)
         accelerations: NDArray[np.float64] = np.cross(spin, np.cross(spin, arms))
         if self.arcs is not None:
-            accelerations[self.arcs.mask[moves]] = np.nan
+            curved = self.arcs.mask[moves]
+            if curved.any():
+                bend = self.arcs.accelerations(moves[curved], s[curved])
+                accelerations[curved] += bend[:, None, :]
         return self._leg_motion(moves, s, arms, w), accelerations
 
 
