@@ -393,11 +393,59 @@ class Loads:
     accuracy_rad: float | None
 
 
-def _is_singular(jacobian: NDArray[np.float64]) -> bool:
-    if not np.all(np.isfinite(jacobian)):
-        return True
-    sigma = np.linalg.svd(jacobian, compute_uv=False)
-    return bool(sigma[-1] <= SINGULAR_RATIO * sigma[0])
+def _regular(jacobian: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """Per pose, J (N, 6, 6) finite and not numerically singular (σ_min > SINGULAR_RATIO·σ_max)."""
+    finite = np.all(np.isfinite(jacobian), axis=(1, 2))
+    sigma = np.linalg.svd(np.where(finite[:, None, None], jacobian, np.eye(6)), compute_uv=False)
+    regular: NDArray[np.bool_] = finite & (sigma[:, -1] > SINGULAR_RATIO * sigma[:, 0])
+    return regular
+
+
+def _rotation6(rotations: NDArray[np.float64]) -> NDArray[np.float64]:
+    """R₆ = diag(R, R) per pose, (N, 6, 6)."""
+    rotation6 = np.zeros((rotations.shape[0], 6, 6))
+    rotation6[:, :3, :3] = rotation6[:, 3:, 3:] = rotations
+    return rotation6
+
+
+def _forces(
+    inverse: NDArray[np.float64],
+    rotations: NDArray[np.float64],
+    rotation6: NDArray[np.float64],
+    case: LoadCase,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Per pose (N, 6) each: the actuator forces per kg of payload, those of the process
+    centre, and their spread over the process box (τ = −J⁻ᵀ·w, module documentation)."""
+    to_forces = -np.swapaxes(inverse, 1, 2)
+    g = case.gravity
+    weight = np.concatenate(
+        [np.broadcast_to(g, (rotations.shape[0], 3)), np.cross(rotations @ case.center_of_mass, g)],
+        axis=1,
+    )
+    per_mass = np.einsum("nij,nj->ni", to_forces, weight)
+    fixed = np.einsum("nij,nj->ni", to_forces, rotation6 @ case.wrench)
+    spread: NDArray[np.float64] = np.abs(to_forces @ rotation6) @ case.wrench_range
+    return per_mass, fixed, spread
+
+
+def _force_distances(
+    force: NDArray[np.float64],
+    spread: NDArray[np.float64],
+    low: NDArray[np.float64],
+    high: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """Per actuator, the distance of the force range [force − spread, force + spread] to the
+    limits [low, high] (< 0: a limit is exceeded somewhere over the process box)."""
+    distances: NDArray[np.float64] = np.minimum(high - (force + spread), (force - spread) - low)
+    return distances
+
+
+def _compliance(
+    inverse: NDArray[np.float64], stiffness: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """K⁻¹ = J⁻¹·diag(1/k)·J⁻ᵀ per pose, (N, 6, 6)."""
+    result: NDArray[np.float64] = inverse @ (np.swapaxes(inverse, 1, 2) / stiffness[:, None])
+    return result
 
 
 def _capacity(
@@ -421,23 +469,14 @@ def _capacity(
 
 def _largest(
     inverse: NDArray[np.float64], centre: NDArray[np.float64], half: NDArray[np.float64]
-) -> tuple[float, float]:
-    """Largest |translation| and |rotation| of ``inverse @ (centre + σ∘half)`` over σ ∈ {±1}⁶."""
-    moves = (centre + _VERTICES * half) @ inverse.T
-    return (
-        float(np.max(np.linalg.norm(moves[:, :3], axis=1))),
-        float(np.max(np.linalg.norm(moves[:, 3:], axis=1))),
-    )
-
-
-def _largest_translations(
-    inverse: NDArray[np.float64], centre: NDArray[np.float64], half: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """Per pose, the largest |translation| of ``inverse[n] @ (centre + σ∘half)`` over the 64
-    sign vertices σ (``inverse`` (N, 6, 6)): :func:`_largest` for N poses at once."""
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Per pose, the largest |translation| and |rotation| of ``inverse[n] @ (centre + σ∘half)``
+    over σ ∈ {±1}⁶ (``inverse`` (N, 6, 6); (N,) each)."""
     moves = np.einsum("vj,nij->nvi", centre + _VERTICES * half, inverse)
-    result: NDArray[np.float64] = np.max(np.linalg.norm(moves[..., :3], axis=-1), axis=1)
-    return result
+    return (
+        np.max(np.linalg.norm(moves[..., :3], axis=-1), axis=1),
+        np.max(np.linalg.norm(moves[..., 3:], axis=-1), axis=1),
+    )
 
 
 def loads_at(
@@ -460,9 +499,10 @@ def loads_at(
     -------
     Loads
     """
-    r = np.asarray(rotation, dtype=np.float64)
-    jacobian = actuator_jacobian(manipulator, r, position)[0]
-    singular = _is_singular(jacobian)
+    r = np.asarray(rotation, dtype=np.float64).reshape(1, 3, 3)
+    jacobians = actuator_jacobian(manipulator, r, position)
+    jacobian = jacobians[0]
+    singular = not bool(_regular(jacobians)[0])
     inf6 = np.full(6, math.inf)
     limited = case.force_max is not None and case.force_min is not None
     if singular:
@@ -481,34 +521,31 @@ def loads_at(
             accuracy_m=None if case.actuator_error is None else math.inf,
             accuracy_rad=None if case.actuator_error is None else math.inf,
         )
-    inverse = np.linalg.inv(jacobian)  # J⁻¹: actuator motion -> tool twist
-    to_forces = -inverse.T  # τ = −J⁻ᵀ·w
-    rotation6 = np.zeros((6, 6))
-    rotation6[:3, :3] = rotation6[3:, 3:] = r
-    g = case.gravity
-    per_mass = to_forces @ np.concatenate([g, np.cross(r @ case.center_of_mass, g)])
-    fixed = to_forces @ (rotation6 @ case.wrench)
-    spread = np.abs(to_forces @ rotation6) @ case.wrench_range
+    inverses = np.asarray(np.linalg.inv(jacobians), dtype=np.float64)  # J⁻¹: motion -> twist
+    rotation6 = _rotation6(r)
+    masses, fixeds, spreads = _forces(inverses, r, rotation6, case)
+    per_mass, fixed, spread = masses[0], fixeds[0], spreads[0]
     force = case.mass * per_mass + fixed
     worst = np.abs(force) + spread
     margin: float | None = None
     capacity: float | None = None
     limiting = int(np.argmax(worst)) + 1
     if case.force_max is not None and case.force_min is not None:
-        each = np.minimum(case.force_max - (force + spread), (force - spread) - case.force_min)
+        each = _force_distances(force, spread, case.force_min, case.force_max)
         margin = float(np.min(each))
         limiting = int(np.argmin(each)) + 1
         capacity = _capacity(per_mass, fixed, spread, case.force_min, case.force_max)
     stiffness = deflection_m = deflection_rad = None
     if case.stiffness is not None:
         stiffness = jacobian.T @ (case.stiffness[:, None] * jacobian)
-        compliance = inverse @ (inverse.T / case.stiffness[:, None])  # K⁻¹ = J⁻¹ diag(1/k) J⁻ᵀ
-        deflection_m, deflection_rad = _largest(
-            compliance @ rotation6, case.wrench, case.wrench_range
+        moved, turned = _largest(
+            _compliance(inverses, case.stiffness) @ rotation6, case.wrench, case.wrench_range
         )
+        deflection_m, deflection_rad = float(moved[0]), float(turned[0])
     accuracy_m = accuracy_rad = None
     if case.actuator_error is not None:
-        accuracy_m, accuracy_rad = _largest(inverse, np.zeros(6), case.actuator_error)
+        moved, turned = _largest(inverses, np.zeros(6), case.actuator_error)
+        accuracy_m, accuracy_rad = float(moved[0]), float(turned[0])
     return Loads(
         jacobian=jacobian,
         singular=False,
@@ -595,39 +632,29 @@ def load_rows(
     count = r.shape[0]
     p = np.broadcast_to(np.asarray(positions, dtype=np.float64), (count, 3))
     jacobian = actuator_jacobian(manipulator, r, p)
-    # the same formulas as loads_at, for every pose at once; singular poses answer -inf
-    finite = np.all(np.isfinite(jacobian), axis=(1, 2))
-    safe = np.where(finite[:, None, None], jacobian, np.eye(6))
-    sigma = np.linalg.svd(safe, compute_uv=False)
-    regular = finite & (sigma[:, -1] > SINGULAR_RATIO * sigma[:, 0])
-    safe = np.where(regular[:, None, None], safe, np.eye(6))
-    inverse = np.linalg.inv(safe)
+    # loads_at's formulas for every pose at once; singular poses answer -inf
+    regular = _regular(jacobian)
+    inverse: NDArray[np.float64] = np.linalg.inv(
+        np.where(regular[:, None, None], jacobian, np.eye(6))
+    )
+    rotation6 = _rotation6(r)
     margins: dict[str, NDArray[np.float64]] = {}
     limiting: NDArray[np.int64] = np.zeros(count, dtype=np.int64)
-    rotation6 = np.zeros((count, 6, 6))
-    rotation6[:, :3, :3] = rotation6[:, 3:, 3:] = r
     if "actuator_force" in names:
         assert case.force_max is not None and case.force_min is not None
-        to_forces = -np.swapaxes(inverse, 1, 2)  # τ = −J⁻ᵀ·w
-        g = case.gravity
-        load = np.concatenate(
-            [np.broadcast_to(g, (count, 3)), np.cross(r @ case.center_of_mass, g)], axis=1
-        )
-        force = case.mass * np.einsum("nij,nj->ni", to_forces, load) + np.einsum(
-            "nij,nj->ni", to_forces, rotation6 @ case.wrench
-        )
-        spread = np.abs(to_forces @ rotation6) @ case.wrench_range
-        each = np.minimum(case.force_max - (force + spread), (force - spread) - case.force_min)
+        per_mass, fixed, spread = _forces(inverse, r, rotation6, case)
+        force = case.mass * per_mass + fixed
+        each = _force_distances(force, spread, case.force_min, case.force_max)
         margins["actuator_force"] = np.where(regular, np.min(each, axis=1), -math.inf)
         limiting = np.where(regular, np.argmin(each, axis=1) + 1, 1).astype(np.int64)
     if "deflection" in names:
         assert case.stiffness is not None
-        compliance = inverse @ (np.swapaxes(inverse, 1, 2) / case.stiffness[:, None])
-        worst = _largest_translations(compliance @ rotation6, case.wrench, case.wrench_range)
+        compliance = _compliance(inverse, case.stiffness) @ rotation6
+        worst, _ = _largest(compliance, case.wrench, case.wrench_range)
         margins["deflection"] = np.where(regular, case.deflection_max - worst, -math.inf)
     if "accuracy" in names:
         assert case.actuator_error is not None
-        worst = _largest_translations(inverse, np.zeros(6), case.actuator_error)
+        worst, _ = _largest(inverse, np.zeros(6), case.actuator_error)
         margins["accuracy"] = np.where(regular, case.accuracy_max - worst, -math.inf)
     unit = architecture_module(manipulator.architecture).FORCE_UNIT
     return LoadRows(margins=margins, limiting_actuator=limiting, force_unit=unit)
