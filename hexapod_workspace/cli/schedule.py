@@ -63,7 +63,12 @@ from ..core.cell.frames import CellFrames
 from ..core.model.manipulator import Manipulator
 from ..core.motions import DEFAULT_PLAN_PSI_STEP, reported_parts
 from ..core.motions.schedule import PathSchedule, schedule_path, steady_feeds
-from ..core.motions.schedule_report import limited_by, programmed_duration
+from ..core.motions.schedule_report import (
+    feed_ceilings,
+    limited_by,
+    programmed_duration,
+    rapid_boundaries,
+)
 from ..core.motions.speeds import ACTUATOR_MODELS, actuator_rates, feed_limits
 from ..errors import InputError
 from .cam import (
@@ -97,9 +102,7 @@ def _ceilings(
     """Per move: the feed ceiling (m/s, inf: none), the rotary ceiling of moves without
     translation (rad/s) and the programmed feed of moves with translation (m/s, NaN: none)."""
     rapid_feed, rotary_feed, feed_max = feeds
-    programmed = np.where(part.rapid[1:], rapid_feed, part.feeds[1:])
-    cap = math.inf if math.isnan(feed_max) else feed_max
-    linear = np.minimum(np.where(np.isnan(programmed), math.inf, programmed), cap)
+    linear, programmed = feed_ceilings(part.feeds[1:], part.rapid[1:], rapid_feed, feed_max)
     turning = np.full(linear.size, math.inf if math.isnan(rotary_feed) else rotary_feed)
     return linear, turning, programmed
 
@@ -158,9 +161,7 @@ def _schedule_part(
     rotations = tt_to_matrix(checked.waypoints.angles)
     positions = checked.waypoints.positions
     linear, turning, programmed = _ceilings(part, feeds)
-    stops = np.zeros(len(positions), dtype=bool)
-    if options.stop_at_rapids:
-        stops[1:-1] = part.rapid[1:-1] != part.rapid[2:]
+    stops = rapid_boundaries(part.rapid[1:]) if options.stop_at_rapids else None
     try:
         schedule = schedule_path(
             model,

@@ -32,7 +32,12 @@ from numpy.typing import NDArray
 from ..core.base.rotations import quaternion_to_matrix
 from ..core.motions import DEFAULT_PATH_TOLERANCE, check_path
 from ..core.motions.schedule import schedule_path
-from ..core.motions.schedule_report import limited_by, programmed_duration
+from ..core.motions.schedule_report import (
+    feed_ceilings,
+    limited_by,
+    programmed_duration,
+    rapid_boundaries,
+)
 from ..core.motions.speeds import ACTUATOR_MODELS
 from ..errors import HexapodWorkspaceError, InputError
 from ..logs.cell import DEG_MIN, MM_MIN, cell_frames_fields
@@ -63,9 +68,7 @@ def _ceilings(
     rapid_feed = cell.optional_rate(request.rapid_feed_mm_min, "rapid_feed_mm_min", "mm/min")
     rotary = cell.optional_rate(request.rotary_feed_deg_min, "rotary_feed_deg_min", "deg/min")
     feed_max = cell.optional_rate(request.feed_max_mm_min, "feed_max_mm_min", "mm/min")
-    programmed = np.where(rapid, rapid_feed * MM_MIN, feeds)
-    cap = math.inf if math.isnan(feed_max) else feed_max * MM_MIN
-    linear = np.minimum(np.where(np.isnan(programmed), math.inf, programmed), cap)
+    linear, programmed = feed_ceilings(feeds, rapid, rapid_feed * MM_MIN, feed_max * MM_MIN)
     return linear, programmed, rotary * DEG_MIN, rapid
 
 
@@ -79,8 +82,8 @@ def _stops(request: Any, count: int, rapid: NDArray[np.bool_]) -> NDArray[np.boo
             )
             raise InputError(msg)
         stops = np.asarray(list(request.stops), dtype=bool)
-    if request.stop_at_rapids and count > 1:
-        stops[1:-1] |= rapid[:-1] != rapid[1:]
+    if request.stop_at_rapids:
+        stops |= rapid_boundaries(rapid)
     return stops
 
 

@@ -19,7 +19,52 @@ from .schedule import BELOW_CEILING, LIMIT_KINDS, PathSchedule
 from .schedule_bounds import rate_derivatives
 from .speeds import ACTUATOR_MODELS, SlerpMoves
 
-__all__ = ["ScheduleProfiles", "limited_by", "programmed_duration", "schedule_profiles"]
+__all__ = [
+    "ScheduleProfiles",
+    "feed_ceilings",
+    "limited_by",
+    "programmed_duration",
+    "rapid_boundaries",
+    "schedule_profiles",
+]
+
+
+def feed_ceilings(
+    feeds: ArrayLike, rapid: ArrayLike, rapid_feed: float, feed_max: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Each move's feed ceiling and programmed feed, as ``schedule`` and ``~/schedule_path``
+    take them: a rapid move's is ``rapid_feed``, another's its own feed; the ceiling is that
+    (the programmed feed is a ceiling, not a target), at most ``feed_max``.
+
+    Parameters
+    ----------
+    feeds : array_like, shape (M,)
+        Programmed feed of each move, m/s (NaN: none).
+    rapid : array_like, shape (M,), bool
+        The rapid moves.
+    rapid_feed, feed_max : float
+        m/s; NaN: none.
+
+    Returns
+    -------
+    ceilings : ndarray, shape (M,)
+        m/s; inf where no feed and no ``feed_max`` bound the move.
+    programmed : ndarray, shape (M,)
+        m/s; NaN where the move has no feed.
+    """
+    programmed = np.where(np.asarray(rapid, dtype=bool), rapid_feed, feeds).astype(np.float64)
+    cap = math.inf if math.isnan(feed_max) else feed_max
+    ceilings = np.minimum(np.where(np.isnan(programmed), math.inf, programmed), cap)
+    return ceilings, programmed
+
+
+def rapid_boundaries(rapid: ArrayLike) -> NDArray[np.bool_]:
+    """Per waypoint (M + 1,), whether a rapid run of moves begins or ends there (``rapid``
+    (M,), bool): where ``--stop-at-rapids`` and ``stop_at_rapids`` rest."""
+    moves = np.asarray(rapid, dtype=bool)
+    stops = np.zeros(moves.size + 1, dtype=bool)
+    stops[1:-1] = moves[:-1] != moves[1:]
+    return stops
 
 
 def limited_by(schedule: PathSchedule, ceilings: ArrayLike) -> tuple[list[str], NDArray[np.int64]]:
