@@ -159,3 +159,35 @@ def test_bad_input_exits_2_in_one_line(tmp_path, csv_path):
     code, _, err = run_main("schedule", str(csv_path), "--config", str(unlimited))
     assert code == 2
     assert "move 1: no limit bounds its speed" in one_error_line(err)
+
+
+APPROACH = """UNITS / MM
+MULTAX / ON
+RAPID
+GOTO / 0.0, 0.0, 25.0, 0.0, 0.0, 1.0
+RAPID
+GOTO / 0.0, 0.0, 5.0, 0.0, 0.0, 1.0
+FEDRAT / 250.0, MMPM
+GOTO / 0.0, 0.0, -4.0, 0.0, 0.0, 1.0
+GOTO / 10.0, 0.0, -4.0, 0.0, 0.0, 1.0
+"""
+
+
+def test_stop_at_rapids_rests_where_rapid_runs_begin_and_end(tmp_path):
+    """A rapid approach straight into a plunge along the same line: the schedule runs through
+    their waypoint, and rests there with --stop-at-rapids."""
+    path = tmp_path / "approach.cl"
+    path.write_text(APPROACH, encoding="utf-8")
+    cell = Path(__file__).resolve().parents[1] / "examples" / "cell_gpm.yaml"
+    arguments = ["schedule", str(path), "--config", str(cell), "--json"]
+    arguments += ["--rapid-feed-mm-min", "3000"]
+    code, out, err = run_main(*arguments)
+    assert code == 0, err
+    plain = json.loads(out)
+    assert [m["rapid"] for m in plain["moves"]] == [True, False, False]
+    assert plain["stops"] == [0, 2, 3]  # run through waypoint 1; the corner at 2 rests
+    code, out, err = run_main(*arguments, "--stop-at-rapids")
+    assert code == 0, err
+    stopped = json.loads(out)
+    assert stopped["stops"] == [0, 1, 2, 3]
+    assert stopped["duration_s"] > plain["duration_s"]
