@@ -29,7 +29,6 @@ from numpy.typing import NDArray
 from rclpy.exceptions import InvalidHandle
 from rclpy.serialization import deserialize_message
 
-from hexapod_workspace.core.base.rotations import tt_to_matrix
 from hexapod_workspace.core.constraints.table import constraint_names
 from hexapod_workspace.core.evaluation.check import check
 from hexapod_workspace.errors import InputError
@@ -141,7 +140,7 @@ class CommandStream:
         for k, command in enumerate(batch):
             result, index, reason = verdicts[k]
             if result is not None and id(result) not in checks:  # with the loads rows set
-                rows = load_rows_of(state, tt_to_matrix(result.angles), result.position)
+                rows = load_rows_of(state, result.position, angles=result.angles)
                 checks[id(result)] = with_load_rows(messages.pose_checks_fields(result), rows)
             fields = messages.reachability_result_fields(
                 result,

@@ -24,7 +24,6 @@ import numpy as np
 from hexapod_workspace_msgs.srv import CheckPosesFlat
 from numpy.typing import NDArray
 
-from hexapod_workspace.core.base.rotations import tt_to_matrix
 from hexapod_workspace.core.constraints.table import constraint_names
 from hexapod_workspace.core.evaluation.check import CONSTRAINT_NAMES, CheckResult, check
 from hexapod_workspace.core.evaluation.loads import LoadRows
@@ -149,7 +148,7 @@ def attach(node: Any, name: str) -> Any:
                     position,
                     singularity=state.settings.report_singularity,
                 ),
-                loads=load_rows_of(state, tt_to_matrix(angles), position),
+                loads=load_rows_of(state, position, angles=angles),
             )
         except InputError as error:
             answer = flat_response(None, message=str(error), names=names)

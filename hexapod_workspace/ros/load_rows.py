@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..core.base.rotations import quaternion_to_matrix, tt_to_matrix
 from ..core.evaluation.loads import LoadCase, LoadRows, load_rows
 from ..core.model.manipulator import Manipulator
 from ..errors import InputError
@@ -66,12 +67,31 @@ _LIMIT_OF = {
 
 
 def load_rows_of(
-    state: State, rotations: NDArray[np.float64], positions: NDArray[np.float64]
+    state: State,
+    positions: NDArray[np.float64],
+    *,
+    angles: NDArray[np.float64] | None = None,
+    quaternions: NDArray[np.float64] | None = None,
 ) -> LoadRows | None:
-    """The loads rows the node's parameters set at N tool poses (rotations (N, 3, 3) and
-    positions (N, 3) or (3,), base frame, m); None when no loads limit is set."""
+    """The loads rows the node's parameters set at N tool poses, or None when no loads limit
+    is set (then nothing is computed: the pose verdicts' path pays nothing without loads).
+
+    Parameters
+    ----------
+    state : State
+    positions : ndarray, shape (N, 3) or (3,)
+        Tool centre points, base frame, m.
+    angles, quaternions : ndarray, shape (N, 3) or (N, 4)
+        The tool frames' orientations, base frame: T&T angles (rad) or quaternions
+        ``(x, y, z, w)``; one of the two.
+    """
     if not state.loads.limited_rows:
         return None
+    if quaternions is not None:
+        rotations = quaternion_to_matrix(quaternions)
+    else:
+        assert angles is not None, "give angles or quaternions"
+        rotations = tt_to_matrix(angles)
     return load_rows(state.manipulator, tool_case(state), rotations, positions)
 
 

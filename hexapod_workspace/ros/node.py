@@ -85,7 +85,6 @@ from hexapod_workspace._resources import example_config_path
 from hexapod_workspace.core import kernels
 from hexapod_workspace.core.base import params
 from hexapod_workspace.core.base.params import NODE_PARAMETERS, ROS_PARAMETERS, unknown_parameter
-from hexapod_workspace.core.base.rotations import tt_to_matrix
 from hexapod_workspace.core.evaluation.check import check
 from hexapod_workspace.core.kernels import planner as planner_kernels
 from hexapod_workspace.core.model.manipulator import Manipulator
@@ -603,7 +602,7 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
                     position,
                     singularity=state.settings.report_singularity,
                 )
-                rows = load_rows_of(state, tt_to_matrix(angles), position)
+                rows = load_rows_of(state, position, angles=angles)
                 return check_poses_with_loads(messages.check_poses_response_fields(result), rows)
             except InputError as error:
                 reason = str(error)

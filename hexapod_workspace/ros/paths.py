@@ -148,7 +148,7 @@ def check_poses_from_poses(
         result = check_waypoints(manipulator, positions, quaternions=quaternions)
         rows = None
         if state is not None:
-            rows = load_rows_of(state, quaternion_to_matrix(quaternions), positions)
+            rows = load_rows_of(state, positions, quaternions=quaternions)
     except InputError as error:
         return messages.check_poses_response_fields(None, success=False, message=str(error))
     return check_poses_with_loads(messages.check_poses_response_fields(result), rows)
