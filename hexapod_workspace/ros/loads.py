@@ -17,7 +17,6 @@ Units: N (legs, slides) or N·m (cranks), m, rad, kg; matrices row-major.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -33,7 +32,7 @@ from . import cell
 from .load_rows import tool_case
 from .parameters import State
 from .paths import pose_arrays
-from .services import RecordedService
+from .services import fields_service
 
 __all__ = ["attach_loads", "loads_response_fields"]
 
@@ -105,9 +104,7 @@ def loads_response_fields(state: State, request: Any) -> dict[str, Any]:
     }
 
 
-def attach_loads(
-    node: Any, get_state: Callable[[], State], recorder: Any | None = None
-) -> RecordedService:
-    """Create ``~/loads`` on ``node``, answered by :func:`loads_response_fields` with the state
-    ``get_state`` returns, its calls recorded by ``recorder``."""
-    return RecordedService(node, LoadsService, "loads", loads_response_fields, get_state, recorder)
+def attach_loads(node: Any) -> Any:
+    """Create ``~/loads`` on ``node``, answered by :func:`loads_response_fields` with the node's
+    state and recorded (:func:`~hexapod_workspace.ros.services.fields_service`)."""
+    return fields_service(node, LoadsService, "loads", loads_response_fields)

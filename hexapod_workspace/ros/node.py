@@ -294,9 +294,9 @@ class WorkspaceNode(ManagedTransitions, LifecycleNode):
             lambda: self.configured_state,
         )
         # ~/schedule_path (hexapod_workspace.ros.schedule)
-        self.schedules = attach_schedule(self, lambda: self.configured_state, self.recorder)
+        self.schedules = attach_schedule(self)
         # ~/loads (hexapod_workspace.ros.loads)
-        self.loads = attach_loads(self, lambda: self.configured_state, self.recorder)
+        self.loads = attach_loads(self)
         self.cell_status = cell.CellStatus(self)  # parameter changes: log and /diagnostics
         self._extensions = list(extensions)
         for attach in self._extensions:

@@ -22,7 +22,6 @@ them; actuator speeds m/s (legs, slides) or rad/s (cranks).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -45,7 +44,7 @@ from . import cell
 from .load_rows import require_geometric
 from .parameters import State
 from .paths import curve_rows, pose_arrays, positive_option
-from .services import RecordedService
+from .services import fields_service
 
 __all__ = ["MAX_WAYPOINTS", "attach_schedule", "schedule_response_fields"]
 
@@ -197,12 +196,7 @@ def schedule_response_fields(state: State, request: Any) -> dict[str, Any]:
     }
 
 
-def attach_schedule(
-    node: Any, get_state: Callable[[], State], recorder: Any | None = None
-) -> RecordedService:
+def attach_schedule(node: Any) -> Any:
     """Create ``~/schedule_path`` on ``node``, answered by :func:`schedule_response_fields`
-    with the state ``get_state`` returns, its calls recorded by ``recorder``
-    (:class:`~hexapod_workspace.ros.services.RecordedService`)."""
-    return RecordedService(
-        node, SchedulePath, "schedule_path", schedule_response_fields, get_state, recorder
-    )
+    with the node's state and recorded (:func:`~hexapod_workspace.ros.services.fields_service`)."""
+    return fields_service(node, SchedulePath, "schedule_path", schedule_response_fields)
